@@ -1,0 +1,49 @@
+#include "apps/commands.h"
+
+#include <cstdio>
+#include <vector>
+
+namespace sft {
+namespace {
+
+const CommandEntry kCommands[] = {
+    {"synth", "Render a synthetic dataset (sft-dataset/1) of a mesh from Fibonacci-sphere cameras",
+     &SetupSynthCommand},
+    {"render", "Render every view of a dataset with a given mesh and material",
+     &SetupRenderCommand},
+};
+
+}  // namespace
+
+int PrintError(const std::string& command, const Status& status) {
+  std::fprintf(stderr, "sft %s: error: %s\n", command.c_str(), status.message().c_str());
+  return 1;
+}
+
+int RunCommandTable(int argc, char** argv) {
+  CLI::App app{"sft — Shape from Tracing: reconstruct a mesh and its spatially varying material "
+               "from calibrated photographs with a differentiable path tracer.",
+               "sft"};
+  app.require_subcommand(1);
+  // One error line; no "Run with --help" epilogue.
+  app.failure_message([](const CLI::App* failed, const CLI::Error& e) {
+    return "sft " + failed->get_name() + ": error: " + std::string(e.what()) + "\n";
+  });
+  std::vector<std::pair<CLI::App*, CommandRunner>> runners;
+  for (const CommandEntry& entry : kCommands) {
+    CLI::App* sub = app.add_subcommand(entry.name, entry.description);
+    runners.emplace_back(sub, entry.setup(sub));
+  }
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    return code == 0 ? 0 : 2;
+  }
+  for (auto& [sub, runner] : runners) {
+    if (sub->parsed()) return runner();
+  }
+  return 2;
+}
+
+}  // namespace sft

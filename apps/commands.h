@@ -1,0 +1,38 @@
+// The command table of the `sft` CLI. Each command lives in apps/<name>_command.cc and provides a
+// Setup function that declares its options on a CLI11 subcommand and returns the function that
+// runs it. A command returns the process exit code: 0 on success, 1 on a user error (after
+// printing one line "sft CMD: error: ..." via PrintError), 2 on a usage error.
+#ifndef SFT_APPS_COMMANDS_H_
+#define SFT_APPS_COMMANDS_H_
+
+#include <functional>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "src/core/status.h"
+
+namespace sft {
+
+using CommandRunner = std::function<int()>;
+using CommandSetup = CommandRunner (*)(CLI::App* app);
+
+struct CommandEntry {
+  const char* name;
+  const char* description;
+  CommandSetup setup;
+};
+
+// Prints "sft CMD: error: MESSAGE" on stderr and returns 1.
+int PrintError(const std::string& command, const Status& status);
+
+int RunCommandTable(int argc, char** argv);
+
+// One per command file.
+CommandRunner SetupSynthCommand(CLI::App* app);
+CommandRunner SetupRenderCommand(CLI::App* app);
+
+
+}  // namespace sft
+
+#endif  // SFT_APPS_COMMANDS_H_

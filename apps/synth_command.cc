@@ -1,0 +1,284 @@
+// sft synth: renders a synthetic dataset of a mesh in the report's setup (DESIGN.md §1): cameras
+// on a Fibonacci sphere looking at the object, one or more zoom levels, a camera-attached point
+// light (or an environment probe), black background, masks from pixel coverage, and the ground
+// truth (normalized mesh and material) under gt/.
+//
+// Decisions (README "sft synth"): the mesh is centred on its bounding-box centre and scaled to a
+// bounding-box diagonal of 1 (--no-normalize keeps it as is); --up-axis y rotates y-up meshes to
+// the z-up world (x, y, z) -> (x, −z, y) as the Cycles dataset tool does; the camera distance puts
+// the bounding sphere at --fill of the half-image at zoom 1; zoom z multiplies the focal length.
+// The default light intensity gives a white Lambertian patch facing the camera at the object's
+// centre a radiance of 0.5. The dataset is written to OUT.partial and renamed to OUT at the end.
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <filesystem>
+
+#include "apps/commands.h"
+#include "src/core/file_util.h"
+#include "src/core/progress.h"
+#include "src/geometry/material.h"
+#include "src/geometry/mesh.h"
+#include "src/io/dataset.h"
+#include "src/io/image_io.h"
+#include "src/io/scene_setup.h"
+#include "src/render/render.h"
+
+namespace sft {
+namespace {
+namespace fs = std::filesystem;
+
+struct SynthOptions {
+  std::string mesh;
+  std::string out;
+  std::string material;
+  int cameras = 32;
+  std::vector<double> zooms = {1.0, 2.0};
+  int res = 128;
+  double fov_deg = 40.0;
+  double fill = 0.6;
+  std::string up_axis = "z";
+  bool normalize = true;
+  std::vector<double> light_offset = {0.15, 0.0, 0.0};
+  double light_intensity = -1.0;  // < 0: automatic (see file comment).
+  std::string envmap;
+  double envmap_scale = 1.0;
+  bool environment_background = false;
+  RenderOptions render;
+  std::string effects = "all";
+  bool overwrite = false;
+  bool quiet = false;
+};
+
+// cam_from_world for a camera at `center` looking at `target`, +y of the image pointing as close
+// to world −up as possible (COLMAP: x right, y down, z forward).
+Rigid3d LookAt(const Eigen::Vector3d& center, const Eigen::Vector3d& target,
+               const Eigen::Vector3d& up) {
+  const Eigen::Vector3d forward = (target - center).normalized();
+  Eigen::Vector3d right = forward.cross(up);
+  if (right.norm() < 1e-6) right = forward.cross(Eigen::Vector3d(0, 1, 0));
+  right.normalize();
+  const Eigen::Vector3d down = forward.cross(right);
+  Eigen::Matrix3d rotation;
+  rotation.row(0) = right;
+  rotation.row(1) = down;
+  rotation.row(2) = forward;
+  Rigid3d cam_from_world;
+  cam_from_world.rotation = Eigen::Quaterniond(rotation).normalized();
+  if (cam_from_world.rotation.w() < 0) cam_from_world.rotation.coeffs() *= -1.0;
+  cam_from_world.translation = -(rotation * center);
+  return cam_from_world;
+}
+
+Status CheckSynthOptions(const SynthOptions& o) {
+  if (o.cameras < 1 || o.cameras > 10000) return Status::Error("--cameras: must be in [1, 10000]");
+  if (o.zooms.empty()) return Status::Error("--zooms: needs at least one value");
+  for (double z : o.zooms) {
+    if (!(z > 0) || !std::isfinite(z)) return Status::Error("--zooms: values must be > 0");
+  }
+  if (o.res < 1 || o.res > 16384) return Status::Error("--res: must be in [1, 16384]");
+  if (!(o.fov_deg > 0 && o.fov_deg < 179)) return Status::Error("--fov: must be in (0, 179)");
+  if (!(o.fill > 0 && o.fill <= 10)) return Status::Error("--fill: must be in (0, 10]");
+  if (o.up_axis != "y" && o.up_axis != "z") return Status::Error("--up-axis: must be y or z");
+  if (o.light_offset.size() != 3) return Status::Error("--light-offset: needs 3 numbers x,y,z");
+  if (!(o.envmap_scale >= 0)) return Status::Error("--envmap-scale: must be >= 0");
+  if (o.environment_background && o.envmap.empty()) {
+    return Status::Error("--background-environment: needs --envmap");
+  }
+  return Status::Ok();
+}
+
+Status RunSynth(const SynthOptions& opts) {
+  SFT_RETURN_IF_ERROR(CheckSynthOptions(opts));
+  RenderOptions render = opts.render;
+  std::string why;
+  if (!Effects::Parse(opts.effects, &render.effects, &why)) return Status::Error("--" + why);
+  if (!render.Check(&why)) return Status::Error("--" + why);
+  std::error_code ec;
+  if (fs::exists(opts.out, ec) && !fs::is_empty(opts.out, ec) && !opts.overwrite) {
+    return Status::Error(opts.out + ": output exists and is not empty (use --overwrite)");
+  }
+
+  TriMesh mesh;
+  SFT_RETURN_IF_ERROR(ReadMesh(opts.mesh, &mesh));
+  if (opts.up_axis == "y") {
+    for (auto vh : mesh.vertices()) {
+      const auto p = mesh.point(vh);
+      mesh.set_point(vh, TriMesh::Point(p[0], -p[2], p[1]));
+    }
+  }
+  if (opts.normalize) {
+    Eigen::Vector3d lo, hi;
+    MeshBounds(mesh, &lo, &hi);
+    const Eigen::Vector3d centre = 0.5 * (lo + hi);
+    const double diagonal = (hi - lo).norm();
+    if (!(diagonal > 0)) return Status::Error(opts.mesh + ": mesh has zero extent");
+    for (auto vh : mesh.vertices()) {
+      const auto p = mesh.point(vh);
+      mesh.set_point(vh, TriMesh::Point((p[0] - centre.x()) / diagonal,
+                                        (p[1] - centre.y()) / diagonal,
+                                        (p[2] - centre.z()) / diagonal));
+    }
+  }
+  Material material;
+  SFT_RETURN_IF_ERROR(LoadMaterial(opts.material, mesh, &material));
+
+  Eigen::Vector3d lo, hi;
+  MeshBounds(mesh, &lo, &hi);
+  const Eigen::Vector3d target = 0.5 * (lo + hi);
+  const double radius = 0.5 * (hi - lo).norm();
+  const double tan_half = std::tan(0.5 * opts.fov_deg * M_PI / 180.0);
+  const double focal = 0.5 * opts.res / tan_half;
+  const double distance = radius / (opts.fill * tan_half);
+
+  const std::string partial = opts.out + ".partial";
+  fs::remove_all(partial, ec);
+  SFT_RETURN_IF_ERROR(MakeDirectories(partial));
+
+  Dataset dataset;
+  dataset.root = partial;
+  for (size_t z = 0; z < opts.zooms.size(); ++z) {
+    Camera camera;
+    camera.id = "zoom" + std::to_string(z);
+    camera.model = CameraModel::kPinhole;
+    camera.width = camera.height = opts.res;
+    const double f = focal * opts.zooms[z];
+    camera.params = {f, f, 0.5 * opts.res, 0.5 * opts.res};
+    dataset.cameras.push_back(camera);
+  }
+  if (opts.envmap.empty()) {
+    LightSpec light;
+    light.id = "flash";
+    light.type = LightType::kPoint;
+    light.frame = LightFrame::kCamera;
+    light.position = Eigen::Vector3d(opts.light_offset[0], opts.light_offset[1],
+                                     opts.light_offset[2]);
+    const double intensity =
+        opts.light_intensity >= 0 ? opts.light_intensity : 0.5 * M_PI * distance * distance;
+    light.intensity = Eigen::Vector3d::Constant(intensity);
+    dataset.lights.push_back(light);
+  } else {
+    Image probe;
+    SFT_RETURN_IF_ERROR(ReadImage(opts.envmap, &probe));
+    const std::string probe_name = "probes/" + fs::path(opts.envmap).stem().string() + ".exr";
+    SFT_RETURN_IF_ERROR(WriteExr(JoinPath(partial, probe_name), probe));
+    LightSpec light;
+    light.id = "probe";
+    light.type = LightType::kEnvironment;
+    light.image = probe_name;
+    light.scale = opts.envmap_scale;
+    dataset.lights.push_back(light);
+    if (opts.environment_background) dataset.background = Background::kEnvironment;
+  }
+  const Eigen::Vector3d up(0, 0, 1);
+  const double golden = M_PI * (3.0 - std::sqrt(5.0));
+  int index = 0;
+  for (size_t z = 0; z < opts.zooms.size(); ++z) {
+    for (int k = 0; k < opts.cameras; ++k, ++index) {
+      const double cz = 1.0 - (2.0 * k + 1.0) / opts.cameras;
+      const double r = std::sqrt(std::max(0.0, 1.0 - cz * cz));
+      const double phi = golden * k;
+      const Eigen::Vector3d dir(r * std::cos(phi), r * std::sin(phi), cz);
+      ViewSpec view;
+      char name[32];
+      std::snprintf(name, sizeof(name), "%03d", index);
+      view.image = std::string("images/") + name + ".exr";
+      view.mask = std::string("masks/") + name + ".png";
+      view.camera_id = dataset.cameras[z].id;
+      view.camera = static_cast<int>(z);
+      view.light_ids = {dataset.lights[0].id};
+      view.lights = {0};
+      view.cam_from_world = LookAt(target + distance * dir, target, up);
+      dataset.views.push_back(view);
+    }
+  }
+  DatasetViews views;
+  SFT_RETURN_IF_ERROR(MakeDatasetViews(dataset, &views));
+  const RenderScene scene(mesh);
+  Progress progress("synth", static_cast<int64_t>(views.views.size()), !opts.quiet);
+  for (size_t v = 0; v < views.views.size(); ++v) {
+    Image image;
+    RenderView(scene, material, views.views[v], render, &image);
+    Image mask(image.width, image.height, 1);
+    for (int y = 0; y < image.height; ++y) {
+      for (int x = 0; x < image.width; ++x) mask.at(x, y) = image.at(x, y, 3) > 0.5f ? 1.f : 0.f;
+    }
+    SFT_RETURN_IF_ERROR(WriteExr(JoinPath(partial, dataset.views[v].image), image));
+    SFT_RETURN_IF_ERROR(WritePng(JoinPath(partial, dataset.views[v].mask), mask, false));
+    progress.Advance();
+  }
+  progress.Finish();
+
+  SFT_RETURN_IF_ERROR(WriteMesh(JoinPath(partial, "gt/mesh.ply"), mesh));
+  SFT_RETURN_IF_ERROR(SaveMaterial(JoinPath(partial, "gt/material.json"), material));
+  dataset.gt_mesh = "gt/mesh.ply";
+  dataset.ground_truth = {{"mesh", "gt/mesh.ply"},
+                          {"material", "gt/material.json"},
+                          {"renderer", "sft"},
+                          {"samples", render.spp},
+                          {"bounces", render.bounces},
+                          {"seed", render.seed},
+                          {"source_mesh", opts.mesh}};
+  SFT_RETURN_IF_ERROR(WriteSceneJson(dataset, partial));
+  if (fs::exists(opts.out, ec)) fs::remove_all(opts.out, ec);
+  fs::rename(partial, opts.out, ec);
+  if (ec) return Status::Error(opts.out + ": cannot move the finished dataset in place (" +
+                               ec.message() + ")");
+  return Status::Ok();
+}
+
+}  // namespace
+
+CommandRunner SetupSynthCommand(CLI::App* app) {
+  auto opts = std::make_shared<SynthOptions>();
+  opts->render.spp = 512;
+  opts->render.bounces = 2;
+  app->add_option("--mesh", opts->mesh, "Object mesh (OBJ, PLY, OFF)")->required();
+  app->add_option("--out", opts->out, "Output dataset directory")->required();
+  app->add_option("--material", opts->material, "Material JSON file or inline JSON");
+  app->add_option("--cameras", opts->cameras, "Cameras on the Fibonacci sphere")
+      ->capture_default_str();
+  app->add_option("--zooms", opts->zooms, "Zoom levels (focal-length factors), comma-separated")
+      ->delimiter(',')
+      ->capture_default_str();
+  app->add_option("--res", opts->res, "Image width and height in pixels")->capture_default_str();
+  app->add_option("--fov", opts->fov_deg, "Field of view at zoom 1, degrees")
+      ->capture_default_str();
+  app->add_option("--fill", opts->fill,
+                  "Bounding-sphere radius as a fraction of the half image at zoom 1")
+      ->capture_default_str();
+  app->add_option("--up-axis", opts->up_axis, "Mesh up axis: z (as is) or y (rotated to z)")
+      ->capture_default_str();
+  app->add_flag("!--no-normalize", opts->normalize,
+                "Keep the mesh's coordinates (default: centre, bounding-box diagonal 1)");
+  app->add_option("--light-offset", opts->light_offset,
+                  "Point light position in the camera frame, x,y,z")
+      ->delimiter(',')
+      ->expected(3)
+      ->capture_default_str();
+  app->add_option("--light-intensity", opts->light_intensity,
+                  "Radiant intensity, W/sr (default: white facing patch at the centre = 0.5)");
+  app->add_option("--envmap", opts->envmap,
+                  "Equirectangular EXR probe to light the object instead of the point light");
+  app->add_option("--envmap-scale", opts->envmap_scale, "Probe radiance scale")
+      ->capture_default_str();
+  app->add_flag("--background-environment", opts->environment_background,
+                "Camera rays that miss see the probe (default: black background)");
+  app->add_option("--spp", opts->render.spp, "Samples per pixel")->capture_default_str();
+  app->add_option("--bounces", opts->render.bounces,
+                  "Path segments: 1 = direct light only, 2 = one indirect bounce")
+      ->capture_default_str();
+  app->add_option("--effects", opts->effects, "Enabled effects (see sft render --help)")
+      ->capture_default_str();
+  app->add_option("--seed", opts->render.seed, "Sample seed")->capture_default_str();
+  app->add_option("--threads", opts->render.threads, "Worker threads (0 = all cores)")
+      ->capture_default_str();
+  app->add_flag("--overwrite", opts->overwrite, "Replace an existing output directory");
+  app->add_flag("--quiet", opts->quiet, "No progress line");
+  return [opts]() {
+    const Status status = RunSynth(*opts);
+    return status.ok() ? 0 : PrintError("synth", status);
+  };
+}
+
+}  // namespace sft

@@ -1,0 +1,48 @@
+#!/usr/bin/env bash
+# Installs every Debian 12 package sft needs to build, test and run. Idempotent: re-running it
+# only re-checks the packages. Needs root (or sudo). Set SFT_SKIP_APT=1 to skip (e.g. when the
+# packages are known to be present and the network is unavailable).
+set -euo pipefail
+
+PACKAGES=(
+  # toolchain
+  build-essential cmake git pkg-config ca-certificates
+  # numerics and solver
+  libeigen3-dev libceres-dev libgoogle-glog-dev libgflags-dev libsuitesparse-dev
+  # ray tracing and parallelism
+  libembree-dev libtbb-dev
+  # images (PNG via OpenCV, EXR via tinyexr; SSIM from opencv contrib's quality module)
+  libopencv-dev libopencv-contrib-dev libtinyexr-dev
+  # meshes
+  libopenmesh-dev
+  # CLI, JSON
+  libcli11-dev nlohmann-json3-dev
+  # tests and benchmarks
+  libgtest-dev libgmock-dev libbenchmark-dev
+)
+
+if [[ "${SFT_SKIP_APT:-0}" == "1" ]]; then
+  echo "setup: SFT_SKIP_APT=1, not installing packages"
+  exit 0
+fi
+
+SUDO=""
+if [[ "$(id -u)" != "0" ]]; then SUDO="sudo"; fi
+
+missing=()
+for p in "${PACKAGES[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+
+if [[ ${#missing[@]} -eq 0 ]]; then
+  echo "setup: all ${#PACKAGES[@]} packages already installed"
+  exit 0
+fi
+
+echo "setup: installing ${#missing[@]} packages: ${missing[*]}"
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -q
+$SUDO apt-get install -y -q --no-install-recommends "${missing[@]}"
+echo "setup: done"

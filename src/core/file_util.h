@@ -1,0 +1,38 @@
+// Small file helpers: atomic writes (temporary file + rename, so no reader ever sees a half-written
+// output) and path joining.
+#ifndef SFT_CORE_FILE_UTIL_H_
+#define SFT_CORE_FILE_UTIL_H_
+
+#include <functional>
+#include <string>
+
+#include "src/core/status.h"
+
+namespace sft {
+
+// Joins `base` and `relative` unless `relative` is absolute.
+std::string JoinPath(const std::string& base, const std::string& relative);
+
+// Returns `path`'s lower-case extension without the dot ("exr", "png"; "" if none).
+std::string FileExtension(const std::string& path);
+
+// Calls `write(tmp_path)` with a temporary path in the same directory (same extension, so
+// extension-sniffing writers work), then renames it to `path`. Creates the parent directory.
+// The temporary file is removed when `write` fails.
+Status WriteAtomically(const std::string& path,
+                       const std::function<Status(const std::string& tmp_path)>& write);
+
+// Writes `contents` to `path` atomically.
+Status WriteTextFile(const std::string& path, const std::string& contents);
+
+// Reads a whole file; error names the path.
+Status ReadTextFile(const std::string& path, std::string* contents);
+
+// Creates a directory and its parents; OK if it exists.
+Status MakeDirectories(const std::string& path);
+
+bool FileExists(const std::string& path);
+
+}  // namespace sft
+
+#endif  // SFT_CORE_FILE_UTIL_H_

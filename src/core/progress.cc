@@ -1,0 +1,49 @@
+#include "src/core/progress.h"
+
+#include <cstdio>
+#include <unistd.h>
+
+namespace sft {
+
+Progress::Progress(std::string label, int64_t total, bool enabled)
+    : label_(std::move(label)),
+      total_(total > 0 ? total : 1),
+      enabled_(enabled),
+      start_(std::chrono::steady_clock::now()),
+      last_print_(start_) {}
+
+double Progress::ElapsedSeconds() const {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+}
+
+void Progress::Advance(int64_t units) {
+  done_ += units;
+  if (!enabled_) return;
+  const auto now = std::chrono::steady_clock::now();
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (now - last_print_ < std::chrono::milliseconds(250)) return;
+  last_print_ = now;
+  Print(false);
+}
+
+void Progress::Finish() {
+  if (!enabled_) return;
+  std::lock_guard<std::mutex> lock(mutex_);
+  Print(true);
+}
+
+void Progress::Print(bool final_line) {
+  const int64_t done = done_.load();
+  const double elapsed = ElapsedSeconds();
+  const double fraction = static_cast<double>(done) / static_cast<double>(total_);
+  const double eta = fraction > 0 ? elapsed * (1.0 - fraction) / fraction : 0.0;
+  // A carriage return keeps one line on a terminal; a log file gets one line per update.
+  const bool tty = isatty(fileno(stderr));
+  std::fprintf(stderr, "%s%s: %lld/%lld (%.0f%%) elapsed %.1fs ETA %.1fs%s", tty ? "\r" : "",
+               label_.c_str(), static_cast<long long>(done), static_cast<long long>(total_),
+               100.0 * fraction, elapsed, final_line ? 0.0 : eta,
+               (final_line || !tty) ? "\n" : "");
+  std::fflush(stderr);
+}
+
+}  // namespace sft

@@ -1,0 +1,37 @@
+// A progress line with ETA on stderr for long commands. Thread-safe: Advance() may be called from
+// worker threads. Prints at most ~4 times per second, and a final line on Finish().
+#ifndef SFT_CORE_PROGRESS_H_
+#define SFT_CORE_PROGRESS_H_
+
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <mutex>
+#include <string>
+
+namespace sft {
+
+class Progress {
+ public:
+  // `total` units of work; `label` is printed in front ("render", "synth"...). Quiet when
+  // `enabled` is false (tests, --quiet).
+  Progress(std::string label, int64_t total, bool enabled = true);
+  void Advance(int64_t units = 1);
+  void Finish();
+  double ElapsedSeconds() const;
+
+ private:
+  void Print(bool final_line);
+
+  std::string label_;
+  int64_t total_;
+  bool enabled_;
+  std::atomic<int64_t> done_{0};
+  std::chrono::steady_clock::time_point start_;
+  std::chrono::steady_clock::time_point last_print_;
+  std::mutex mutex_;
+};
+
+}  // namespace sft
+
+#endif  // SFT_CORE_PROGRESS_H_

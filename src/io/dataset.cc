@@ -1,0 +1,664 @@
+#include "src/io/dataset.h"
+
+#include <glog/logging.h>
+#include <tbb/parallel_for.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <exception>
+#include <filesystem>
+#include <limits>
+#include <map>
+#include <set>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "src/core/file_util.h"
+#include "src/io/image_io.h"
+
+namespace sft {
+namespace {
+
+using json = nlohmann::json;
+
+constexpr char kFormatTag[] = "sft-dataset/1";
+constexpr char kSceneFile[] = "scene.json";
+// Largest deviation of world_from_env^T world_from_env from the identity that still counts as a
+// rotation (the file holds decimal numbers written by other tools).
+constexpr double kRotationTolerance = 1e-3;
+// Keys of the top-level object that ReadDataset interprets; all others go to Dataset::extra.
+const char* const kKnownTopLevelKeys[] = {"format", "cameras",    "lights",
+                                          "views",  "background", "ground_truth"};
+
+std::string Field(const std::string& prefix, const std::string& key) {
+  return prefix.empty() ? key : prefix + "." + key;
+}
+
+std::string Index(const std::string& prefix, size_t i) {
+  return prefix + "[" + std::to_string(i) + "]";
+}
+
+std::string SizeText(int width, int height) {
+  return std::to_string(width) + "x" + std::to_string(height);
+}
+
+// "string \"abc\"", "number 3", "array" ... for error messages.
+std::string Describe(const json& value) {
+  if (value.is_string() || value.is_number() || value.is_boolean()) {
+    std::string text = value.dump(-1, ' ', false, json::error_handler_t::replace);
+    if (text.size() > 40) text = text.substr(0, 37) + "...";
+    return std::string(value.type_name()) + " " + text;
+  }
+  return value.type_name();
+}
+
+// Parses the JSON document of one scene file; every error names the file and the JSON path.
+class SceneParser {
+ public:
+  explicit SceneParser(std::string file) : file_(std::move(file)) {}
+
+  Status Error(const std::string& path, const std::string& what) const {
+    return Status::Error(file_ + ": " + path + ": " + what);
+  }
+
+  Status Parse(const json& root, Dataset* dataset) {
+    if (!root.is_object()) {
+      return Status::Error(file_ + ": expected a JSON object at the top level, got " +
+                           Describe(root));
+    }
+    SFT_RETURN_IF_ERROR(ParseFormat(root));
+    SFT_RETURN_IF_ERROR(ParseCameras(root, dataset));
+    SFT_RETURN_IF_ERROR(ParseLights(root, dataset));
+    SFT_RETURN_IF_ERROR(ParseViews(root, dataset));
+    SFT_RETURN_IF_ERROR(ParseBackground(root, dataset));
+    SFT_RETURN_IF_ERROR(ParseGroundTruth(root, dataset));
+    for (const auto& [key, value] : root.items()) {
+      bool known = false;
+      for (const char* k : kKnownTopLevelKeys) known = known || key == k;
+      if (!known) dataset->extra[key] = value;
+    }
+    return Status::Ok();
+  }
+
+ private:
+  // Member `key` of object `obj`, or null when absent.
+  static const json* Find(const json& obj, const char* key) {
+    const auto it = obj.find(key);
+    return it == obj.end() ? nullptr : &*it;
+  }
+
+  Status Require(const json& obj, const std::string& prefix, const char* key,
+                 const json** value) const {
+    *value = Find(obj, key);
+    if (*value == nullptr) return Error(Field(prefix, key), "missing");
+    return Status::Ok();
+  }
+
+  Status String(const json& value, const std::string& path, bool allow_empty,
+                std::string* out) const {
+    if (!value.is_string()) return Error(path, "expected a string, got " + Describe(value));
+    *out = value.get<std::string>();
+    if (!allow_empty && out->empty()) return Error(path, "must not be empty");
+    return Status::Ok();
+  }
+
+  Status RequiredString(const json& obj, const std::string& prefix, const char* key,
+                        std::string* out) const {
+    const json* value = nullptr;
+    SFT_RETURN_IF_ERROR(Require(obj, prefix, key, &value));
+    return String(*value, Field(prefix, key), /*allow_empty=*/false, out);
+  }
+
+  Status Number(const json& value, const std::string& path, double* out) const {
+    if (!value.is_number()) return Error(path, "expected a number, got " + Describe(value));
+    *out = value.get<double>();
+    if (!std::isfinite(*out)) return Error(path, "expected a finite number");
+    return Status::Ok();
+  }
+
+  Status PositiveInt(const json& value, const std::string& path, int* out) const {
+    double v = 0;
+    if (!value.is_number() || !Number(value, path, &v).ok() || v != std::floor(v) || v <= 0 ||
+        v > std::numeric_limits<int>::max()) {
+      return Error(path, "expected a positive integer, got " + Describe(value));
+    }
+    *out = static_cast<int>(v);
+    return Status::Ok();
+  }
+
+  // An array of exactly `n` finite numbers (any length when n < 0).
+  Status Numbers(const json& value, const std::string& path, int n,
+                 std::vector<double>* out) const {
+    const std::string expected =
+        n >= 0 ? "expected " + std::to_string(n) + " numbers" : "expected an array of numbers";
+    if (!value.is_array()) return Error(path, expected + ", got " + Describe(value));
+    if (n >= 0 && value.size() != static_cast<size_t>(n)) {
+      return Error(path, expected + ", got " + std::to_string(value.size()));
+    }
+    out->assign(value.size(), 0.0);
+    for (size_t i = 0; i < value.size(); ++i) {
+      SFT_RETURN_IF_ERROR(Number(value[i], Index(path, i), &(*out)[i]));
+    }
+    return Status::Ok();
+  }
+
+  Status Vector3(const json& value, const std::string& path, Eigen::Vector3d* out) const {
+    std::vector<double> v;
+    SFT_RETURN_IF_ERROR(Numbers(value, path, 3, &v));
+    *out = Eigen::Vector3d(v[0], v[1], v[2]);
+    return Status::Ok();
+  }
+
+  Status Array(const json& root, const char* key, bool required, const json** value) const {
+    *value = Find(root, key);
+    if (*value == nullptr) {
+      if (required) return Error(key, "missing");
+      return Status::Ok();
+    }
+    if (!(*value)->is_array()) return Error(key, "expected an array, got " + Describe(**value));
+    return Status::Ok();
+  }
+
+  Status ParseFormat(const json& root) const {
+    const json* format = Find(root, "format");
+    if (format == nullptr) {
+      return Error("format", std::string("missing (expected \"") + kFormatTag + "\")");
+    }
+    if (!format->is_string() || format->get<std::string>() != kFormatTag) {
+      return Error("format",
+                   std::string("expected \"") + kFormatTag + "\", got " + Describe(*format));
+    }
+    return Status::Ok();
+  }
+
+  Status ParseCameras(const json& root, Dataset* dataset) const {
+    const json* cameras = nullptr;
+    SFT_RETURN_IF_ERROR(Array(root, "cameras", /*required=*/true, &cameras));
+    std::map<std::string, size_t> seen;
+    for (size_t i = 0; i < cameras->size(); ++i) {
+      const json& entry = (*cameras)[i];
+      const std::string path = Index("cameras", i);
+      if (!entry.is_object()) return Error(path, "expected an object, got " + Describe(entry));
+      Camera camera;
+      SFT_RETURN_IF_ERROR(RequiredString(entry, path, "id", &camera.id));
+      if (const auto it = seen.find(camera.id); it != seen.end()) {
+        return Error(Field(path, "id"), "duplicate camera id \"" + camera.id + "\" (also " +
+                                            Index("cameras", it->second) + ")");
+      }
+      seen[camera.id] = i;
+      std::string model;
+      SFT_RETURN_IF_ERROR(RequiredString(entry, path, "model", &model));
+      if (!CameraModelFromName(model, &camera.model)) {
+        return Error(Field(path, "model"),
+                     "unknown camera model \"" + model +
+                         "\" (known: SIMPLE_PINHOLE, PINHOLE, SIMPLE_RADIAL, RADIAL, OPENCV)");
+      }
+      const json* value = nullptr;
+      SFT_RETURN_IF_ERROR(Require(entry, path, "width", &value));
+      SFT_RETURN_IF_ERROR(PositiveInt(*value, Field(path, "width"), &camera.width));
+      SFT_RETURN_IF_ERROR(Require(entry, path, "height", &value));
+      SFT_RETURN_IF_ERROR(PositiveInt(*value, Field(path, "height"), &camera.height));
+      SFT_RETURN_IF_ERROR(Require(entry, path, "params", &value));
+      SFT_RETURN_IF_ERROR(Numbers(*value, Field(path, "params"), -1, &camera.params));
+      std::string why;
+      if (!camera.Check(&why)) return Status::Error(file_ + ": " + path + "." + why);
+      dataset->cameras.push_back(std::move(camera));
+    }
+    return Status::Ok();
+  }
+
+  Status ParsePointLight(const json& entry, const std::string& path, LightSpec* light) const {
+    light->type = LightType::kPoint;
+    if (const json* frame = Find(entry, "frame")) {
+      std::string name;
+      SFT_RETURN_IF_ERROR(String(*frame, Field(path, "frame"), false, &name));
+      if (name == "world") {
+        light->frame = LightFrame::kWorld;
+      } else if (name == "camera") {
+        light->frame = LightFrame::kCamera;
+      } else {
+        return Error(Field(path, "frame"),
+                     "expected \"world\" or \"camera\", got \"" + name + "\"");
+      }
+    }
+    const json* value = nullptr;
+    SFT_RETURN_IF_ERROR(Require(entry, path, "position", &value));
+    SFT_RETURN_IF_ERROR(Vector3(*value, Field(path, "position"), &light->position));
+    SFT_RETURN_IF_ERROR(Require(entry, path, "intensity", &value));
+    const std::string intensity_path = Field(path, "intensity");
+    if (value->is_number()) {  // a grey light.
+      double grey = 0;
+      SFT_RETURN_IF_ERROR(Number(*value, intensity_path, &grey));
+      light->intensity = Eigen::Vector3d::Constant(grey);
+    } else {
+      SFT_RETURN_IF_ERROR(Vector3(*value, intensity_path, &light->intensity));
+    }
+    if ((light->intensity.array() < 0).any()) {
+      return Error(intensity_path, "must be non-negative");
+    }
+    return Status::Ok();
+  }
+
+  Status ParseEnvironmentLight(const json& entry, const std::string& path, LightSpec* light) const {
+    light->type = LightType::kEnvironment;
+    SFT_RETURN_IF_ERROR(RequiredString(entry, path, "image", &light->image));
+    if (const json* matrix = Find(entry, "world_from_env")) {
+      const std::string matrix_path = Field(path, "world_from_env");
+      if (!matrix->is_array() || matrix->size() != 3) {
+        return Error(matrix_path, "expected a 3x3 matrix (3 rows of 3 numbers), got " +
+                                      (matrix->is_array() ? std::to_string(matrix->size()) + " rows"
+                                                          : Describe(*matrix)));
+      }
+      for (int r = 0; r < 3; ++r) {
+        std::vector<double> row;
+        SFT_RETURN_IF_ERROR(Numbers((*matrix)[r], Index(matrix_path, r), 3, &row));
+        for (int c = 0; c < 3; ++c) light->world_from_env(r, c) = row[c];
+      }
+      const Eigen::Matrix3d& m = light->world_from_env;
+      const double error = (m.transpose() * m - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
+      if (error > kRotationTolerance || m.determinant() <= 0) {
+        return Error(matrix_path, "must be a rotation (orthonormal with determinant +1)");
+      }
+    }
+    if (const json* scale = Find(entry, "scale")) {
+      SFT_RETURN_IF_ERROR(Number(*scale, Field(path, "scale"), &light->scale));
+      if (light->scale < 0) return Error(Field(path, "scale"), "must be non-negative");
+    }
+    return Status::Ok();
+  }
+
+  Status ParseLights(const json& root, Dataset* dataset) const {
+    const json* lights = nullptr;
+    SFT_RETURN_IF_ERROR(Array(root, "lights", /*required=*/false, &lights));
+    if (lights == nullptr) return Status::Ok();
+    std::map<std::string, size_t> seen;
+    for (size_t i = 0; i < lights->size(); ++i) {
+      const json& entry = (*lights)[i];
+      const std::string path = Index("lights", i);
+      if (!entry.is_object()) return Error(path, "expected an object, got " + Describe(entry));
+      LightSpec light;
+      SFT_RETURN_IF_ERROR(RequiredString(entry, path, "id", &light.id));
+      if (const auto it = seen.find(light.id); it != seen.end()) {
+        return Error(Field(path, "id"), "duplicate light id \"" + light.id + "\" (also " +
+                                            Index("lights", it->second) + ")");
+      }
+      seen[light.id] = i;
+      std::string type;
+      SFT_RETURN_IF_ERROR(RequiredString(entry, path, "type", &type));
+      if (type == "point") {
+        SFT_RETURN_IF_ERROR(ParsePointLight(entry, path, &light));
+      } else if (type == "environment") {
+        SFT_RETURN_IF_ERROR(ParseEnvironmentLight(entry, path, &light));
+      } else {
+        return Error(Field(path, "type"),
+                     "unknown light type \"" + type + "\" (expected \"point\" or \"environment\")");
+      }
+      dataset->lights.push_back(std::move(light));
+    }
+    return Status::Ok();
+  }
+
+  Status ParsePose(const json& view, const std::string& view_path, Rigid3d* pose) const {
+    const json* value = nullptr;
+    SFT_RETURN_IF_ERROR(Require(view, view_path, "cam_from_world", &value));
+    const std::string path = Field(view_path, "cam_from_world");
+    if (!value->is_object()) return Error(path, "expected an object, got " + Describe(*value));
+    const json* rotation = nullptr;
+    SFT_RETURN_IF_ERROR(Require(*value, path, "rotation", &rotation));
+    std::vector<double> q;
+    SFT_RETURN_IF_ERROR(Numbers(*rotation, Field(path, "rotation"), 4, &q));
+    Eigen::Quaterniond quaternion(q[0], q[1], q[2], q[3]);  // (w, x, y, z)
+    const double norm = quaternion.norm();
+    if (!(norm > 1e-12) || !std::isfinite(norm)) {
+      return Error(Field(path, "rotation"), "quaternion must have a non-zero finite norm");
+    }
+    quaternion.coeffs() /= norm;
+    pose->rotation = quaternion;
+    const json* translation = nullptr;
+    SFT_RETURN_IF_ERROR(Require(*value, path, "translation", &translation));
+    return Vector3(*translation, Field(path, "translation"), &pose->translation);
+  }
+
+  Status ParseViews(const json& root, Dataset* dataset) const {
+    const json* views = nullptr;
+    SFT_RETURN_IF_ERROR(Array(root, "views", /*required=*/true, &views));
+    if (views->empty()) return Error("views", "expected at least one view");
+    for (size_t i = 0; i < views->size(); ++i) {
+      const json& entry = (*views)[i];
+      const std::string path = Index("views", i);
+      if (!entry.is_object()) return Error(path, "expected an object, got " + Describe(entry));
+      ViewSpec view;
+      SFT_RETURN_IF_ERROR(RequiredString(entry, path, "image", &view.image));
+      if (const json* mask = Find(entry, "mask"); mask != nullptr && !mask->is_null()) {
+        SFT_RETURN_IF_ERROR(String(*mask, Field(path, "mask"), false, &view.mask));
+      }
+      SFT_RETURN_IF_ERROR(RequiredString(entry, path, "camera", &view.camera_id));
+      for (size_t c = 0; c < dataset->cameras.size(); ++c) {
+        if (dataset->cameras[c].id == view.camera_id) view.camera = static_cast<int>(c);
+      }
+      if (view.camera < 0) {
+        return Error(Field(path, "camera"), "unknown camera \"" + view.camera_id + "\"");
+      }
+      if (const json* lights = Find(entry, "lights")) {
+        const std::string lights_path = Field(path, "lights");
+        if (!lights->is_array()) {
+          return Error(lights_path, "expected an array of light ids, got " + Describe(*lights));
+        }
+        for (size_t k = 0; k < lights->size(); ++k) {
+          std::string id;
+          SFT_RETURN_IF_ERROR(String((*lights)[k], Index(lights_path, k), false, &id));
+          int index = -1;
+          for (size_t l = 0; l < dataset->lights.size(); ++l) {
+            if (dataset->lights[l].id == id) index = static_cast<int>(l);
+          }
+          if (index < 0) return Error(Index(lights_path, k), "unknown light \"" + id + "\"");
+          for (const std::string& other : view.light_ids) {
+            if (other == id)
+              return Error(Index(lights_path, k), "light \"" + id + "\" listed twice");
+          }
+          view.light_ids.push_back(id);
+          view.lights.push_back(index);
+        }
+      }
+      SFT_RETURN_IF_ERROR(ParsePose(entry, path, &view.cam_from_world));
+      dataset->views.push_back(std::move(view));
+    }
+    return Status::Ok();
+  }
+
+  Status ParseBackground(const json& root, Dataset* dataset) const {
+    const json* value = Find(root, "background");
+    if (value == nullptr) return Status::Ok();
+    std::string name;
+    SFT_RETURN_IF_ERROR(String(*value, "background", false, &name));
+    if (name == "black") {
+      dataset->background = Background::kBlack;
+    } else if (name == "environment") {
+      bool has_environment = false;
+      for (const LightSpec& light : dataset->lights) {
+        has_environment = has_environment || light.type == LightType::kEnvironment;
+      }
+      if (!has_environment) {
+        return Error("background", "\"environment\" needs an environment light in \"lights\"");
+      }
+      dataset->background = Background::kEnvironment;
+    } else {
+      return Error("background", "expected \"black\" or \"environment\", got \"" + name + "\"");
+    }
+    return Status::Ok();
+  }
+
+  Status ParseGroundTruth(const json& root, Dataset* dataset) const {
+    const json* value = Find(root, "ground_truth");
+    if (value == nullptr || value->is_null()) return Status::Ok();
+    if (!value->is_object()) {
+      return Error("ground_truth", "expected an object, got " + Describe(*value));
+    }
+    dataset->ground_truth = *value;
+    if (const json* mesh = Find(*value, "mesh"); mesh != nullptr && !mesh->is_null()) {
+      SFT_RETURN_IF_ERROR(String(*mesh, "ground_truth.mesh", false, &dataset->gt_mesh));
+    }
+    return Status::Ok();
+  }
+
+  std::string file_;
+};
+
+// "[json.exception.parse_error.101] parse error at ..." -> "parse error at ...".
+std::string StripJsonExceptionId(const std::string& what) {
+  if (!what.empty() && what[0] == '[') {
+    const size_t end = what.find("] ");
+    if (end != std::string::npos) return what.substr(end + 2);
+  }
+  return what;
+}
+
+Status CheckSize(const std::string& path, const char* what, const Image& image,
+                 const Camera& camera) {
+  if (image.width != camera.width || image.height != camera.height) {
+    return Status::Error(path + ": " + what + " is " + SizeText(image.width, image.height) +
+                         " but camera \"" + camera.id + "\" is " +
+                         SizeText(camera.width, camera.height));
+  }
+  return Status::Ok();
+}
+
+Image ToRgb(const Image& image) {
+  if (image.channels == 3) return image;
+  Image rgb(image.width, image.height, 3);
+  for (int y = 0; y < image.height; ++y) {
+    for (int x = 0; x < image.width; ++x) {
+      for (int c = 0; c < 3; ++c) {
+        rgb.at(x, y, c) = image.at(x, y, image.channels >= 3 ? c : 0);
+      }
+    }
+  }
+  return rgb;
+}
+
+std::string ScenePath(const Dataset& dataset) { return JoinPath(dataset.root, kSceneFile); }
+
+const Camera& ViewCamera(const Dataset& dataset, int index) {
+  CHECK_GE(index, 0);
+  CHECK_LT(index, static_cast<int>(dataset.views.size()));
+  const int camera = dataset.views[index].camera;
+  CHECK_GE(camera, 0) << "view " << index << " has no resolved camera";
+  CHECK_LT(camera, static_cast<int>(dataset.cameras.size()));
+  return dataset.cameras[camera];
+}
+
+Status CheckViewFiles(const Dataset& dataset, int index) {
+  const ViewSpec& view = dataset.views[index];
+  const Camera& camera = ViewCamera(dataset, index);
+  Image image;
+  const std::string image_path = JoinPath(dataset.root, view.image);
+  SFT_RETURN_IF_ERROR(ReadImage(image_path, &image));
+  SFT_RETURN_IF_ERROR(CheckSize(image_path, "image", image, camera));
+  if (!view.mask.empty()) {
+    const std::string mask_path = JoinPath(dataset.root, view.mask);
+    Image mask;
+    SFT_RETURN_IF_ERROR(ReadMask(mask_path, &mask));
+    SFT_RETURN_IF_ERROR(CheckSize(mask_path, "mask", mask, camera));
+  }
+  return Status::Ok();
+}
+
+}  // namespace
+
+Status ReadDataset(const std::string& dir, Dataset* dataset) {
+  const std::string file = JoinPath(dir, kSceneFile);
+  std::error_code ec;
+  if (!std::filesystem::is_directory(dir, ec)) {
+    return Status::Error(dir + ": dataset directory not found");
+  }
+  std::string text;
+  SFT_RETURN_IF_ERROR(ReadTextFile(file, &text));
+  try {
+    json root;
+    try {
+      root = json::parse(text);
+    } catch (const json::parse_error& e) {
+      return Status::Error(file + ": invalid JSON: " + StripJsonExceptionId(e.what()));
+    }
+    Dataset result;
+    result.root = dir;
+    SFT_RETURN_IF_ERROR(SceneParser(file).Parse(root, &result));
+    *dataset = std::move(result);
+    return Status::Ok();
+  } catch (const std::exception& e) {
+    return Status::Error(file + ": " + StripJsonExceptionId(e.what()));
+  }
+}
+
+Status CheckDatasetFiles(const Dataset& dataset) {
+  const int num_views = static_cast<int>(dataset.views.size());
+  std::vector<Status> statuses(num_views);
+  // Photographs can be large: decode them in parallel, report the first failure in view order.
+  tbb::parallel_for(0, num_views, [&](int i) { statuses[i] = CheckViewFiles(dataset, i); });
+  for (const Status& status : statuses) SFT_RETURN_IF_ERROR(status);
+  for (int l = 0; l < static_cast<int>(dataset.lights.size()); ++l) {
+    if (dataset.lights[l].type != LightType::kEnvironment) continue;
+    Image probe;
+    SFT_RETURN_IF_ERROR(LoadProbe(dataset, l, &probe));
+  }
+  return Status::Ok();
+}
+
+Status WriteSceneJson(const Dataset& dataset, const std::string& dir) {
+  const std::string file = JoinPath(dir, kSceneFile);
+  try {
+    nlohmann::ordered_json root;
+    root["format"] = kFormatTag;
+    nlohmann::ordered_json cameras = nlohmann::ordered_json::array();
+    for (const Camera& camera : dataset.cameras) {
+      nlohmann::ordered_json entry;
+      entry["id"] = camera.id;
+      entry["model"] = CameraModelName(camera.model);
+      entry["width"] = camera.width;
+      entry["height"] = camera.height;
+      entry["params"] = camera.params;
+      cameras.push_back(std::move(entry));
+    }
+    root["cameras"] = std::move(cameras);
+
+    nlohmann::ordered_json lights = nlohmann::ordered_json::array();
+    for (const LightSpec& light : dataset.lights) {
+      nlohmann::ordered_json entry;
+      entry["id"] = light.id;
+      if (light.type == LightType::kPoint) {
+        entry["type"] = "point";
+        entry["frame"] = light.frame == LightFrame::kCamera ? "camera" : "world";
+        entry["position"] = {light.position.x(), light.position.y(), light.position.z()};
+        entry["intensity"] = {light.intensity.x(), light.intensity.y(), light.intensity.z()};
+      } else {
+        entry["type"] = "environment";
+        entry["image"] = light.image;
+        nlohmann::ordered_json matrix = nlohmann::ordered_json::array();
+        for (int r = 0; r < 3; ++r) {
+          matrix.push_back(
+              {light.world_from_env(r, 0), light.world_from_env(r, 1), light.world_from_env(r, 2)});
+        }
+        entry["world_from_env"] = std::move(matrix);
+        entry["scale"] = light.scale;
+      }
+      lights.push_back(std::move(entry));
+    }
+    root["lights"] = std::move(lights);
+
+    nlohmann::ordered_json views = nlohmann::ordered_json::array();
+    for (size_t i = 0; i < dataset.views.size(); ++i) {
+      const ViewSpec& view = dataset.views[i];
+      const std::string path = Index("views", i);
+      // A view built in code may carry indices or ids: use whichever is set, refuse to guess when
+      // they disagree, and never write a reference that ReadDataset would reject.
+      std::string camera_id = view.camera_id;
+      if (view.camera >= 0 && view.camera < static_cast<int>(dataset.cameras.size())) {
+        const std::string& by_index = dataset.cameras[view.camera].id;
+        if (!camera_id.empty() && camera_id != by_index) {
+          return Status::Error(file + ": " + path + ".camera: camera_id \"" + camera_id +
+                               "\" disagrees with camera index " + std::to_string(view.camera));
+        }
+        camera_id = by_index;
+      }
+      bool camera_known = false;
+      for (const Camera& camera : dataset.cameras)
+        camera_known = camera_known || camera.id == camera_id;
+      if (!camera_known) {
+        return Status::Error(file + ": " + path + ".camera: unknown camera \"" + camera_id + "\"");
+      }
+      std::vector<std::string> light_ids;
+      for (int l : view.lights) {
+        if (l < 0 || l >= static_cast<int>(dataset.lights.size())) {
+          return Status::Error(file + ": " + path + ".lights: light index " + std::to_string(l) +
+                               " out of range");
+        }
+        light_ids.push_back(dataset.lights[l].id);
+      }
+      if (view.lights.empty()) {
+        light_ids = view.light_ids;
+      } else if (!view.light_ids.empty() && view.light_ids != light_ids) {
+        return Status::Error(file + ": " + path + ".lights: light_ids disagree with light indices");
+      }
+      for (const std::string& id : light_ids) {
+        bool known = false;
+        for (const LightSpec& light : dataset.lights) known = known || light.id == id;
+        if (!known) {
+          return Status::Error(file + ": " + path + ".lights: unknown light \"" + id + "\"");
+        }
+      }
+      nlohmann::ordered_json entry;
+      entry["image"] = view.image;
+      if (!view.mask.empty()) entry["mask"] = view.mask;
+      entry["camera"] = camera_id;
+      entry["lights"] = light_ids;
+      const Eigen::Quaterniond& q = view.cam_from_world.rotation;
+      const Eigen::Vector3d& t = view.cam_from_world.translation;
+      entry["cam_from_world"]["rotation"] = {q.w(), q.x(), q.y(), q.z()};
+      entry["cam_from_world"]["translation"] = {t.x(), t.y(), t.z()};
+      views.push_back(std::move(entry));
+    }
+    root["views"] = std::move(views);
+    root["background"] = dataset.background == Background::kEnvironment ? "environment" : "black";
+
+    nlohmann::ordered_json ground_truth;
+    if (dataset.ground_truth.is_object()) ground_truth = dataset.ground_truth;
+    if (!dataset.gt_mesh.empty()) ground_truth["mesh"] = dataset.gt_mesh;
+    if (!ground_truth.is_null()) root["ground_truth"] = std::move(ground_truth);
+
+    if (dataset.extra.is_object()) {
+      for (const auto& [key, value] : dataset.extra.items()) {
+        if (!root.contains(key)) root[key] = value;  // documented keys always win.
+      }
+    }
+    return WriteTextFile(file, root.dump(1, ' ', false, json::error_handler_t::replace) + "\n");
+  } catch (const std::exception& e) {
+    return Status::Error(file + ": cannot serialize scene (" + StripJsonExceptionId(e.what()) +
+                         ")");
+  }
+}
+
+Status LoadViewImage(const Dataset& dataset, int index, Image* rgb) {
+  const Camera& camera = ViewCamera(dataset, index);
+  const std::string path = JoinPath(dataset.root, dataset.views[index].image);
+  Image image;
+  SFT_RETURN_IF_ERROR(ReadImage(path, &image));
+  SFT_RETURN_IF_ERROR(CheckSize(path, "image", image, camera));
+  *rgb = ToRgb(image);
+  return Status::Ok();
+}
+
+Status LoadViewMask(const Dataset& dataset, int index, Image* mask) {
+  const Camera& camera = ViewCamera(dataset, index);
+  const ViewSpec& view = dataset.views[index];
+  if (view.mask.empty()) {
+    return Status::Error(ScenePath(dataset) + ": " + Index("views", index) +
+                         ".mask: view has no mask");
+  }
+  const std::string path = JoinPath(dataset.root, view.mask);
+  Image result;
+  SFT_RETURN_IF_ERROR(ReadMask(path, &result));
+  SFT_RETURN_IF_ERROR(CheckSize(path, "mask", result, camera));
+  *mask = std::move(result);
+  return Status::Ok();
+}
+
+Status LoadProbe(const Dataset& dataset, int light_index, Image* rgb) {
+  CHECK_GE(light_index, 0);
+  CHECK_LT(light_index, static_cast<int>(dataset.lights.size()));
+  const LightSpec& light = dataset.lights[light_index];
+  CHECK(light.type == LightType::kEnvironment) << "light " << light.id << " is not a probe";
+  const std::string path = JoinPath(dataset.root, light.image);
+  Image image;
+  SFT_RETURN_IF_ERROR(ReadImage(path, &image));
+  Image result = ToRgb(image);
+  // Negative texels (ringing from HDR resampling) and non-finite ones would break importance
+  // sampling; they carry no usable radiance.
+  for (float& v : result.data) {
+    if (!(v > 0.0f) || !std::isfinite(v)) v = 0.0f;
+  }
+  *rgb = std::move(result);
+  return Status::Ok();
+}
+
+}  // namespace sft

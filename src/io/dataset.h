@@ -1,0 +1,79 @@
+// The `sft-dataset/1` format of DESIGN.md §2.5: a directory with scene.json, images/, masks/,
+// probes/, gt/. This is a contract with other tools: unknown keys are preserved on round trips and
+// the meaning of the documented keys never changes.
+#ifndef SFT_IO_DATASET_H_
+#define SFT_IO_DATASET_H_
+
+#include <Eigen/Core>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "src/core/image.h"
+#include "src/core/status.h"
+#include "src/render/camera.h"
+
+namespace sft {
+
+enum class LightType { kPoint, kEnvironment };
+enum class LightFrame { kWorld, kCamera };  // a point light's `position` frame.
+enum class Background { kBlack, kEnvironment };
+
+struct LightSpec {
+  std::string id;
+  LightType type = LightType::kPoint;
+  // Point lights.
+  LightFrame frame = LightFrame::kWorld;
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();   // in `frame`, scene units.
+  Eigen::Vector3d intensity = Eigen::Vector3d::Zero();  // radiant intensity, W/sr, RGB.
+  // Environment lights.
+  std::string image;  // relative to the dataset root: an equirectangular linear EXR.
+  Eigen::Matrix3d world_from_env = Eigen::Matrix3d::Identity();
+  double scale = 1.0;  // radiance = scale * texel value.
+};
+
+struct ViewSpec {
+  std::string image;  // relative to the dataset root.
+  std::string mask;   // relative; empty when the view has no mask.
+  std::string camera_id;
+  int camera = -1;  // index into Dataset::cameras, resolved by ReadDataset.
+  std::vector<std::string> light_ids;
+  std::vector<int> lights;  // indices into Dataset::lights, resolved by ReadDataset.
+  Rigid3d cam_from_world;
+};
+
+struct Dataset {
+  std::string root;  // the dataset directory (paths in the specs are relative to it).
+  std::vector<Camera> cameras;
+  std::vector<LightSpec> lights;
+  std::vector<ViewSpec> views;
+  Background background = Background::kBlack;
+  std::string gt_mesh;          // `ground_truth.mesh` (relative), empty when absent.
+  nlohmann::json ground_truth;  // the whole `ground_truth` object as read (null when absent).
+  nlohmann::json extra;         // top-level keys this version does not interpret, kept verbatim.
+};
+
+// Reads and validates DIR/scene.json: format tag, camera models and parameter counts, positive
+// sizes, quaternion length 4 (normalized on read; a zero quaternion is an error), translation
+// length 3, every view's camera and lights exist, light types and fields, background value.
+// Does not open images (see CheckDatasetFiles). Errors name the file and the JSON path, e.g.
+// "data/x/scene.json: views[3].cam_from_world.rotation: expected 4 numbers, got 3".
+Status ReadDataset(const std::string& dir, Dataset* dataset);
+
+// Opens every view image, mask and light probe once and checks sizes against the cameras
+// (an image whose size differs from its camera's is an error naming both sizes).
+Status CheckDatasetFiles(const Dataset& dataset);
+
+// Writes DIR/scene.json atomically from `dataset` (root is ignored; paths are written as stored).
+Status WriteSceneJson(const Dataset& dataset, const std::string& dir);
+
+// Loads view `index`'s image as linear RGB (alpha dropped; 3 channels), checking its size.
+Status LoadViewImage(const Dataset& dataset, int index, Image* rgb);
+// Loads view `index`'s mask as a 1-channel image of 0/1 (> 127 = object). Error if no mask.
+Status LoadViewMask(const Dataset& dataset, int index, Image* mask);
+// Loads environment light `light_index`'s probe as linear RGB with negative texels clamped to 0.
+Status LoadProbe(const Dataset& dataset, int light_index, Image* rgb);
+
+}  // namespace sft
+
+#endif  // SFT_IO_DATASET_H_

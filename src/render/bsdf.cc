@@ -1,0 +1,165 @@
+#include "src/render/bsdf.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace sft {
+namespace {
+
+constexpr double kPi = M_PI;
+
+Eigen::Vector3d ToLocal(const Eigen::Vector3d& w, const Eigen::Vector3d& t, const Eigen::Vector3d& b,
+                        const Eigen::Vector3d& n) {
+  return {w.dot(t), w.dot(b), w.dot(n)};
+}
+
+// Cosine-weighted hemisphere direction in the local frame (z up), Malley's method.
+Eigen::Vector3d SampleCosineHemisphere(double u1, double u2) {
+  const double r = std::sqrt(u1);
+  const double phi = 2.0 * kPi * u2;
+  return {r * std::cos(phi), r * std::sin(phi), std::sqrt(std::max(0.0, 1.0 - u1))};
+}
+
+// GGX visible-normal sample (Heitz 2018, "Sampling the GGX Distribution of Visible Normals"),
+// isotropic α, local frame with wo.z > 0. Returns the microfacet normal h.
+Eigen::Vector3d SampleGgxVisibleNormal(const Eigen::Vector3d& wo, double alpha, double u1,
+                                       double u2) {
+  // Stretch to the hemisphere configuration.
+  const Eigen::Vector3d vh = Eigen::Vector3d(alpha * wo.x(), alpha * wo.y(), wo.z()).normalized();
+  const double lensq = vh.x() * vh.x() + vh.y() * vh.y();
+  const Eigen::Vector3d t1 = lensq > 0 ? Eigen::Vector3d(-vh.y(), vh.x(), 0) / std::sqrt(lensq)
+                                       : Eigen::Vector3d(1, 0, 0);
+  const Eigen::Vector3d t2 = vh.cross(t1);
+  const double r = std::sqrt(u1);
+  const double phi = 2.0 * kPi * u2;
+  const double p1 = r * std::cos(phi);
+  double p2 = r * std::sin(phi);
+  const double s = 0.5 * (1.0 + vh.z());
+  p2 = (1.0 - s) * std::sqrt(std::max(0.0, 1.0 - p1 * p1)) + s * p2;
+  const Eigen::Vector3d nh =
+      p1 * t1 + p2 * t2 + std::sqrt(std::max(0.0, 1.0 - p1 * p1 - p2 * p2)) * vh;
+  // Unstretch.
+  return Eigen::Vector3d(alpha * nh.x(), alpha * nh.y(), std::max(1e-12, nh.z())).normalized();
+}
+
+double Luminance(const Eigen::Vector3d& c) { return (c.x() + c.y() + c.z()) / 3.0; }
+
+}  // namespace
+
+double BsdfParams::Alpha() const {
+  return std::max(kMinGgxAlpha, roughness * roughness);
+}
+
+double GgxD(double cos_h, double alpha) {
+  if (cos_h <= 0.0) return 0.0;
+  const double a2 = alpha * alpha;
+  const double cos2 = cos_h * cos_h;
+  // 1 + cos²(α² − 1) written as sin² + cos²·α² so it stays accurate for tiny α.
+  const double denom = std::max(0.0, 1.0 - cos2) + cos2 * a2;
+  return a2 / (kPi * denom * denom);
+}
+
+double GgxG1(double cos_w, double alpha) {
+  if (cos_w <= 0.0) return 0.0;
+  const double cos2 = cos_w * cos_w;
+  const double tan2 = std::max(0.0, 1.0 - cos2) / cos2;
+  return 2.0 / (1.0 + std::sqrt(1.0 + alpha * alpha * tan2));
+}
+
+double SchlickFresnel(double f0, double cos_d) {
+  const double m = std::clamp(1.0 - cos_d, 0.0, 1.0);
+  const double m2 = m * m;
+  return f0 + (1.0 - f0) * m2 * m2 * m;
+}
+
+double GlossySelectionProbability(const BsdfParams& params) {
+  const double diffuse = std::max(0.0, Luminance(params.albedo));
+  const double glossy = std::max(0.0, params.specular);
+  if (glossy <= 0.0) return 0.0;
+  if (diffuse <= 0.0) return 1.0;
+  // Keep both lobes sampled with at least 10% so MIS never faces a near-zero pdf.
+  return std::clamp(glossy / (glossy + diffuse), 0.1, 0.9);
+}
+
+Eigen::Vector3d EvalBsdf(const BsdfParams& params, const Eigen::Vector3d& n,
+                         const Eigen::Vector3d& wo, const Eigen::Vector3d& wi) {
+  const double cos_o = n.dot(wo);
+  const double cos_i = n.dot(wi);
+  if (cos_o <= 0.0 || cos_i <= 0.0) return Eigen::Vector3d::Zero();
+  Eigen::Vector3d f = params.albedo / kPi;
+  if (params.specular > 0.0) {
+    const Eigen::Vector3d sum = wi + wo;
+    const double len = sum.norm();
+    if (len > 1e-12) {
+      const Eigen::Vector3d h = sum / len;
+      const double alpha = params.Alpha();
+      const double fresnel = params.fresnel == FresnelMode::kSchlick
+                                 ? SchlickFresnel(params.specular, wi.dot(h))
+                                 : params.specular;
+      const double glossy = fresnel * GgxD(n.dot(h), alpha) * GgxG1(cos_i, alpha) *
+                            GgxG1(cos_o, alpha) / (4.0 * cos_i * cos_o);
+      f.array() += glossy;
+    }
+  }
+  return f;
+}
+
+double BsdfPdf(const BsdfParams& params, const Eigen::Vector3d& n, const Eigen::Vector3d& wo,
+               const Eigen::Vector3d& wi) {
+  const double cos_o = n.dot(wo);
+  const double cos_i = n.dot(wi);
+  if (cos_o <= 0.0 || cos_i <= 0.0) return 0.0;
+  const double p_glossy = GlossySelectionProbability(params);
+  double pdf = (1.0 - p_glossy) * cos_i / kPi;
+  if (p_glossy > 0.0) {
+    const Eigen::Vector3d sum = wi + wo;
+    const double len = sum.norm();
+    if (len > 1e-12) {
+      const Eigen::Vector3d h = sum / len;
+      const double alpha = params.Alpha();
+      const double cos_oh = wo.dot(h);
+      if (cos_oh > 0.0) {
+        // Visible-normal density D_wo(h) = G1(wo)·max(0, wo·h)·D(h)/(n·wo), and dwi/dh = 4·wo·h.
+        const double d_visible = GgxG1(cos_o, alpha) * cos_oh * GgxD(n.dot(h), alpha) / cos_o;
+        pdf += p_glossy * d_visible / (4.0 * cos_oh);
+      }
+    }
+  }
+  return pdf;
+}
+
+bool SampleBsdf(const BsdfParams& params, const Eigen::Vector3d& n, const Eigen::Vector3d& wo,
+                const Eigen::Vector3d& u, BsdfSample* sample) {
+  if (n.dot(wo) <= 0.0) return false;
+  if (params.albedo.maxCoeff() <= 0.0 && params.specular <= 0.0) return false;
+  Eigen::Vector3d t, b;
+  OrthonormalBasis(n, &t, &b);
+  const double p_glossy = GlossySelectionProbability(params);
+  Eigen::Vector3d wi;
+  if (u.x() < p_glossy) {
+    const Eigen::Vector3d wo_local = ToLocal(wo, t, b, n);
+    const Eigen::Vector3d h_local = SampleGgxVisibleNormal(wo_local, params.Alpha(), u.y(), u.z());
+    const Eigen::Vector3d h = h_local.x() * t + h_local.y() * b + h_local.z() * n;
+    wi = 2.0 * wo.dot(h) * h - wo;
+  } else {
+    const Eigen::Vector3d local = SampleCosineHemisphere(u.y(), u.z());
+    wi = local.x() * t + local.y() * b + local.z() * n;
+  }
+  wi.normalize();
+  if (n.dot(wi) <= 0.0) return false;
+  sample->wi = wi;
+  sample->pdf = BsdfPdf(params, n, wo, wi);
+  if (!(sample->pdf > 0.0) || !std::isfinite(sample->pdf)) return false;
+  sample->f = EvalBsdf(params, n, wo, wi);
+  return true;
+}
+
+void OrthonormalBasis(const Eigen::Vector3d& n, Eigen::Vector3d* t, Eigen::Vector3d* b) {
+  const double sign = std::copysign(1.0, n.z());
+  const double a = -1.0 / (sign + n.z());
+  const double bb = n.x() * n.y() * a;
+  *t = Eigen::Vector3d(1.0 + sign * n.x() * n.x() * a, sign * bb, -sign * n.x());
+  *b = Eigen::Vector3d(bb, sign + n.y() * n.y() * a, -n.y());
+}
+
+}  // namespace sft

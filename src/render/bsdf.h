@@ -1,0 +1,73 @@
+// The surface BSDF: Lambert plus a Torrance–Sparrow microfacet lobe with the GGX distribution
+// (Walter et al. 2007), α = roughness², separable Smith masking G1(wi)·G1(wo), and Fresnel equal
+// to the constant `specular` weight (optionally Schlick with F0 = specular):
+//
+//   f(wo, wi) = albedo/π + F · D(h)·G1(wi)·G1(wo) / (4·|n·wi|·|n·wo|),   h = normalize(wi + wo).
+//
+// This is exactly Blender's Diffuse BSDF + Glossy BSDF (GGX) joined by an Add Shader, so Cycles
+// renders are references (PLATFORM.md).
+//
+// Direction convention, used everywhere in sft: `wo` points from the surface towards the viewer
+// (the previous path vertex or the camera), `wi` from the surface towards the light (the next path
+// vertex); both are unit vectors in world space. `n` is the unit shading normal already flipped
+// to the side of `wo` (two-sided shading, as Cycles' Diffuse BSDF): only reflection is modelled,
+// so f = 0 whenever n·wi ≤ 0 or n·wo ≤ 0.
+#ifndef SFT_RENDER_BSDF_H_
+#define SFT_RENDER_BSDF_H_
+
+#include <Eigen/Core>
+
+#include "src/geometry/material.h"
+
+namespace sft {
+
+// α below this is clamped: D(h) then peaks at 1/(π·kMinAlpha²) = 3.2e7, large but finite, and
+// roughness → 0 stays finite (a perfect mirror would need a singular, unsampleable lobe).
+constexpr double kMinGgxAlpha = 1e-4;
+
+struct BsdfParams {
+  Eigen::Vector3d albedo = Eigen::Vector3d::Constant(0.7);
+  double roughness = 0.5;
+  double specular = 0.0;
+  FresnelMode fresnel = FresnelMode::kConstant;
+
+  double Alpha() const;
+};
+
+// GGX normal distribution D(h) with cos_h = n·h, α as above; 0 for cos_h ≤ 0.
+double GgxD(double cos_h, double alpha);
+// Smith G1 for GGX of a direction with cosine `cos_w` to the normal.
+double GgxG1(double cos_w, double alpha);
+// Schlick's Fresnel with F0 = f0 at cos_d = wi·h.
+double SchlickFresnel(double f0, double cos_d);
+
+// f(wo, wi) (no cosine factor). Returns zero for directions below the surface.
+Eigen::Vector3d EvalBsdf(const BsdfParams& params, const Eigen::Vector3d& n,
+                         const Eigen::Vector3d& wo, const Eigen::Vector3d& wi);
+
+struct BsdfSample {
+  Eigen::Vector3d wi;
+  Eigen::Vector3d f;  // f(wo, wi)
+  double pdf = 0.0;   // solid-angle density of the mixture (both lobes), > 0 when valid.
+};
+
+// Probability of choosing the glossy lobe when sampling (the rest goes to the cosine lobe):
+// proportional to the lobes' weights (specular vs mean albedo).
+double GlossySelectionProbability(const BsdfParams& params);
+
+// Samples wi from the lobe mixture: cosine-weighted hemisphere for Lambert, GGX visible normals
+// (Heitz 2018) for the glossy lobe. `u` holds three uniform numbers in [0, 1). Returns false when
+// no direction can be produced (black material, wo below the surface, sample below the surface).
+bool SampleBsdf(const BsdfParams& params, const Eigen::Vector3d& n, const Eigen::Vector3d& wo,
+                const Eigen::Vector3d& u, BsdfSample* sample);
+
+// The solid-angle pdf with which SampleBsdf produces wi.
+double BsdfPdf(const BsdfParams& params, const Eigen::Vector3d& n, const Eigen::Vector3d& wo,
+               const Eigen::Vector3d& wi);
+
+// An orthonormal basis (t, b, n) around unit n (Duff et al. 2017).
+void OrthonormalBasis(const Eigen::Vector3d& n, Eigen::Vector3d* t, Eigen::Vector3d* b);
+
+}  // namespace sft
+
+#endif  // SFT_RENDER_BSDF_H_

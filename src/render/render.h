@@ -1,0 +1,89 @@
+// The forward path tracer (DESIGN.md §2.3): camera rays through a box pixel filter, next-event
+// estimation to point and environment lights, BSDF sampling with multiple importance sampling
+// (power heuristic) against the environment, a fixed number of path segments. Deterministic:
+// sample s of pixel p of view v uses Sampler(seed, v, p, s) only, so the image is identical for
+// any thread count.
+#ifndef SFT_RENDER_RENDER_H_
+#define SFT_RENDER_RENDER_H_
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "src/core/image.h"
+#include "src/core/status.h"
+#include "src/geometry/material.h"
+#include "src/render/camera.h"
+#include "src/render/environment.h"
+#include "src/render/scene.h"
+
+namespace sft {
+
+// Which light transport the renderer simulates. Turning an effect off changes the image (it is
+// not an approximation switch for derivatives only).
+struct Effects {
+  bool direct = true;       // light reaching the first surface straight from a light source.
+  bool shadows = true;      // occlusion of light sources (shadow rays); off = lights always seen.
+  bool bounces = true;      // indirect light (paths of more than one segment before the light).
+  bool specular = true;     // the glossy lobe; off = the specular weight is treated as 0.
+  bool environment = true;  // environment lights (lighting and the visible background).
+
+  std::string ToString() const;
+  // Parses a comma-separated list of enabled effects ("direct,shadows,bounces,specular,
+  // environment"; "all"; "none"). Returns false and sets *why on an unknown name.
+  static bool Parse(const std::string& list, Effects* effects, std::string* why);
+};
+
+enum class RenderPass { kColor, kAlbedo, kRoughness, kNormal, kDepth };
+bool RenderPassFromName(const std::string& name, RenderPass* pass);
+
+struct RenderOptions {
+  int spp = 64;         // samples per pixel, >= 1.
+  int bounces = 2;      // path segments as in the report: 1 = direct light only, 2 = one
+                        // indirect bounce (= Cycles' max_bounces + 1); range 1..16.
+  Effects effects;
+  uint64_t seed = 0;    // base seed; the image is a deterministic function of it.
+  int threads = 0;      // worker threads; 0 = all cores.
+  RenderPass pass = RenderPass::kColor;
+
+  bool Check(std::string* why) const;
+};
+
+struct PointLight {
+  Eigen::Vector3d position;   // world frame.
+  Eigen::Vector3d intensity;  // radiant intensity, W/sr.
+};
+
+// Everything one view needs besides the scene and material.
+struct ViewSetup {
+  Camera camera;
+  Rigid3d cam_from_world;
+  std::vector<PointLight> point_lights;
+  const EnvironmentMap* environment = nullptr;  // not owned; may be null.
+  bool environment_background = false;          // camera rays that miss see the environment.
+  uint64_t view_index = 0;                      // part of the sample seed.
+};
+
+// Counters of one render, for throughput measurements.
+struct RenderStats {
+  int64_t camera_rays = 0;
+  int64_t shadow_rays = 0;
+  int64_t bounce_rays = 0;
+  double seconds = 0.0;
+  int64_t TotalRays() const { return camera_rays + shadow_rays + bounce_rays; }
+};
+
+// Renders one view into `image` (width × height × 4: RGB of the pass, alpha = pixel coverage,
+// i.e. the fraction of samples whose camera ray hit the mesh). Pixel values are averages over
+// the pixel's area (box filter). For the color pass the values are radiance; for albedo and
+// roughness they are the first-hit material averaged over the pixel (0 where nothing is hit,
+// i.e. premultiplied by coverage, like Cycles' DiffCol pass); normal = world-space geometric
+// normal facing the camera; depth = camera-frame z.
+void RenderView(const RenderScene& scene, const Material& material, const ViewSetup& view,
+                const RenderOptions& options, Image* image, RenderStats* stats = nullptr);
+
+}  // namespace sft
+
+#endif  // SFT_RENDER_RENDER_H_

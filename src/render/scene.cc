@@ -1,0 +1,152 @@
+#include "src/render/scene.h"
+
+#include <glog/logging.h>
+
+#include <cmath>
+#include <limits>
+#include <mutex>
+
+namespace sft {
+
+RTCDevice EmbreeDevice() {
+  static RTCDevice device = [] {
+    RTCDevice d = rtcNewDevice(nullptr);
+    CHECK(d != nullptr) << "Embree device creation failed: " << rtcGetDeviceError(nullptr);
+    rtcSetDeviceErrorFunction(
+        d,
+        [](void*, RTCError code, const char* message) {
+          LOG(ERROR) << "Embree error " << code << ": " << (message ? message : "");
+        },
+        nullptr);
+    return d;
+  }();
+  return device;
+}
+
+RenderScene::RenderScene(const std::vector<Eigen::Vector3d>& positions,
+                         const std::vector<Eigen::Vector3i>& faces)
+    : positions_(positions), faces_(faces) {
+  Build();
+}
+
+RenderScene::RenderScene(const TriMesh& mesh) {
+  MeshToArrays(mesh, &positions_, &faces_);
+  Build();
+}
+
+RenderScene::~RenderScene() {
+  if (scene_ != nullptr) rtcReleaseScene(scene_);
+}
+
+void RenderScene::Build() {
+  RTCDevice device = EmbreeDevice();
+  scene_ = rtcNewScene(device);
+  rtcSetSceneFlags(scene_, RTC_SCENE_FLAG_DYNAMIC | RTC_SCENE_FLAG_ROBUST);
+  rtcSetSceneBuildQuality(scene_, RTC_BUILD_QUALITY_MEDIUM);
+  geometry_ = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+  rtcSetGeometryBuildQuality(geometry_, RTC_BUILD_QUALITY_REFIT);
+  vertex_buffer_ = static_cast<float*>(rtcSetNewGeometryBuffer(
+      geometry_, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float),
+      std::max<size_t>(1, positions_.size())));
+  unsigned* index_buffer = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
+      geometry_, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned),
+      std::max<size_t>(1, faces_.size())));
+  for (size_t f = 0; f < faces_.size(); ++f) {
+    for (int k = 0; k < 3; ++k) {
+      CHECK(faces_[f][k] >= 0 && faces_[f][k] < static_cast<int>(positions_.size()));
+      index_buffer[3 * f + k] = static_cast<unsigned>(faces_[f][k]);
+    }
+  }
+  UpdateDerived();
+  rtcCommitGeometry(geometry_);
+  rtcAttachGeometry(scene_, geometry_);
+  rtcReleaseGeometry(geometry_);  // the scene holds the reference.
+  rtcCommitScene(scene_);
+}
+
+void RenderScene::UpdateDerived() {
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector3d hi = -lo;
+  for (size_t i = 0; i < positions_.size(); ++i) {
+    for (int k = 0; k < 3; ++k) vertex_buffer_[3 * i + k] = static_cast<float>(positions_[i][k]);
+    lo = lo.cwiseMin(positions_[i]);
+    hi = hi.cwiseMax(positions_[i]);
+  }
+  extent_ = positions_.empty() ? 1.0 : (hi - lo).norm();
+  if (!(extent_ > 0) || !std::isfinite(extent_)) extent_ = 1.0;
+  face_normals_.resize(faces_.size());
+  for (size_t f = 0; f < faces_.size(); ++f) {
+    const Eigen::Vector3d& p0 = positions_[faces_[f][0]];
+    const Eigen::Vector3d n = (positions_[faces_[f][1]] - p0).cross(positions_[faces_[f][2]] - p0);
+    const double len = n.norm();
+    face_normals_[f] = len > 0 && std::isfinite(len) ? Eigen::Vector3d(n / len)
+                                                     : Eigen::Vector3d::Zero();
+  }
+}
+
+void RenderScene::SetVertices(const std::vector<Eigen::Vector3d>& positions) {
+  CHECK_EQ(positions.size(), positions_.size());
+  positions_ = positions;
+  UpdateDerived();
+  rtcUpdateGeometryBuffer(geometry_, RTC_BUFFER_TYPE_VERTEX, 0);
+  rtcCommitGeometry(geometry_);
+  rtcCommitScene(scene_);
+}
+
+RayHit RenderScene::Intersect(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir,
+                              double t_near, double t_far) const {
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  RTCRayHit rh;
+  rh.ray.org_x = static_cast<float>(origin.x());
+  rh.ray.org_y = static_cast<float>(origin.y());
+  rh.ray.org_z = static_cast<float>(origin.z());
+  rh.ray.dir_x = static_cast<float>(dir.x());
+  rh.ray.dir_y = static_cast<float>(dir.y());
+  rh.ray.dir_z = static_cast<float>(dir.z());
+  rh.ray.tnear = static_cast<float>(t_near);
+  rh.ray.tfar = static_cast<float>(std::min(t_far, 3.0e38));
+  rh.ray.time = 0.0f;
+  rh.ray.mask = 0xFFFFFFFFu;
+  rh.ray.id = 0;
+  rh.ray.flags = 0;
+  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+  rtcIntersect1(scene_, &context, &rh);
+  RayHit hit;
+  if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return hit;
+  hit.hit = true;
+  hit.t = rh.ray.tfar;
+  hit.face = static_cast<int>(rh.hit.primID);
+  hit.u = rh.hit.u;
+  hit.v = rh.hit.v;
+  return hit;
+}
+
+bool RenderScene::Occluded(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir,
+                           double t_near, double t_far) const {
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  RTCRay ray;
+  ray.org_x = static_cast<float>(origin.x());
+  ray.org_y = static_cast<float>(origin.y());
+  ray.org_z = static_cast<float>(origin.z());
+  ray.dir_x = static_cast<float>(dir.x());
+  ray.dir_y = static_cast<float>(dir.y());
+  ray.dir_z = static_cast<float>(dir.z());
+  ray.tnear = static_cast<float>(t_near);
+  ray.tfar = static_cast<float>(std::min(t_far, 3.0e38));
+  ray.time = 0.0f;
+  ray.mask = 0xFFFFFFFFu;
+  ray.id = 0;
+  ray.flags = 0;
+  rtcOccluded1(scene_, &context, &ray);
+  return ray.tfar < 0.0f;  // Embree sets tfar = -inf on a hit.
+}
+
+Eigen::Vector3d RenderScene::Point(int face, double u, double v) const {
+  const Eigen::Vector3i& f = faces_[face];
+  return (1.0 - u - v) * positions_[f[0]] + u * positions_[f[1]] + v * positions_[f[2]];
+}
+
+}  // namespace sft

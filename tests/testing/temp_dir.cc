@@ -1,0 +1,39 @@
+#include "tests/testing/temp_dir.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <sys/wait.h>
+
+#include <filesystem>
+
+namespace sft {
+namespace testing {
+
+TempDir::TempDir() {
+  const char* base = getenv("TMPDIR");
+  std::string tmpl = std::string(base && *base ? base : "/tmp") + "/sft_test_XXXXXX";
+  char* made = mkdtemp(tmpl.data());
+  path_ = made ? std::string(made) : std::string();
+}
+
+TempDir::~TempDir() {
+  std::error_code ec;
+  if (!path_.empty()) std::filesystem::remove_all(path_, ec);
+}
+
+std::string DataDir() { return SFT_DATA_DIR; }
+std::string SftBinary() { return SFT_BINARY; }
+
+int RunCommand(const std::string& command, std::string* output) {
+  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
+  if (pipe == nullptr) return -1;
+  char buffer[4096];
+  std::string text;
+  while (fgets(buffer, sizeof(buffer), pipe) != nullptr) text += buffer;
+  const int status = pclose(pipe);
+  if (output != nullptr) *output = text;
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+}  // namespace testing
+}  // namespace sft

@@ -1,0 +1,35 @@
+// A fresh temporary directory per test, removed on destruction.
+#ifndef SFT_TESTS_TESTING_TEMP_DIR_H_
+#define SFT_TESTS_TESTING_TEMP_DIR_H_
+
+#include <string>
+
+namespace sft {
+namespace testing {
+
+class TempDir {
+ public:
+  TempDir();
+  ~TempDir();
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+
+  const std::string& path() const { return path_; }
+  // path()/relative
+  std::string Join(const std::string& relative) const { return path_ + "/" + relative; }
+
+ private:
+  std::string path_;
+};
+
+// The source tree's data/ directory (fixtures, Cycles reference datasets).
+std::string DataDir();
+// Absolute path of the built `sft` executable (for CLI tests).
+std::string SftBinary();
+// Runs a shell command, returns its exit code; stdout+stderr captured into *output if non-null.
+int RunCommand(const std::string& command, std::string* output = nullptr);
+
+}  // namespace testing
+}  // namespace sft
+
+#endif  // SFT_TESTS_TESTING_TEMP_DIR_H_
