@@ -11,6 +11,7 @@ const CommandEntry kCommands[] = {
      &SetupSynthCommand},
     {"render", "Render every view of a dataset with a given mesh and material",
      &SetupRenderCommand},
+    {"bench", "Measure throughput against the limit (raw Embree rays/s)", &SetupBenchCommand},
 };
 
 }  // namespace

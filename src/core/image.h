@@ -4,6 +4,7 @@
 #ifndef SFT_CORE_IMAGE_H_
 #define SFT_CORE_IMAGE_H_
 
+#include <cstddef>
 #include <vector>
 
 namespace sft {

@@ -16,22 +16,76 @@ inline uint64_t Mix64(uint64_t x) {
   return x ^ (x >> 31);
 }
 
-// A stream of uniform numbers in [0, 1) for one (seed, view, pixel, sample) key. Next1D() draws
-// the next dimension; the stream is stateless apart from its dimension counter.
+inline uint32_t ReverseBits32(uint32_t v) {
+  v = ((v >> 1) & 0x55555555u) | ((v & 0x55555555u) << 1);
+  v = ((v >> 2) & 0x33333333u) | ((v & 0x33333333u) << 2);
+  v = ((v >> 4) & 0x0F0F0F0Fu) | ((v & 0x0F0F0F0Fu) << 4);
+  v = ((v >> 8) & 0x00FF00FFu) | ((v & 0x00FF00FFu) << 8);
+  return (v >> 16) | (v << 16);
+}
+
+// The first two dimensions of the Sobol sequence as 32-bit fractions: dimension 0 is the van der
+// Corput sequence (bit reversal), dimension 1 has direction numbers v_k = v_{k−1} ^ (v_{k−1} >> 1)
+// (primitive polynomial x + 1). Together they form a (0, 2)-sequence: every power-of-two prefix
+// is stratified in every elementary interval.
+inline void Sobol2D(uint32_t index, uint32_t* x, uint32_t* y) {
+  *x = ReverseBits32(index);
+  uint32_t result = 0, v = 0x80000000u;
+  for (uint32_t i = index; i != 0; i >>= 1) {
+    if (i & 1u) result ^= v;
+    v ^= v >> 1;
+  }
+  *y = result;
+}
+
+// A nested uniform (Owen) scramble of a 32-bit fraction by a hash (Laine & Karras 2011, with
+// Burley's 2020 constants): keeps the stratification of (0, 2)-sequences, randomizes the rest.
+inline uint32_t OwenScramble(uint32_t v, uint32_t seed) {
+  v = ReverseBits32(v);
+  v ^= v * 0x3D20ADEAu;
+  v += seed;
+  v *= (seed >> 16) | 1u;
+  v ^= v * 0x05526C56u;
+  v ^= v * 0x53A22864u;
+  return ReverseBits32(v);
+}
+
+// The random numbers of one Monte Carlo sample: sample `sample` of pixel `pixel` of view `view`.
+// Next2D() draws stratified pairs: each pair of dimensions uses its own Owen-scrambled Sobol
+// (0, 2)-sequence over the pixel's sample index, with the index shuffled per pair ("padded"
+// sampling), so the samples of one pixel are stratified in every 2D projection the renderer uses
+// (sub-pixel position, light sample, BSDF direction). Next1D() draws an independent hashed value.
+// Both are pure functions of (seed, view, pixel, sample, dimension counter).
 class Sampler {
  public:
   Sampler(uint64_t seed, uint64_t view, uint64_t pixel, uint64_t sample)
-      : key_(Mix64(Mix64(Mix64(seed) ^ view) ^ pixel) ^ Mix64(sample + 0x5851F42D4C957F2Dull)) {}
+      : pixel_key_(Mix64(Mix64(Mix64(seed) ^ view) ^ pixel)), sample_(sample) {}
 
   double Next1D() {
-    const uint64_t bits = Mix64(key_ + 0xD1B54A32D192ED03ull * (++dimension_));
+    const uint64_t bits =
+        Mix64(pixel_key_ ^ Mix64(sample_ + 0x5851F42D4C957F2Dull * (++dimension_)));
     return static_cast<double>(bits >> 11) * 0x1.0p-53;  // 53 random mantissa bits: < 1 always.
   }
-  uint32_t dimension() const { return dimension_; }
+
+  void Next2D(double* u1, double* u2) {
+    const uint64_t hash = Mix64(pixel_key_ + 0xD1B54A32D192ED03ull * (++pair_));
+    // Shuffle the index within its power-of-two block by XOR (a permutation of the block).
+    const uint32_t index =
+        static_cast<uint32_t>(sample_) ^ static_cast<uint32_t>(hash & 0xFFFFu);
+    uint32_t x, y;
+    Sobol2D(index, &x, &y);
+    x = OwenScramble(x, static_cast<uint32_t>(hash >> 16));
+    y = OwenScramble(y, static_cast<uint32_t>(hash >> 40) * 0x9E3779B9u + 1u);
+    // Centre of the 2^-32 cell: never exactly 0 or 1.
+    *u1 = (static_cast<double>(x) + 0.5) * 0x1.0p-32;
+    *u2 = (static_cast<double>(y) + 0.5) * 0x1.0p-32;
+  }
 
  private:
-  uint64_t key_;
+  uint64_t pixel_key_;
+  uint64_t sample_;
   uint32_t dimension_ = 0;
+  uint32_t pair_ = 0;
 };
 
 }  // namespace sft

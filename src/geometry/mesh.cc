@@ -9,8 +9,9 @@
 //   - per-corner OBJ UVs are only right for triangles: for polygons and for non-manifold faces
 //     (whose vertices get duplicated) the importer walks the wrong halfedges, and corners without
 //     a `vt` keep uninitialized memory.
-// Writing: OBJ by hand (OpenMesh's OBJ writer prints to stdout), PLY (binary, float32 vertices)
-// and OFF (ascii, 17 digits) with OpenMesh's writers.
+// Writing: PLY (binary little endian, float32 vertices) with OpenMesh's writer; OBJ and OFF by hand
+// with shortest round-trip decimals (OpenMesh's OBJ writer prints to stdout, its OFF writer rounds
+// to float), so that OBJ and OFF round trips are exact.
 #include "src/geometry/mesh.h"
 
 #include <glog/logging.h>
@@ -18,6 +19,7 @@
 #include <OpenMesh/Core/IO/MeshIO.hh>
 #include <OpenMesh/Core/System/omstream.hh>
 #include <cerrno>
+#include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -103,27 +105,34 @@ void Tokenize(std::string_view line, std::vector<std::string_view>* tokens) {
 }
 
 // Parses a whole token as a double (accepts "nan"/"inf": the caller checks finiteness, so that the
-// error says "non-finite" rather than "malformed").
+// error says "non-finite" rather than "malformed"). std::from_chars: locale-independent and fast.
 bool ParseDouble(std::string_view token, double* value) {
-  if (token.empty() || token.size() > 64) return false;
-  char buffer[65];
-  std::memcpy(buffer, token.data(), token.size());
-  buffer[token.size()] = '\0';
-  char* end = nullptr;
-  errno = 0;
-  *value = std::strtod(buffer, &end);
-  return end == buffer + token.size();
+  if (!token.empty() && token[0] == '+') token.remove_prefix(1);
+  if (token.empty()) return false;
+  const char* end = token.data() + token.size();
+  const std::from_chars_result result = std::from_chars(token.data(), end, *value);
+  if (result.ec == std::errc::result_out_of_range && result.ptr == end) {
+    // Overflow or underflow: strtod gives ±inf or the nearest tiny value / 0, as wanted.
+    const std::string copy(token);
+    *value = std::strtod(copy.c_str(), nullptr);
+    return true;
+  }
+  return result.ec == std::errc() && result.ptr == end;
 }
 
 bool ParseInt(std::string_view token, long long* value) {
-  if (token.empty() || token.size() > 32) return false;
-  char buffer[33];
-  std::memcpy(buffer, token.data(), token.size());
-  buffer[token.size()] = '\0';
-  char* end = nullptr;
-  errno = 0;
-  *value = std::strtoll(buffer, &end, 10);
-  return end == buffer + token.size() && errno == 0;
+  if (!token.empty() && token[0] == '+') token.remove_prefix(1);
+  if (token.empty()) return false;
+  const char* end = token.data() + token.size();
+  const std::from_chars_result result = std::from_chars(token.data(), end, *value);
+  return result.ec == std::errc() && result.ptr == end;
+}
+
+// Appends the shortest decimal text that reads back to exactly `value` (std::to_chars).
+void AppendDouble(double value, std::string* out) {
+  char buffer[32];
+  const std::to_chars_result result = std::to_chars(buffer, buffer + sizeof(buffer), value);
+  out->append(buffer, result.ptr);
 }
 
 // Iterates over the lines of a text buffer, numbering them from 1.
@@ -236,8 +245,8 @@ Status ParseObj(const std::string& path, const std::string& text, ParsedMesh* ou
           *index = value > 0 ? value - 1 : count + value;
           if (*index < 0) {
             return Status::Error(LinePrefix(path, ln) + ": " + what + " index " +
-                                 std::to_string(value) + " out of range (" +
-                                 std::to_string(count) + " defined before it)");
+                                 std::to_string(value) + " out of range (" + std::to_string(count) +
+                                 " defined before it)");
           }
           return Status::Ok();
         };
@@ -404,12 +413,12 @@ enum class PlyType { kInt8, kUint8, kInt16, kUint16, kInt32, kUint32, kFloat32, 
 
 bool ParsePlyType(std::string_view name, PlyType* type) {
   static const std::pair<const char*, PlyType> kTypes[] = {
-      {"char", PlyType::kInt8},       {"int8", PlyType::kInt8},     {"uchar", PlyType::kUint8},
-      {"uint8", PlyType::kUint8},     {"short", PlyType::kInt16},   {"int16", PlyType::kInt16},
-      {"ushort", PlyType::kUint16},   {"uint16", PlyType::kUint16}, {"int", PlyType::kInt32},
-      {"int32", PlyType::kInt32},     {"uint", PlyType::kUint32},   {"uint32", PlyType::kUint32},
-      {"float", PlyType::kFloat32},   {"float32", PlyType::kFloat32},
-      {"double", PlyType::kFloat64},  {"float64", PlyType::kFloat64}};
+      {"char", PlyType::kInt8},      {"int8", PlyType::kInt8},       {"uchar", PlyType::kUint8},
+      {"uint8", PlyType::kUint8},    {"short", PlyType::kInt16},     {"int16", PlyType::kInt16},
+      {"ushort", PlyType::kUint16},  {"uint16", PlyType::kUint16},   {"int", PlyType::kInt32},
+      {"int32", PlyType::kInt32},    {"uint", PlyType::kUint32},     {"uint32", PlyType::kUint32},
+      {"float", PlyType::kFloat32},  {"float32", PlyType::kFloat32}, {"double", PlyType::kFloat64},
+      {"float64", PlyType::kFloat64}};
   for (const auto& t : kTypes) {
     if (name == t.first) {
       *type = t.second;
@@ -476,14 +485,30 @@ class PlyBodyReader {
       for (int i = 0; i < size / 2; ++i) std::swap(bytes[i], bytes[size - 1 - i]);
     }
     switch (type) {
-      case PlyType::kInt8: *value = static_cast<int8_t>(bytes[0]); break;
-      case PlyType::kUint8: *value = bytes[0]; break;
-      case PlyType::kInt16: *value = Load<int16_t>(bytes); break;
-      case PlyType::kUint16: *value = Load<uint16_t>(bytes); break;
-      case PlyType::kInt32: *value = Load<int32_t>(bytes); break;
-      case PlyType::kUint32: *value = Load<uint32_t>(bytes); break;
-      case PlyType::kFloat32: *value = Load<float>(bytes); break;
-      case PlyType::kFloat64: *value = Load<double>(bytes); break;
+      case PlyType::kInt8:
+        *value = static_cast<int8_t>(bytes[0]);
+        break;
+      case PlyType::kUint8:
+        *value = bytes[0];
+        break;
+      case PlyType::kInt16:
+        *value = Load<int16_t>(bytes);
+        break;
+      case PlyType::kUint16:
+        *value = Load<uint16_t>(bytes);
+        break;
+      case PlyType::kInt32:
+        *value = Load<int32_t>(bytes);
+        break;
+      case PlyType::kUint32:
+        *value = Load<uint32_t>(bytes);
+        break;
+      case PlyType::kFloat32:
+        *value = Load<float>(bytes);
+        break;
+      case PlyType::kFloat64:
+        *value = Load<double>(bytes);
+        break;
     }
     return true;
   }
@@ -568,8 +593,8 @@ Status ParsePly(const std::string& path, const std::string& text, ParsedMesh* ou
       if (tokens.size() == 5 && tokens[1] == "list") {
         property.is_list = true;
         if (!ParsePlyType(tokens[2], &property.count_type) ||
-            !ParsePlyType(tokens[3], &property.type) ||
-            property.count_type == PlyType::kFloat32 || property.count_type == PlyType::kFloat64) {
+            !ParsePlyType(tokens[3], &property.type) || property.count_type == PlyType::kFloat32 ||
+            property.count_type == PlyType::kFloat64) {
           return Status::Error(LinePrefix(path, ln) + ": malformed list property");
         }
         property.name = std::string(tokens[4]);
@@ -580,8 +605,8 @@ Status ParsePly(const std::string& path, const std::string& text, ParsedMesh* ou
       }
       elements.back().properties.push_back(property);
     } else {
-      return Status::Error(LinePrefix(path, ln) + ": unknown PLY header line '" +
-                           std::string(key) + "'");
+      return Status::Error(LinePrefix(path, ln) + ": unknown PLY header line '" + std::string(key) +
+                           "'");
     }
   }
   if (!have_format) return Status::Error(path + ": PLY header has no format line");
@@ -635,8 +660,8 @@ Status ParsePly(const std::string& path, const std::string& text, ParsedMesh* ou
       for (size_t pi = 0; pi < e.properties.size(); ++pi) {
         const PlyProperty& prop = e.properties[pi];
         auto truncated = [&]() {
-          return Status::Error(path + ": truncated or malformed data in element '" + e.name +
-                               "' " + std::to_string(n) + ", property '" + prop.name + "'");
+          return Status::Error(path + ": truncated or malformed data in element '" + e.name + "' " +
+                               std::to_string(n) + ", property '" + prop.name + "'");
         };
         if (!prop.is_list) {
           double value = 0.0;
@@ -692,8 +717,7 @@ Status ParsePly(const std::string& path, const std::string& text, ParsedMesh* ou
       }
       if (&e == vertex_element) {
         if (!p.allFinite()) {
-          return Status::Error(path + ": vertex " + std::to_string(n) +
-                               ": non-finite coordinate");
+          return Status::Error(path + ": vertex " + std::to_string(n) + ": non-finite coordinate");
         }
         out->positions.push_back(p);
         if (vertex_uvs) {
@@ -840,20 +864,68 @@ Status BuildMesh(const std::string& path, const ParsedMesh& parsed, TriMesh* mes
 
 // ---- Writing ------------------------------------------------------------------------------------
 
+// Text output through a buffer flushed in 1 MB chunks.
+class TextFileWriter {
+ public:
+  explicit TextFileWriter(const std::string& path) : file_(std::fopen(path.c_str(), "wb")) {}
+  ~TextFileWriter() {
+    if (file_ != nullptr) std::fclose(file_);
+  }
+  bool is_open() const { return file_ != nullptr; }
+  std::string& buffer() { return buffer_; }
+  void MaybeFlush() {
+    if (buffer_.size() > (1 << 20)) Flush();
+  }
+  // Flushes and closes; false on any write error.
+  bool Close() {
+    Flush();
+    const bool ok = std::ferror(file_) == 0;
+    const bool closed = std::fclose(file_) == 0;
+    file_ = nullptr;
+    return ok && closed;
+  }
+
+ private:
+  void Flush() {
+    if (!buffer_.empty()) std::fwrite(buffer_.data(), 1, buffer_.size(), file_);
+    buffer_.clear();
+  }
+  std::FILE* file_;
+  std::string buffer_;
+};
+
+// 1-based (OBJ) or 0-based (OFF) indices of the mesh's non-deleted vertices, in order.
+std::vector<int> CompactVertexIndices(const TriMesh& mesh, int first, int* count) {
+  std::vector<int> compact(mesh.n_vertices(), -1);
+  int next = first;
+  for (TriMesh::VertexHandle vh : mesh.vertices()) compact[vh.idx()] = next++;
+  *count = next - first;
+  return compact;
+}
+
 Status WriteObj(const std::string& path, const TriMesh& mesh) {
   return WriteAtomically(path, [&](const std::string& tmp) -> Status {
-    std::FILE* file = std::fopen(tmp.c_str(), "wb");
-    if (file == nullptr) return Status::Error(path + ": cannot open for writing");
-    std::fprintf(file, "# sft mesh: %zu vertices, %zu faces\n", mesh.n_vertices(),
-                 mesh.n_faces());
+    TextFileWriter out(tmp);
+    if (!out.is_open()) return Status::Error(path + ": cannot open for writing");
+    std::string& text = out.buffer();
+    int num_vertices = 0;
+    const std::vector<int> compact = CompactVertexIndices(mesh, 1, &num_vertices);
+    text += "# sft mesh\n";
     for (TriMesh::VertexHandle vh : mesh.vertices()) {
       const TriMesh::Point& p = mesh.point(vh);
-      std::fprintf(file, "v %.17g %.17g %.17g\n", p[0], p[1], p[2]);
+      text += 'v';
+      for (int c = 0; c < 3; ++c) {
+        text += ' ';
+        AppendDouble(p[c], &text);
+      }
+      text += '\n';
+      out.MaybeFlush();
     }
+    // Corner UVs: one vt per distinct value (exact match), in order of first use. FaceCornerUvs
+    // lists all faces by index, deleted ones included; they are skipped below like the faces.
     const std::vector<Eigen::Vector2d> uvs = FaceCornerUvs(mesh);
     std::vector<int> corner_uv_index;
     if (!uvs.empty()) {
-      // One vt per distinct UV value (exact match), in order of first use.
       struct KeyHash {
         size_t operator()(const std::pair<uint64_t, uint64_t>& k) const {
           return std::hash<uint64_t>()(k.first * 0x9E3779B97F4A7C15ull ^ k.second);
@@ -868,43 +940,78 @@ Status WriteObj(const std::string& path, const TriMesh& mesh) {
         auto it = index.find(key);
         if (it == index.end()) {
           it = index.emplace(key, static_cast<int>(index.size()) + 1).first;
-          std::fprintf(file, "vt %.17g %.17g\n", uv.x(), uv.y());
+          text += "vt ";
+          AppendDouble(uv.x(), &text);
+          text += ' ';
+          AppendDouble(uv.y(), &text);
+          text += '\n';
+          out.MaybeFlush();
         }
         corner_uv_index.push_back(it->second);
       }
     }
-    std::vector<int> compact(mesh.n_vertices(), -1);
-    int next = 1;
-    for (TriMesh::VertexHandle vh : mesh.vertices()) compact[vh.idx()] = next++;
-    size_t corner = 0;
     for (TriMesh::FaceHandle fh : mesh.faces()) {
-      std::fputc('f', file);
+      text += 'f';
+      int corner = 3 * fh.idx();
       for (TriMesh::HalfedgeHandle h : mesh.fh_range(fh)) {
-        const int v = compact[mesh.to_vertex_handle(h).idx()];
-        if (corner_uv_index.empty()) {
-          std::fprintf(file, " %d", v);
-        } else {
-          std::fprintf(file, " %d/%d", v, corner_uv_index[corner++]);
+        text += ' ';
+        text += std::to_string(compact[mesh.to_vertex_handle(h).idx()]);
+        if (!corner_uv_index.empty()) {
+          text += '/';
+          text += std::to_string(corner_uv_index[corner++]);
         }
       }
-      std::fputc('\n', file);
+      text += '\n';
+      out.MaybeFlush();
     }
-    const bool ok = std::ferror(file) == 0;
-    if (std::fclose(file) != 0 || !ok) return Status::Error(path + ": write failed");
+    if (!out.Close()) return Status::Error(path + ": write failed");
     return Status::Ok();
   });
 }
 
-Status WriteWithOpenMesh(const std::string& path, const TriMesh& mesh,
-                         OpenMesh::IO::Options options, std::streamsize precision) {
+// OFF by hand as well: OpenMesh's OFF writer rounds coordinates to float.
+Status WriteOff(const std::string& path, const TriMesh& mesh) {
+  return WriteAtomically(path, [&](const std::string& tmp) -> Status {
+    TextFileWriter out(tmp);
+    if (!out.is_open()) return Status::Error(path + ": cannot open for writing");
+    std::string& text = out.buffer();
+    int num_vertices = 0;
+    const std::vector<int> compact = CompactVertexIndices(mesh, 0, &num_vertices);
+    size_t num_faces = 0;
+    for (TriMesh::FaceHandle fh : mesh.faces()) num_faces += fh.is_valid() ? 1 : 0;
+    text += "OFF\n" + std::to_string(num_vertices) + " " + std::to_string(num_faces) + " 0\n";
+    for (TriMesh::VertexHandle vh : mesh.vertices()) {
+      const TriMesh::Point& p = mesh.point(vh);
+      for (int c = 0; c < 3; ++c) {
+        if (c > 0) text += ' ';
+        AppendDouble(p[c], &text);
+      }
+      text += '\n';
+      out.MaybeFlush();
+    }
+    for (TriMesh::FaceHandle fh : mesh.faces()) {
+      text += '3';
+      for (TriMesh::HalfedgeHandle h : mesh.fh_range(fh)) {
+        text += ' ';
+        text += std::to_string(compact[mesh.to_vertex_handle(h).idx()]);
+      }
+      text += '\n';
+      out.MaybeFlush();
+    }
+    if (!out.Close()) return Status::Error(path + ": write failed");
+    return Status::Ok();
+  });
+}
+
+Status WritePly(const std::string& path, const TriMesh& mesh) {
   // OpenMesh's writers index vertices by position in the arrays: garbage-collect deleted elements
   // on a copy first.
   bool has_deleted = false;
   if (mesh.has_vertex_status() || mesh.has_face_status()) {
-    has_deleted = mesh.n_vertices() != static_cast<size_t>(std::distance(
-                                           mesh.vertices_begin(), mesh.vertices_end())) ||
-                  mesh.n_faces() != static_cast<size_t>(
-                                        std::distance(mesh.faces_begin(), mesh.faces_end()));
+    has_deleted =
+        mesh.n_vertices() !=
+            static_cast<size_t>(std::distance(mesh.vertices_begin(), mesh.vertices_end())) ||
+        mesh.n_faces() != static_cast<size_t>(std::distance(mesh.faces_begin(), mesh.faces_end()));
   }
   TriMesh compacted;
   const TriMesh* source = &mesh;
@@ -915,7 +1022,8 @@ Status WriteWithOpenMesh(const std::string& path, const TriMesh& mesh,
   }
   return WriteAtomically(path, [&](const std::string& tmp) -> Status {
     ScopedOpenMeshQuiet quiet;
-    if (!OpenMesh::IO::write_mesh(*source, tmp, options, precision)) {
+    const OpenMesh::IO::Options options(OpenMesh::IO::Options::Binary | OpenMesh::IO::Options::LSB);
+    if (!OpenMesh::IO::write_mesh(*source, tmp, options)) {
       return Status::Error(path + ": write failed");
     }
     return Status::Ok();
@@ -951,13 +1059,8 @@ Status ReadMesh(const std::string& path, TriMesh* mesh, MeshReport* report) {
 Status WriteMesh(const std::string& path, const TriMesh& mesh) {
   const std::string ext = FileExtension(path);
   if (ext == "obj") return WriteObj(path, mesh);
-  if (ext == "ply") {
-    return WriteWithOpenMesh(path, mesh,
-                             OpenMesh::IO::Options(OpenMesh::IO::Options::Binary |
-                                                   OpenMesh::IO::Options::LSB),
-                             6);
-  }
-  if (ext == "off") return WriteWithOpenMesh(path, mesh, OpenMesh::IO::Options::Default, 17);
+  if (ext == "ply") return WritePly(path, mesh);
+  if (ext == "off") return WriteOff(path, mesh);
   return Status::Error(path + ": unknown mesh extension '" + ext + "' (expected obj, ply, off)");
 }
 

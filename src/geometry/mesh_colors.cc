@@ -144,8 +144,8 @@ Status ReadMeshColors(const std::string& path, MeshColors* colors,
   auto get_string = [&](const char* field, const char* expected) -> Status {
     if (!header.contains(field)) return field_error(field, "missing");
     if (!header[field].is_string() || header[field].get<std::string>() != expected) {
-      return field_error(field, std::string("expected \"") + expected + "\", got " +
-                                    header[field].dump());
+      return field_error(field,
+                         std::string("expected \"") + expected + "\", got " + header[field].dump());
     }
     return Status::Ok();
   };
@@ -178,15 +178,14 @@ Status ReadMeshColors(const std::string& path, MeshColors* colors,
     names.push_back(name.get<std::string>());
   }
 
-  const uint64_t expected_values = static_cast<uint64_t>(num_faces) *
-                                   MeshColors::TexelsPerFace(resolution) * channels;
+  const uint64_t expected_values =
+      static_cast<uint64_t>(num_faces) * MeshColors::TexelsPerFace(resolution) * channels;
   const uint64_t payload_bytes = data.size() - newline - 1;
   if (payload_bytes != expected_values * sizeof(float)) {
-    return Status::Error(path + ": payload has " + std::to_string(payload_bytes) +
-                         " bytes, header (num_faces " + std::to_string(num_faces) +
-                         ", resolution " + std::to_string(resolution) + ", channels " +
-                         std::to_string(channels) + ") needs " +
-                         std::to_string(expected_values * sizeof(float)));
+    return Status::Error(
+        path + ": payload has " + std::to_string(payload_bytes) + " bytes, header (num_faces " +
+        std::to_string(num_faces) + ", resolution " + std::to_string(resolution) + ", channels " +
+        std::to_string(channels) + ") needs " + std::to_string(expected_values * sizeof(float)));
   }
   MeshColors result(num_faces, resolution, channels);
   const char* payload = data.data() + newline + 1;

@@ -313,7 +313,10 @@ class SceneParser {
     if (!(norm > 1e-12) || !std::isfinite(norm)) {
       return Error(Field(path, "rotation"), "quaternion must have a non-zero finite norm");
     }
-    quaternion.coeffs() /= norm;
+    // Leave already-unit quaternions untouched so that write/read cycles are exact.
+    if (std::abs(norm - 1.0) > 4 * std::numeric_limits<double>::epsilon()) {
+      quaternion.coeffs() /= norm;
+    }
     pose->rotation = quaternion;
     const json* translation = nullptr;
     SFT_RETURN_IF_ERROR(Require(*value, path, "translation", &translation));
@@ -478,7 +481,7 @@ Status ReadDataset(const std::string& dir, Dataset* dataset) {
     json root;
     try {
       root = json::parse(text);
-    } catch (const json::parse_error& e) {
+    } catch (const json::exception& e) {  // parse_error, or out_of_range for 1e999.
       return Status::Error(file + ": invalid JSON: " + StripJsonExceptionId(e.what()));
     }
     Dataset result;

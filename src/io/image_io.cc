@@ -76,10 +76,11 @@ Status ReadExr(const std::string& path, Image* image) {
   }
   ExrHolder exr;
   const char* err = nullptr;
+  // tinyexr may allocate channel tables before failing: the header is freed either way.
+  exr.header_parsed = true;
   if (ParseEXRHeaderFromFile(&exr.header, &version, path.c_str(), &err) != TINYEXR_SUCCESS) {
     return PathError(path, "cannot read OpenEXR header (" + TakeExrError(err) + ")");
   }
-  exr.header_parsed = true;
   for (int c = 0; c < exr.header.num_channels; ++c) {
     if (exr.header.pixel_types[c] == TINYEXR_PIXELTYPE_HALF) {
       exr.header.requested_pixel_types[c] = TINYEXR_PIXELTYPE_FLOAT;

@@ -16,6 +16,7 @@
 #define SFT_RENDER_BSDF_H_
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 #include "src/geometry/material.h"
 

@@ -104,7 +104,8 @@ Eigen::Vector3d TraceRadiance(const Context& ctx, Sampler* sampler, const Eigen:
       if (ctx.environment != nullptr) {
         Eigen::Vector3d wi, le;
         double pdf_light = 0.0;
-        const double u1 = sampler->Next1D(), u2 = sampler->Next1D();
+        double u1, u2;
+        sampler->Next2D(&u1, &u2);
         if (ctx.environment->Sample(u1, u2, &wi, &le, &pdf_light)) {
           const double cos_i = n.dot(wi);
           if (cos_i > 0.0) {
@@ -131,7 +132,9 @@ Eigen::Vector3d TraceRadiance(const Context& ctx, Sampler* sampler, const Eigen:
         ctx.environment != nullptr && lit_here && effects.shadows;
     if (!continue_path && !bsdf_lights_environment) break;
     BsdfSample sample;
-    const Eigen::Vector3d u(sampler->Next1D(), sampler->Next1D(), sampler->Next1D());
+    Eigen::Vector3d u;
+    u.x() = sampler->Next1D();  // lobe choice
+    sampler->Next2D(&u.y(), &u.z());
     if (!SampleBsdf(params, n, wo, u, &sample)) break;
     const Eigen::Vector3d next_throughput =
         throughput.cwiseProduct(sample.f) * (n.dot(sample.wi) / sample.pdf);
@@ -281,7 +284,9 @@ void RenderView(const RenderScene& scene, const Material& material, const ViewSe
         int hits = 0;
         for (int s = 0; s < options.spp; ++s) {
           Sampler sampler(options.seed, view.view_index, pixel, static_cast<uint64_t>(s));
-          const Eigen::Vector2d film(x + sampler.Next1D(), y + sampler.Next1D());
+          double jitter_x, jitter_y;
+          sampler.Next2D(&jitter_x, &jitter_y);
+          const Eigen::Vector2d film(x + jitter_x, y + jitter_y);
           const Eigen::Vector3d dir =
               (world_from_cam_rotation * view.camera.CamFromImage(film)).normalized();
           bool hit = false;

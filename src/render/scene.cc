@@ -51,6 +51,9 @@ void RenderScene::Build() {
   unsigned* index_buffer = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
       geometry_, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned),
       std::max<size_t>(1, faces_.size())));
+  // An empty mesh still gets one (degenerate, never hit) primitive: Embree wants non-empty buffers.
+  index_buffer[0] = index_buffer[1] = index_buffer[2] = 0;
+  vertex_buffer_[0] = vertex_buffer_[1] = vertex_buffer_[2] = 0.0f;
   for (size_t f = 0; f < faces_.size(); ++f) {
     for (int k = 0; k < 3; ++k) {
       CHECK(faces_[f][k] >= 0 && faces_[f][k] < static_cast<int>(positions_.size()));

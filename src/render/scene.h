@@ -9,6 +9,7 @@
 #include <embree3/rtcore.h>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <vector>
 
 #include "src/geometry/material.h"

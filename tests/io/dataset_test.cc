@@ -180,6 +180,11 @@ TEST(DatasetErrors, InvalidJson) {
   EXPECT_THAT(status.message(), AllOf(HasSubstr(dir.Join("scene.json")), HasSubstr("invalid JSON"),
                                       HasSubstr("line 4")));
   EXPECT_EQ(status.message().find('\n'), std::string::npos);  // one line.
+
+  std::ofstream(dir.Join("scene.json"), std::ios::trunc) << "{\"format\": 1e999}";
+  const Status overflow = ReadDataset(dir.path(), &dataset);
+  ASSERT_FALSE(overflow.ok());
+  EXPECT_THAT(overflow.message(), AllOf(HasSubstr("scene.json"), HasSubstr("invalid JSON")));
 }
 
 TEST(DatasetErrors, TopLevelNotAnObject) {
@@ -431,7 +436,7 @@ TEST(DatasetFiles, LoadViewImageAndMask) {
   EXPECT_EQ(image.width, kWidth);
   EXPECT_EQ(image.at(2, 3, 2), 0.25f);
   ASSERT_TRUE(LoadViewImage(dataset, 1, &image).ok());  // sRGB PNG -> linear
-  EXPECT_NEAR(image.at(0, 0, 0), 0.2158605f, 1e-6);
+  EXPECT_NEAR(image.at(0, 0, 0), 0.5f, 0.005f);         // written as linear 0.5, 8-bit quantized.
 
   Image mask;
   ASSERT_TRUE(LoadViewMask(dataset, 0, &mask).ok());

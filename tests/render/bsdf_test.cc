@@ -14,12 +14,14 @@ Eigen::Vector3d Direction(double theta, double phi) {
   return {std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta)};
 }
 
-// ∫ pdf dω over the hemisphere by a midpoint rule in (cos θ, φ): must be 1 for mixtures of
-// normalized lobes, up to the grazing mass the visible-normal lobe places below the horizon
-// (which SampleBsdf rejects), so ≤ 1 and ≥ 0.9 here.
-TEST(BsdfTest, PdfIntegratesToAtMostOne) {
+// ∫ pdf dω over the upper hemisphere by a midpoint rule in (cos θ, φ). The visible-normal lobe
+// reflects part of its mass below the horizon (much of it for rough, grazing cases), which
+// SampleBsdf rejects; so the integral is ≤ 1 and must equal SampleBsdf's acceptance rate.
+TEST(BsdfTest, PdfIntegratesToAcceptanceRate) {
   const Eigen::Vector3d n(0, 0, 1);
-  for (double roughness : {0.05, 0.2, 0.5, 1.0}) {
+  // Roughness ≥ 0.15: sharper lobes are below what the grid resolves (their D normalization is
+  // checked by GgxDistributionIsNormalized with a 1D quadrature instead).
+  for (double roughness : {0.15, 0.3, 0.6, 1.0}) {
     for (double theta_o : {0.1, 0.8, 1.4}) {
       BsdfParams params;
       params.albedo = Eigen::Vector3d(0.5, 0.5, 0.5);
@@ -36,10 +38,19 @@ TEST(BsdfTest, PdfIntegratesToAtMostOne) {
         }
       }
       integral *= (1.0 / nc) * (2 * M_PI / np);
-      // Tolerance: the grid resolves lobes down to roughness 0.05 (α = 0.0025 is sharper; the
-      // lobe width in cos θ is ~α², so 800 cells still resolve it to a few percent).
-      EXPECT_LE(integral, 1.02) << "roughness " << roughness << " theta_o " << theta_o;
-      EXPECT_GE(integral, 0.85) << "roughness " << roughness << " theta_o " << theta_o;
+      const int samples = 40000;
+      int accepted = 0;
+      for (int s = 0; s < samples; ++s) {
+        Sampler sampler(11, 0, 0, s);
+        BsdfSample sample;
+        const Eigen::Vector3d u(sampler.Next1D(), sampler.Next1D(), sampler.Next1D());
+        accepted += SampleBsdf(params, n, wo, u, &sample) ? 1 : 0;
+      }
+      // Tolerance 0.02: the acceptance rate's binomial standard deviation is ≤ 0.0025, and the
+      // 800×800 grid resolves the sharpest lobe here (α = 0.0225) to well under 1%.
+      EXPECT_LE(integral, 1.01) << "roughness " << roughness << " theta_o " << theta_o;
+      EXPECT_NEAR(integral, static_cast<double>(accepted) / samples, 0.02)
+          << "roughness " << roughness << " theta_o " << theta_o;
     }
   }
 }
@@ -94,7 +105,7 @@ TEST(BsdfTest, SamplingMatchesPdfChiSquare) {
     }
     EXPECT_GT(dof, 50);
     EXPECT_LT(chi2, dof + 6.0 * std::sqrt(2.0 * dof)) << "roughness " << roughness;
-    EXPECT_GT(accepted, samples * 0.9);
+    EXPECT_GT(accepted, samples / 2);
   }
 }
 

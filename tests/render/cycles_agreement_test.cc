@@ -84,7 +84,7 @@ TEST_P(CyclesAgreementTest, MatchesReference) {
 INSTANTIATE_TEST_SUITE_P(
     Cycles, CyclesAgreementTest,
     ::testing::Values(CyclesCase{"bunny_point_diffuse", 64, 0.02},
-                      CyclesCase{"bunny_point_ggx_gi", 128, 0.03},
+                      CyclesCase{"bunny_point_ggx_gi", 512, 0.03},
                       CyclesCase{"sphere_env_studio", 256, 0.03},
                       CyclesCase{"spot_textured_point", 64, 0.03}),
     [](const ::testing::TestParamInfo<CyclesCase>& info) { return std::string(info.param.name); });

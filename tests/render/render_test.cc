@@ -29,9 +29,10 @@ std::vector<Eigen::Vector3d> QuadPositions(double half) {
 std::vector<Eigen::Vector3i> QuadFaces() { return {{0, 1, 2}, {0, 2, 3}}; }
 
 // Lambert plane under a point light: radiance ρ·I·cos θ/(π·d²) at every point (DESIGN.md §2.5).
-// The pixel value is the area average of that smooth function; we compare with the value at the
-// pixel's centre, whose difference is O((pixel size/d)²) ≈ 1e-5 here, and the jitter noise over
-// 64 samples of a function that varies < 0.2% across a pixel is far smaller. Tolerance 0.2%.
+// The pixel value is the box-filter average of that smooth function, computed here by a 16×16
+// midpoint rule over the pixel (quadrature error < 1e-5 relative). The render's only noise is
+// the pixel jitter: the function varies ≲ 2% across a pixel, so 64 samples leave ≲ 0.1%
+// (2%/√(12·64)). Tolerance 0.2%.
 TEST(RenderTest, LambertPlaneUnderPointLight) {
   const RenderScene scene(QuadPositions(1.0), QuadFaces());
   const Eigen::Vector3d albedo(0.8, 0.5, 0.2);
@@ -47,24 +48,32 @@ TEST(RenderTest, LambertPlaneUnderPointLight) {
   Image image;
   RenderView(scene, material, view, options, &image);
   int checked = 0;
-  for (int y = 0; y < res; y += 5) {
-    for (int x = 0; x < res; x += 5) {
-      // Pixel centre → world point on z = 0.
-      const double u = (x + 0.5 - 0.5 * res) / focal, v = (y + 0.5 - 0.5 * res) / focal;
-      const Eigen::Vector3d p(u * height, -v * height, 0.0);
-      if (std::abs(p.x()) > 0.95 || std::abs(p.y()) > 0.95) continue;
-      const Eigen::Vector3d to_light = light - p;
-      const double d2 = to_light.squaredNorm();
-      const double cos_t = to_light.z() / std::sqrt(d2);
+  for (int y = 0; y < res; y += 3) {
+    for (int x = 0; x < res; x += 3) {
+      // Pixel → world points on z = 0 (the camera looks straight down).
+      const double cu = (x + 0.5 - 0.5 * res) / focal, cv = (y + 0.5 - 0.5 * res) / focal;
+      if (std::abs(cu * height) > 0.9 || std::abs(cv * height) > 0.9) continue;
+      double irradiance_factor = 0.0;  // mean of cos θ / d² over the pixel.
+      const int q = 16;
+      for (int a = 0; a < q; ++a) {
+        for (int b = 0; b < q; ++b) {
+          const double u = (x + (a + 0.5) / q - 0.5 * res) / focal;
+          const double v = (y + (b + 0.5) / q - 0.5 * res) / focal;
+          const Eigen::Vector3d to_light = light - Eigen::Vector3d(u * height, -v * height, 0.0);
+          const double d2 = to_light.squaredNorm();
+          irradiance_factor += to_light.z() / std::sqrt(d2) / d2;
+        }
+      }
+      irradiance_factor /= q * q;
       for (int c = 0; c < 3; ++c) {
-        const double expected = albedo[c] * intensity[c] * cos_t / (M_PI * d2);
+        const double expected = albedo[c] * intensity[c] * irradiance_factor / M_PI;
         EXPECT_NEAR(image.at(x, y, c), expected, 2e-3 * expected) << x << "," << y;
       }
       EXPECT_FLOAT_EQ(image.at(x, y, 3), 1.0f);
       ++checked;
     }
   }
-  EXPECT_GT(checked, 50);
+  EXPECT_GT(checked, 120);
 }
 
 // Furnace test: a convex object under a constant environment of radiance L, Lambertian albedo ρ,
@@ -95,7 +104,7 @@ TEST(RenderTest, FurnaceConvexObject) {
         ++count;
       }
     }
-    ASSERT_GT(count, 500);
+    ASSERT_GT(count, 200);  // the sphere covers ~330 pixels fully.
     EXPECT_NEAR(sum / count, rho * radiance, 0.01 * rho * radiance) << "bounces " << bounces;
   }
 }

@@ -1,0 +1,94 @@
+// Google Benchmark: raw Embree vs the renderer on the bunny (5k faces), 256² pixels, 4 spp, all
+// cores, on the renderer's own BVH and ray set (src/eval/throughput.h). items_per_second = rays
+// per wall-clock second (real time: the work is multithreaded).
+//   ./sft_benchmarks --benchmark_filter=Embree
+#include <benchmark/benchmark.h>
+#include <glog/logging.h>
+
+#include <memory>
+#include <vector>
+
+#include "src/eval/throughput.h"
+#include "src/geometry/material.h"
+#include "src/geometry/mesh.h"
+#include "src/render/render.h"
+#include "src/render/scene.h"
+
+namespace sft {
+namespace {
+
+constexpr int kResolution = 256;
+constexpr int kSpp = 4;
+constexpr uint64_t kSeed = 0;
+
+// The bunny scene, view, material and ray sets, built once.
+struct BunnyFixture {
+  std::unique_ptr<RenderScene> scene;
+  Material material;
+  ViewSetup view;
+  std::vector<BenchRay> camera_rays;
+  std::vector<BenchRay> shadow_rays;
+};
+
+const BunnyFixture& Bunny() {
+  static const BunnyFixture* fixture = [] {
+    auto* f = new BunnyFixture;
+    TriMesh mesh;
+    const Status status = ReadMesh(SFT_DATA_DIR "/meshes/bunny_watertight_5k.obj", &mesh);
+    CHECK(status.ok()) << status.message();
+    f->scene = std::make_unique<RenderScene>(mesh);
+    f->material = ConstantMaterial(static_cast<int>(mesh.n_faces()), Eigen::Vector3d::Constant(0.7),
+                                   0.5, 0.0);
+    f->view = ThroughputView(*f->scene, kResolution);
+    f->camera_rays = CameraRays(f->view, kSpp, kSeed);
+    f->shadow_rays = ShadowRays(*f->scene, f->view, kSpp, kSeed, /*threads=*/0);
+    return f;
+  }();
+  return *fixture;
+}
+
+void RunEmbree(benchmark::State& state, EmbreeQuery query) {
+  const BunnyFixture& bunny = Bunny();
+  const std::vector<BenchRay>& rays =
+      query == EmbreeQuery::kOccluded1 ? bunny.shadow_rays : bunny.camera_rays;
+  int64_t rays_traced = 0;
+  for (auto _ : state) {
+    const RayRate rate = TraceEmbree(bunny.scene->embree_scene(), rays, query, /*threads=*/0);
+    benchmark::DoNotOptimize(rate.hits);
+    rays_traced += rate.rays;
+  }
+  state.SetItemsProcessed(rays_traced);
+}
+
+void RunRender(benchmark::State& state, int bounces) {
+  const BunnyFixture& bunny = Bunny();
+  RenderOptions options;
+  options.spp = kSpp;
+  options.bounces = bounces;
+  options.seed = kSeed;
+  int64_t rays_traced = 0;
+  for (auto _ : state) {
+    Image image;
+    RenderStats stats;
+    RenderView(*bunny.scene, bunny.material, bunny.view, options, &image, &stats);
+    rays_traced += stats.TotalRays();
+  }
+  state.SetItemsProcessed(rays_traced);
+}
+
+void BM_EmbreeIntersect1(benchmark::State& state) { RunEmbree(state, EmbreeQuery::kIntersect1); }
+void BM_EmbreeIntersect8(benchmark::State& state) { RunEmbree(state, EmbreeQuery::kIntersect8); }
+void BM_EmbreeOccluded1(benchmark::State& state) { RunEmbree(state, EmbreeQuery::kOccluded1); }
+void BM_RenderDirect(benchmark::State& state) { RunRender(state, 1); }
+void BM_RenderTwoBounces(benchmark::State& state) { RunRender(state, 2); }
+
+BENCHMARK(BM_EmbreeIntersect1)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_EmbreeIntersect8)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_EmbreeOccluded1)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_RenderDirect)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_RenderTwoBounces)->UseRealTime()->Unit(benchmark::kMillisecond);
+
+}  // namespace
+}  // namespace sft
+
+BENCHMARK_MAIN();

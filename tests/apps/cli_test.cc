@@ -1,0 +1,127 @@
+// End-to-end tests of the `sft` command line: real files in and out, exit codes, one-line errors.
+#include <gtest/gtest.h>
+#include <gmock/gmock.h>
+
+#include <filesystem>
+
+#include "src/core/image.h"
+#include "src/io/dataset.h"
+#include "src/io/image_io.h"
+#include "tests/testing/temp_dir.h"
+
+namespace sft {
+namespace {
+
+using ::testing::HasSubstr;
+
+int Sft(const std::string& args, std::string* output) {
+  return testing::RunCommand(testing::SftBinary() + " " + args, output);
+}
+
+int CountLines(const std::string& text) {
+  int lines = 0;
+  for (char c : text) lines += c == '\n';
+  return lines;
+}
+
+TEST(CliTest, HelpListsCommands) {
+  std::string out;
+  EXPECT_EQ(Sft("--help", &out), 0);
+  EXPECT_THAT(out, HasSubstr("synth"));
+  EXPECT_THAT(out, HasSubstr("render"));
+  EXPECT_EQ(Sft("render --help", &out), 0);
+  EXPECT_THAT(out, HasSubstr("--bounces"));
+  EXPECT_THAT(out, HasSubstr("--pass"));
+}
+
+// synth writes a complete dataset that ReadDataset/CheckDatasetFiles accept; render re-renders it
+// with the ground truth and reproduces the images within Monte Carlo noise.
+TEST(CliTest, SynthThenRenderRoundTrip) {
+  testing::TempDir tmp;
+  const std::string mesh = testing::DataDir() + "/meshes/icosphere_r1_320f.obj";
+  std::string out;
+  ASSERT_EQ(Sft("synth --quiet --mesh " + mesh + " --out " + tmp.Join("ds") +
+                    " --cameras 3 --zooms 1,2 --res 24 --spp 16 --bounces 2 "
+                    "--material '{\"albedo\": [0.5, 0.4, 0.3], \"roughness\": 0.3, "
+                    "\"specular\": 0.2}'",
+                &out),
+            0)
+      << out;
+  Dataset dataset;
+  const Status read = ReadDataset(tmp.Join("ds"), &dataset);
+  ASSERT_TRUE(read.ok()) << read.message();
+  EXPECT_EQ(dataset.views.size(), 6u);
+  EXPECT_EQ(dataset.cameras.size(), 2u);
+  ASSERT_TRUE(CheckDatasetFiles(dataset).ok());
+  EXPECT_TRUE(std::filesystem::exists(tmp.Join("ds/gt/mesh.ply")));
+  EXPECT_FALSE(std::filesystem::exists(tmp.Join("ds.partial")));
+
+  ASSERT_EQ(Sft("render --quiet --dataset " + tmp.Join("ds") + " --mesh " + tmp.Join("ds/gt/mesh.ply") +
+                    " --material " + tmp.Join("ds/gt/material.json") +
+                    " --spp 16 --bounces 2 --seed 7 --out " + tmp.Join("r"),
+                &out),
+            0)
+      << out;
+  for (int v = 0; v < 6; ++v) {
+    Image target, ours;
+    ASSERT_TRUE(LoadViewImage(dataset, v, &target).ok());
+    char name[64];
+    std::snprintf(name, sizeof(name), "/r/images/%03d.exr", v);
+    ASSERT_TRUE(ReadImage(tmp.path() + name, &ours).ok());
+    double sum_t = 0, sum_o = 0;
+    for (int y = 0; y < target.height; ++y) {
+      for (int x = 0; x < target.width; ++x) {
+        for (int c = 0; c < 3; ++c) {
+          sum_t += target.at(x, y, c);
+          sum_o += ours.at(x, y, c);
+        }
+      }
+    }
+    ASSERT_GT(sum_t, 0.0);
+    // Independent seeds, 16 spp over ~300 object pixels: the image means agree within ~1%.
+    EXPECT_NEAR(sum_o / sum_t, 1.0, 0.03) << "view " << v;
+  }
+  EXPECT_TRUE(std::filesystem::exists(tmp.Join("r/render.json")));
+}
+
+TEST(CliTest, BadInputGivesOneLineAndNonZeroExit) {
+  testing::TempDir tmp;
+  std::string out;
+  EXPECT_NE(Sft("synth --mesh " + tmp.Join("missing.obj") + " --out " + tmp.Join("ds"), &out), 0);
+  EXPECT_EQ(CountLines(out), 1) << out;
+  EXPECT_THAT(out, HasSubstr("missing.obj"));
+
+  EXPECT_NE(Sft("render --dataset " + tmp.Join("nope") + " --mesh x.obj --out " + tmp.Join("o"),
+                &out),
+            0);
+  EXPECT_EQ(CountLines(out), 1) << out;
+  EXPECT_THAT(out, HasSubstr("nope"));
+
+  const std::string ds = testing::DataDir() + "/cycles/bunny_point_diffuse";
+  EXPECT_NE(Sft("render --dataset " + ds + " --mesh " + ds + "/gt/mesh.ply --bounces 0 --out " +
+                    tmp.Join("o"),
+                &out),
+            0);
+  EXPECT_EQ(CountLines(out), 1) << out;
+  EXPECT_THAT(out, HasSubstr("bounces"));
+
+  EXPECT_NE(Sft("render --dataset " + ds + " --mesh " + ds + "/gt/mesh.ply --pass glow --out " +
+                    tmp.Join("o"),
+                &out),
+            0);
+  EXPECT_THAT(out, HasSubstr("--pass"));
+
+  EXPECT_NE(Sft("render --dataset " + ds + " --mesh " + ds +
+                    "/gt/mesh.ply --material '{\"albedo\": [2, 0, 0]}' --out " + tmp.Join("o"),
+                &out),
+            0);
+  EXPECT_EQ(CountLines(out), 1) << out;
+  EXPECT_THAT(out, HasSubstr("albedo"));
+
+  EXPECT_NE(Sft("synth --mesh x.obj", &out), 0);  // --out missing: usage error.
+  EXPECT_THAT(out, HasSubstr("--out"));
+  EXPECT_FALSE(std::filesystem::exists(tmp.Join("o/images")));
+}
+
+}  // namespace
+}  // namespace sft
