@@ -29,11 +29,14 @@ void Progress::Advance(int64_t units) {
 void Progress::Finish() {
   if (!enabled_) return;
   std::lock_guard<std::mutex> lock(mutex_);
+  // A log file already has the final count when the last Advance printed it.
+  if (!isatty(fileno(stderr)) && last_printed_ == done_.load()) return;
   Print(true);
 }
 
 void Progress::Print(bool final_line) {
   const int64_t done = done_.load();
+  last_printed_ = done;
   const double elapsed = ElapsedSeconds();
   const double fraction = static_cast<double>(done) / static_cast<double>(total_);
   const double eta = fraction > 0 ? elapsed * (1.0 - fraction) / fraction : 0.0;

@@ -27,6 +27,7 @@ class Progress {
   int64_t total_;
   bool enabled_;
   std::atomic<int64_t> done_{0};
+  int64_t last_printed_ = -1;  // `done_` at the last printed line (guarded by mutex_).
   std::chrono::steady_clock::time_point start_;
   std::chrono::steady_clock::time_point last_print_;
   std::mutex mutex_;

@@ -397,7 +397,7 @@ Status ReadMeshColorsFor(const Context& ctx, const std::string& field, const std
     const double v = colors->values()[k];
     if (!(v >= 0.0 && v <= 1.0)) {
       return ctx.Error(field, path + ": texel " + std::to_string(k / channels) + " has value " +
-                                  std::to_string(v) + " outside [0, 1]");
+                                  FormatNumber(v) + " outside [0, 1]");
     }
   }
   return Status::Ok();

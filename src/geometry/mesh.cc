@@ -828,6 +828,12 @@ Status BuildMesh(const std::string& path, const ParsedMesh& parsed, TriMesh* mes
       }
     }
   }
+  if (with_uvs) {
+    // Boundary halfedges belong to no face and got no UV: give them a defined value.
+    for (TriMesh::HalfedgeHandle h : mesh->halfedges()) {
+      if (mesh->is_boundary(h)) mesh->set_texcoord2D(h, TriMesh::TexCoord2D(0.0, 0.0));
+    }
+  }
   if (mesh->n_faces() == 0) {
     return Status::Error(path + ": no faces (all " + std::to_string(repeated_vertex_faces) +
                          " faces repeat a vertex)");
