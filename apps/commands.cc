@@ -27,8 +27,19 @@ int RunCommandTable(int argc, char** argv) {
                "sft"};
   app.require_subcommand(1);
   // One error line; no "Run with --help" epilogue.
+  // One error line naming the deepest command that was parsed ("sft bench render: error: ...").
   app.failure_message([](const CLI::App* failed, const CLI::Error& e) {
-    return "sft " + failed->get_name() + ": error: " + std::string(e.what()) + "\n";
+    std::string name = "sft";
+    const CLI::App* current = failed;
+    while (current != nullptr) {
+      const CLI::App* next = nullptr;
+      for (const CLI::App* sub : current->get_subcommands()) {
+        if (sub->parsed()) next = sub;
+      }
+      if (next != nullptr) name += " " + next->get_name();
+      current = next;
+    }
+    return name + ": error: " + std::string(e.what()) + "\n";
   });
   std::vector<std::pair<CLI::App*, CommandRunner>> runners;
   for (const CommandEntry& entry : kCommands) {

@@ -58,6 +58,7 @@ inline uint32_t OwenScramble(uint32_t v, uint32_t seed) {
 // Both are pure functions of (seed, view, pixel, sample, dimension counter).
 class Sampler {
  public:
+  Sampler() = default;
   Sampler(uint64_t seed, uint64_t view, uint64_t pixel, uint64_t sample)
       : pixel_key_(Mix64(Mix64(Mix64(seed) ^ view) ^ pixel)), sample_(sample) {}
 
@@ -82,8 +83,8 @@ class Sampler {
   }
 
  private:
-  uint64_t pixel_key_;
-  uint64_t sample_;
+  uint64_t pixel_key_ = 0;
+  uint64_t sample_ = 0;
   uint32_t dimension_ = 0;
   uint32_t pair_ = 0;
 };

@@ -1,7 +1,6 @@
 #include "src/render/render.h"
 
 #include <pmmintrin.h>
-#include <tbb/blocked_range2d.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
@@ -57,14 +56,12 @@ double RayOffset(const Context& ctx, const Eigen::Vector3d& p) {
   return kRelativeRayOffset * std::max(ctx.scene.extent(), p.cwiseAbs().maxCoeff());
 }
 
-// Radiance along the camera ray (origin, dir); sets *hit_surface when the ray hits the mesh.
-Eigen::Vector3d TraceRadiance(const Context& ctx, Sampler* sampler, const Eigen::Vector3d& origin,
-                              Eigen::Vector3d dir, bool* hit_surface, RenderStats* stats) {
+// Radiance along the camera ray with direction `dir` whose first intersection is `hit` (traced
+// by the caller, in packets).
+Eigen::Vector3d TraceRadiance(const Context& ctx, Sampler* sampler, Eigen::Vector3d dir,
+                              RayHit hit, RenderStats* stats) {
   const Effects& effects = ctx.options.effects;
   Eigen::Vector3d radiance = Eigen::Vector3d::Zero();
-  RayHit hit = ctx.scene.Intersect(origin, dir, 0.0, kInfinity);
-  ++stats->camera_rays;
-  *hit_surface = hit.hit;
   if (!hit.hit) {
     if (ctx.environment != nullptr && ctx.view.environment_background) {
       radiance = ctx.environment->Radiance(dir);
@@ -157,11 +154,8 @@ Eigen::Vector3d TraceRadiance(const Context& ctx, Sampler* sampler, const Eigen:
 }
 
 // First-hit auxiliary passes (albedo, roughness, normal, depth).
-Eigen::Vector3d TraceAuxiliary(const Context& ctx, const Eigen::Vector3d& origin,
-                               const Eigen::Vector3d& dir, bool* hit_surface, RenderStats* stats) {
-  const RayHit hit = ctx.scene.Intersect(origin, dir, 0.0, kInfinity);
-  ++stats->camera_rays;
-  *hit_surface = hit.hit;
+Eigen::Vector3d TraceAuxiliary(const Context& ctx, const Eigen::Vector3d& dir,
+                               const RayHit& hit) {
   if (!hit.hit) return Eigen::Vector3d::Zero();
   const BsdfParams params = LookUpMaterial(ctx, hit.face, hit.u, hit.v);
   switch (ctx.options.pass) {
@@ -271,40 +265,59 @@ void RenderView(const RenderScene& scene, const Material& material, const ViewSe
   const Eigen::Matrix3d world_from_cam_rotation = world_from_cam.rotation.toRotationMatrix();
   const double inv_spp = 1.0 / options.spp;
 
+  // Fixed 8×8 tiles; each tile row is one packet of camera rays per sample. The packet
+  // composition depends only on the image size, never on scheduling, so images stay
+  // bit-identical for any thread count.
+  constexpr int kTile = 8;
+  const int tiles_x = (width + kTile - 1) / kTile;
+  const int tiles_y = (height + kTile - 1) / kTile;
   tbb::enumerable_thread_specific<RenderStats> thread_stats;
-  auto render_tile = [&](const tbb::blocked_range2d<int>& tile) {
+  auto render_tile = [&](int tile) {
     // Embree wants flush-to-zero / denormals-are-zero in every tracing thread.
     _MM_SET_FLUSH_ZERO_MODE(_MM_FLUSH_ZERO_ON);
     _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
     RenderStats& local = thread_stats.local();
-    for (int y = tile.rows().begin(); y < tile.rows().end(); ++y) {
-      for (int x = tile.cols().begin(); x < tile.cols().end(); ++x) {
-        const uint64_t pixel = static_cast<uint64_t>(y) * width + x;
-        Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-        int hits = 0;
-        for (int s = 0; s < options.spp; ++s) {
-          Sampler sampler(options.seed, view.view_index, pixel, static_cast<uint64_t>(s));
+    const int x0 = (tile % tiles_x) * kTile;
+    const int y0 = (tile / tiles_x) * kTile;
+    const int count = std::min(kTile, width - x0);
+    for (int y = y0; y < std::min(y0 + kTile, height); ++y) {
+      Eigen::Vector3d sums[kTile];
+      int hits[kTile] = {0};
+      for (int i = 0; i < count; ++i) sums[i].setZero();
+      for (int s = 0; s < options.spp; ++s) {
+        Sampler samplers[kTile];
+        Eigen::Vector3d dirs[kTile];
+        for (int i = 0; i < count; ++i) {
+          const uint64_t pixel = static_cast<uint64_t>(y) * width + (x0 + i);
+          samplers[i] = Sampler(options.seed, view.view_index, pixel, static_cast<uint64_t>(s));
           double jitter_x, jitter_y;
-          sampler.Next2D(&jitter_x, &jitter_y);
-          const Eigen::Vector2d film(x + jitter_x, y + jitter_y);
-          const Eigen::Vector3d dir =
-              (world_from_cam_rotation * view.camera.CamFromImage(film)).normalized();
-          bool hit = false;
+          samplers[i].Next2D(&jitter_x, &jitter_y);
+          const Eigen::Vector2d film(x0 + i + jitter_x, y + jitter_y);
+          dirs[i] = (world_from_cam_rotation * view.camera.CamFromImage(film)).normalized();
+        }
+        RayHit first_hits[kTile];
+        scene.Intersect8(center, dirs, count, first_hits);
+        local.camera_rays += count;
+        for (int i = 0; i < count; ++i) {
           const Eigen::Vector3d value =
               options.pass == RenderPass::kColor
-                  ? TraceRadiance(ctx, &sampler, center, dir, &hit, &local)
-                  : TraceAuxiliary(ctx, center, dir, &hit, &local);
-          if (value.allFinite()) sum += value;
-          hits += hit ? 1 : 0;
+                  ? TraceRadiance(ctx, &samplers[i], dirs[i], first_hits[i], &local)
+                  : TraceAuxiliary(ctx, dirs[i], first_hits[i]);
+          if (value.allFinite()) sums[i] += value;
+          hits[i] += first_hits[i].hit ? 1 : 0;
         }
-        for (int c = 0; c < 3; ++c) image->at(x, y, c) = static_cast<float>(sum[c] * inv_spp);
-        image->at(x, y, 3) = static_cast<float>(hits * inv_spp);
+      }
+      for (int i = 0; i < count; ++i) {
+        for (int c = 0; c < 3; ++c) {
+          image->at(x0 + i, y, c) = static_cast<float>(sums[i][c] * inv_spp);
+        }
+        image->at(x0 + i, y, 3) = static_cast<float>(hits[i] * inv_spp);
       }
     }
   };
   tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
   arena.execute([&] {
-    tbb::parallel_for(tbb::blocked_range2d<int>(0, height, 8, 0, width, 8), render_tile);
+    tbb::parallel_for(0, tiles_x * tiles_y, render_tile);
   });
   if (stats != nullptr) {
     *stats = RenderStats();

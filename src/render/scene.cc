@@ -126,6 +126,45 @@ RayHit RenderScene::Intersect(const Eigen::Vector3d& origin, const Eigen::Vector
   return hit;
 }
 
+void RenderScene::Intersect8(const Eigen::Vector3d& origin, const Eigen::Vector3d* dirs,
+                             int count, RayHit* hits) const {
+  CHECK_LE(count, 8);
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+  alignas(32) int valid[8];
+  alignas(32) RTCRayHit8 rh;
+  for (int i = 0; i < 8; ++i) {
+    valid[i] = i < count ? -1 : 0;
+    const Eigen::Vector3d& dir = dirs[i < count ? i : 0];
+    rh.ray.org_x[i] = static_cast<float>(origin.x());
+    rh.ray.org_y[i] = static_cast<float>(origin.y());
+    rh.ray.org_z[i] = static_cast<float>(origin.z());
+    rh.ray.dir_x[i] = static_cast<float>(dir.x());
+    rh.ray.dir_y[i] = static_cast<float>(dir.y());
+    rh.ray.dir_z[i] = static_cast<float>(dir.z());
+    rh.ray.tnear[i] = 0.0f;
+    rh.ray.tfar[i] = 3.0e38f;
+    rh.ray.time[i] = 0.0f;
+    rh.ray.mask[i] = 0xFFFFFFFFu;
+    rh.ray.id[i] = i;
+    rh.ray.flags[i] = 0;
+    rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
+  }
+  rtcIntersect8(valid, scene_, &context, &rh);
+  for (int i = 0; i < count; ++i) {
+    RayHit& hit = hits[i];
+    hit = RayHit();
+    if (rh.hit.geomID[i] == RTC_INVALID_GEOMETRY_ID) continue;
+    hit.hit = true;
+    hit.t = rh.ray.tfar[i];
+    hit.face = static_cast<int>(rh.hit.primID[i]);
+    hit.u = rh.hit.u[i];
+    hit.v = rh.hit.v[i];
+  }
+}
+
 bool RenderScene::Occluded(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir,
                            double t_near, double t_far) const {
   RTCIntersectContext context;

@@ -41,6 +41,10 @@ class RenderScene {
 
   RayHit Intersect(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, double t_near,
                    double t_far) const;
+  // Up to 8 rays from a common origin (camera rays) as one Embree packet (rtcIntersect8); lanes
+  // are independent, so the results equal Intersect's up to Embree's packet arithmetic.
+  void Intersect8(const Eigen::Vector3d& origin, const Eigen::Vector3d* dirs, int count,
+                  RayHit* hits) const;
   bool Occluded(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, double t_near,
                 double t_far) const;
 
