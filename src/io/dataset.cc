@@ -7,6 +7,7 @@
 #include <cmath>
 #include <exception>
 #include <filesystem>
+#include <initializer_list>
 #include <limits>
 #include <map>
 #include <set>
@@ -27,9 +28,35 @@ constexpr char kSceneFile[] = "scene.json";
 // Largest deviation of world_from_env^T world_from_env from the identity that still counts as a
 // rotation (the file holds decimal numbers written by other tools).
 constexpr double kRotationTolerance = 1e-3;
-// Keys of the top-level object that ReadDataset interprets; all others go to Dataset::extra.
-const char* const kKnownTopLevelKeys[] = {"format", "cameras",    "lights",
-                                          "views",  "background", "ground_truth"};
+// Keys of each object that ReadDataset interprets; all others are kept verbatim as extras.
+using Keys = std::initializer_list<const char*>;
+constexpr Keys kTopLevelKeys = {"format", "cameras",    "lights",
+                                "views",  "background", "ground_truth"};
+constexpr Keys kCameraKeys = {"id", "model", "width", "height", "params"};
+constexpr Keys kPointLightKeys = {"id", "type", "frame", "position", "intensity"};
+constexpr Keys kEnvironmentLightKeys = {"id", "type", "image", "world_from_env", "scale"};
+constexpr Keys kViewKeys = {"image", "mask", "camera", "lights", "cam_from_world"};
+constexpr Keys kPoseKeys = {"rotation", "translation"};
+
+// The members of object `obj` whose keys are not in `known`, as an object; null when none.
+json UnknownKeys(const json& obj, Keys known) {
+  json extra;
+  for (const auto& [key, value] : obj.items()) {
+    bool is_known = false;
+    for (const char* k : known) is_known = is_known || key == k;
+    if (!is_known) extra[key] = value;
+  }
+  return extra;
+}
+
+// Appends the members of `extra` (when it is an object) to `entry`, except keys `entry` already
+// has: documented keys win over same-named extras.
+void AppendExtra(const json& extra, nlohmann::ordered_json* entry) {
+  if (!extra.is_object()) return;
+  for (const auto& [key, value] : extra.items()) {
+    if (!entry->contains(key)) (*entry)[key] = value;
+  }
+}
 
 std::string Field(const std::string& prefix, const std::string& key) {
   return prefix.empty() ? key : prefix + "." + key;
@@ -73,11 +100,7 @@ class SceneParser {
     SFT_RETURN_IF_ERROR(ParseViews(root, dataset));
     SFT_RETURN_IF_ERROR(ParseBackground(root, dataset));
     SFT_RETURN_IF_ERROR(ParseGroundTruth(root, dataset));
-    for (const auto& [key, value] : root.items()) {
-      bool known = false;
-      for (const char* k : kKnownTopLevelKeys) known = known || key == k;
-      if (!known) dataset->extra[key] = value;
-    }
+    dataset->extra = UnknownKeys(root, kTopLevelKeys);
     return Status::Ok();
   }
 
@@ -204,6 +227,7 @@ class SceneParser {
       std::string why;
       if (!camera.Check(&why)) return Status::Error(file_ + ": " + path + "." + why);
       dataset->cameras.push_back(std::move(camera));
+      dataset->camera_extra.push_back(UnknownKeys(entry, kCameraKeys));
     }
     return Status::Ok();
   }
@@ -288,8 +312,10 @@ class SceneParser {
       SFT_RETURN_IF_ERROR(RequiredString(entry, path, "type", &type));
       if (type == "point") {
         SFT_RETURN_IF_ERROR(ParsePointLight(entry, path, &light));
+        light.extra = UnknownKeys(entry, kPointLightKeys);
       } else if (type == "environment") {
         SFT_RETURN_IF_ERROR(ParseEnvironmentLight(entry, path, &light));
+        light.extra = UnknownKeys(entry, kEnvironmentLightKeys);
       } else {
         return Error(Field(path, "type"),
                      "unknown light type \"" + type + "\" (expected \"point\" or \"environment\")");
@@ -299,7 +325,9 @@ class SceneParser {
     return Status::Ok();
   }
 
-  Status ParsePose(const json& view, const std::string& view_path, Rigid3d* pose) const {
+  // Also returns the unknown keys of `cam_from_world` in `extra`.
+  Status ParsePose(const json& view, const std::string& view_path, Rigid3d* pose,
+                   json* extra) const {
     const json* value = nullptr;
     SFT_RETURN_IF_ERROR(Require(view, view_path, "cam_from_world", &value));
     const std::string path = Field(view_path, "cam_from_world");
@@ -320,7 +348,9 @@ class SceneParser {
     pose->rotation = quaternion;
     const json* translation = nullptr;
     SFT_RETURN_IF_ERROR(Require(*value, path, "translation", &translation));
-    return Vector3(*translation, Field(path, "translation"), &pose->translation);
+    SFT_RETURN_IF_ERROR(Vector3(*translation, Field(path, "translation"), &pose->translation));
+    *extra = UnknownKeys(*value, kPoseKeys);
+    return Status::Ok();
   }
 
   Status ParseViews(const json& root, Dataset* dataset) const {
@@ -364,7 +394,8 @@ class SceneParser {
           view.lights.push_back(index);
         }
       }
-      SFT_RETURN_IF_ERROR(ParsePose(entry, path, &view.cam_from_world));
+      SFT_RETURN_IF_ERROR(ParsePose(entry, path, &view.cam_from_world, &view.cam_from_world_extra));
+      view.extra = UnknownKeys(entry, kViewKeys);
       dataset->views.push_back(std::move(view));
     }
     return Status::Ok();
@@ -514,13 +545,15 @@ Status WriteSceneJson(const Dataset& dataset, const std::string& dir) {
     nlohmann::ordered_json root;
     root["format"] = kFormatTag;
     nlohmann::ordered_json cameras = nlohmann::ordered_json::array();
-    for (const Camera& camera : dataset.cameras) {
+    for (size_t i = 0; i < dataset.cameras.size(); ++i) {
+      const Camera& camera = dataset.cameras[i];
       nlohmann::ordered_json entry;
       entry["id"] = camera.id;
       entry["model"] = CameraModelName(camera.model);
       entry["width"] = camera.width;
       entry["height"] = camera.height;
       entry["params"] = camera.params;
+      if (i < dataset.camera_extra.size()) AppendExtra(dataset.camera_extra[i], &entry);
       cameras.push_back(std::move(entry));
     }
     root["cameras"] = std::move(cameras);
@@ -545,6 +578,7 @@ Status WriteSceneJson(const Dataset& dataset, const std::string& dir) {
         entry["world_from_env"] = std::move(matrix);
         entry["scale"] = light.scale;
       }
+      AppendExtra(light.extra, &entry);
       lights.push_back(std::move(entry));
     }
     root["lights"] = std::move(lights);
@@ -599,6 +633,8 @@ Status WriteSceneJson(const Dataset& dataset, const std::string& dir) {
       const Eigen::Vector3d& t = view.cam_from_world.translation;
       entry["cam_from_world"]["rotation"] = {q.w(), q.x(), q.y(), q.z()};
       entry["cam_from_world"]["translation"] = {t.x(), t.y(), t.z()};
+      AppendExtra(view.cam_from_world_extra, &entry["cam_from_world"]);
+      AppendExtra(view.extra, &entry);
       views.push_back(std::move(entry));
     }
     root["views"] = std::move(views);
@@ -609,11 +645,7 @@ Status WriteSceneJson(const Dataset& dataset, const std::string& dir) {
     if (!dataset.gt_mesh.empty()) ground_truth["mesh"] = dataset.gt_mesh;
     if (!ground_truth.is_null()) root["ground_truth"] = std::move(ground_truth);
 
-    if (dataset.extra.is_object()) {
-      for (const auto& [key, value] : dataset.extra.items()) {
-        if (!root.contains(key)) root[key] = value;  // documented keys always win.
-      }
-    }
+    AppendExtra(dataset.extra, &root);
     return WriteTextFile(file, root.dump(1, ' ', false, json::error_handler_t::replace) + "\n");
   } catch (const std::exception& e) {
     return Status::Error(file + ": cannot serialize scene (" + StripJsonExceptionId(e.what()) +

@@ -1,6 +1,21 @@
 // The `sft-dataset/1` format of DESIGN.md §2.5: a directory with scene.json, images/, masks/,
 // probes/, gt/. This is a contract with other tools: unknown keys are preserved on round trips and
 // the meaning of the documented keys never changes.
+//
+// Unknown keys are kept verbatim wherever other tools may put them: at the top level
+// (Dataset::extra), inside each camera (Dataset::camera_extra), each light (LightSpec::extra),
+// each view (ViewSpec::extra) and each view's `cam_from_world` (ViewSpec::cam_from_world_extra);
+// `ground_truth` is kept whole (Dataset::ground_truth). WriteSceneJson writes them back after the
+// documented keys, and a documented key always wins over a same-named extra. "Unknown" means not
+// interpreted by this version: for a light, the keys of the other light type are unknown too
+// (an environment light's "position" is kept as an extra).
+//
+// A read/write cycle reproduces scene.json exactly as JSON (key order and number formatting
+// aside) except for these normalizations of documented keys: a non-unit quaternion is normalized;
+// defaults are written out explicitly (point light "frame": "world", environment light
+// "world_from_env": identity and "scale": 1, view "lights": [], "background": "black"); a grey
+// point-light intensity (one number) becomes [g, g, g]; a null "mask" or "ground_truth" is
+// dropped; an integral float such as a width of 16.0 is written as 16.
 #ifndef SFT_IO_DATASET_H_
 #define SFT_IO_DATASET_H_
 
@@ -30,6 +45,9 @@ struct LightSpec {
   std::string image;  // relative to the dataset root: an equirectangular linear EXR.
   Eigen::Matrix3d world_from_env = Eigen::Matrix3d::Identity();
   double scale = 1.0;  // radiance = scale * texel value.
+  // Keys of this light's JSON object that this version does not interpret for its type, kept
+  // verbatim (an object; null when there are none).
+  nlohmann::json extra;
 };
 
 struct ViewSpec {
@@ -40,11 +58,22 @@ struct ViewSpec {
   std::vector<std::string> light_ids;
   std::vector<int> lights;  // indices into Dataset::lights, resolved by ReadDataset.
   Rigid3d cam_from_world;
+  // Keys of the view's JSON object that this version does not interpret, kept verbatim (an
+  // object; null when there are none).
+  nlohmann::json extra;
+  // The same for the keys of `cam_from_world` other than "rotation" and "translation".
+  nlohmann::json cam_from_world_extra;
 };
 
 struct Dataset {
   std::string root;  // the dataset directory (paths in the specs are relative to it).
   std::vector<Camera> cameras;
+  // camera_extra[i]: keys of cameras[i]'s JSON object that this version does not interpret, kept
+  // verbatim (an object, or null when there are none). Kept here because Camera is a render type.
+  // Parallel to `cameras`, filled for every camera by ReadDataset; it may be shorter (or empty) in
+  // a dataset built in code, and a missing entry means no extras. Code that reorders or removes
+  // cameras must do the same here.
+  std::vector<nlohmann::json> camera_extra;
   std::vector<LightSpec> lights;
   std::vector<ViewSpec> views;
   Background background = Background::kBlack;
@@ -65,6 +94,9 @@ Status ReadDataset(const std::string& dir, Dataset* dataset);
 Status CheckDatasetFiles(const Dataset& dataset);
 
 // Writes DIR/scene.json atomically from `dataset` (root is ignored; paths are written as stored).
+// Every extra (top level, camera, light, view, cam_from_world) is written back after the
+// documented keys of its object; documented keys win over same-named extras. Extras that are not
+// JSON objects are ignored. camera_extra entries beyond cameras.size() are ignored.
 Status WriteSceneJson(const Dataset& dataset, const std::string& dir);
 
 // Loads view `index`'s image as linear RGB (alpha dropped; 3 channels), checking its size.

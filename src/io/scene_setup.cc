@@ -20,6 +20,7 @@ Status MakeDatasetViews(const Dataset& dataset, DatasetViews* out) {
         point.position =
             light.frame == LightFrame::kCamera ? world_from_cam * light.position : light.position;
         point.intensity = light.intensity;
+        point.light_index = l;
         view.point_lights.push_back(point);
         continue;
       }
@@ -35,6 +36,7 @@ Status MakeDatasetViews(const Dataset& dataset, DatasetViews* out) {
             std::make_unique<EnvironmentMap>(probe, light.world_from_env, light.scale);
       }
       view.environment = out->environments[l].get();
+      view.environment_light_index = l;
     }
     view.environment_background =
         dataset.background == Background::kEnvironment && view.environment != nullptr;

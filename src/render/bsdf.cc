@@ -104,6 +104,59 @@ Eigen::Vector3d EvalBsdf(const BsdfParams& params, const Eigen::Vector3d& n,
   return f;
 }
 
+double GgxDAlphaDerivative(double cos_h, double alpha) {
+  if (cos_h <= 0.0) return 0.0;
+  const double cos2 = cos_h * cos_h;
+  const double q = std::max(0.0, 1.0 - cos2) + cos2 * alpha * alpha;
+  // D = α²/(π q²), q = sin² + cos²·α²:  dD/dα = 2α/(π q²) · (1 − 2α² cos²/q).
+  return 2.0 * alpha / (kPi * q * q) * (1.0 - 2.0 * alpha * alpha * cos2 / q);
+}
+
+double GgxG1AlphaDerivative(double cos_w, double alpha) {
+  if (cos_w <= 0.0) return 0.0;
+  const double cos2 = cos_w * cos_w;
+  const double tan2 = std::max(0.0, 1.0 - cos2) / cos2;
+  const double root = std::sqrt(1.0 + alpha * alpha * tan2);
+  // G1 = 2/(1 + R), R = √(1 + α² tan²):  dG1/dα = −2/(1 + R)² · α tan²/R.
+  return -2.0 / ((1.0 + root) * (1.0 + root)) * alpha * tan2 / root;
+}
+
+BsdfDerivatives EvalBsdfDerivatives(const BsdfParams& params, const Eigen::Vector3d& n,
+                                    const Eigen::Vector3d& wo, const Eigen::Vector3d& wi,
+                                    double specular_scale) {
+  BsdfDerivatives d;
+  const double cos_o = n.dot(wo);
+  const double cos_i = n.dot(wi);
+  if (cos_o <= 0.0 || cos_i <= 0.0) return d;
+  d.d_albedo = 1.0 / kPi;
+  if (specular_scale <= 0.0) return d;
+  const Eigen::Vector3d sum = wi + wo;
+  const double len = sum.norm();
+  if (!(len > 1e-12)) return d;
+  const Eigen::Vector3d h = sum / len;
+  const double alpha = params.Alpha();
+  const double cos_h = n.dot(h);
+  const double dist = GgxD(cos_h, alpha);
+  const double g_i = GgxG1(cos_i, alpha), g_o = GgxG1(cos_o, alpha);
+  const double inv = 1.0 / (4.0 * cos_i * cos_o);
+  double fresnel = params.specular;
+  double d_fresnel_d_specular = 1.0;
+  if (params.fresnel == FresnelMode::kSchlick) {
+    fresnel = SchlickFresnel(params.specular, wi.dot(h));
+    const double m = std::clamp(1.0 - wi.dot(h), 0.0, 1.0);
+    d_fresnel_d_specular = 1.0 - m * m * m * m * m;
+  }
+  d.d_specular = specular_scale * d_fresnel_d_specular * dist * g_i * g_o * inv;
+  const double r = params.roughness;
+  if (r * r > kMinGgxAlpha) {
+    const double d_dgg = GgxDAlphaDerivative(cos_h, alpha) * g_i * g_o +
+                         dist * GgxG1AlphaDerivative(cos_i, alpha) * g_o +
+                         dist * g_i * GgxG1AlphaDerivative(cos_o, alpha);
+    d.d_roughness = fresnel * d_dgg * (2.0 * r) * inv;
+  }
+  return d;
+}
+
 double BsdfPdf(const BsdfParams& params, const Eigen::Vector3d& n, const Eigen::Vector3d& wo,
                const Eigen::Vector3d& wi) {
   const double cos_o = n.dot(wo);

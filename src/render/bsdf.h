@@ -46,6 +46,28 @@ double SchlickFresnel(double f0, double cos_d);
 Eigen::Vector3d EvalBsdf(const BsdfParams& params, const Eigen::Vector3d& n,
                          const Eigen::Vector3d& wo, const Eigen::Vector3d& wi);
 
+// Partial derivatives of f(wo, wi) with respect to the material parameters of the shading point
+// (same directions and normal; zero below the surface):
+//   ∂f_c/∂albedo_c = 1/π (and ∂f_c/∂albedo_k = 0 for k ≠ c);
+//   ∂f/∂roughness = F·∂(D·G1·G1)/∂α · dα/dr / (4|n·wi||n·wo|), the same in every channel,
+//                   zero where α is clamped at kMinGgxAlpha;
+//   ∂f/∂specular = D·G1·G1/(4|n·wi||n·wo|) for constant Fresnel, times (1 − (1 − wi·h)⁵) for
+//                  Schlick — the same in every channel.
+// `specular_scale` is the factor the renderer applies to the material's specular weight (0 when
+// the specular effect is off), so ∂f/∂specular is scaled by it.
+struct BsdfDerivatives {
+  double d_albedo = 0.0;     // per channel, on its own channel only.
+  double d_roughness = 0.0;  // all channels.
+  double d_specular = 0.0;   // all channels.
+};
+BsdfDerivatives EvalBsdfDerivatives(const BsdfParams& params, const Eigen::Vector3d& n,
+                                    const Eigen::Vector3d& wo, const Eigen::Vector3d& wi,
+                                    double specular_scale);
+
+// dD/dα and dG1/dα of the functions above (for derivative tests and EvalBsdfDerivatives).
+double GgxDAlphaDerivative(double cos_h, double alpha);
+double GgxG1AlphaDerivative(double cos_w, double alpha);
+
 struct BsdfSample {
   Eigen::Vector3d wi;
   Eigen::Vector3d f;  // f(wo, wi)

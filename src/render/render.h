@@ -16,6 +16,7 @@
 #include "src/core/status.h"
 #include "src/geometry/material.h"
 #include "src/render/camera.h"
+#include "src/render/derivatives.h"
 #include "src/render/environment.h"
 #include "src/render/scene.h"
 
@@ -47,6 +48,11 @@ struct RenderOptions {
   uint64_t seed = 0;    // base seed; the image is a deterministic function of it.
   int threads = 0;      // worker threads; 0 = all cores.
   RenderPass pass = RenderPass::kColor;
+  // Not owned. When set, path sampling (lobe choices, directions, pdfs, MIS weights) uses this
+  // material while path values use the rendered one ("detached sampling"): renders of nearby
+  // materials then follow identical paths, as finite differences and linearizations need. Must
+  // have the rendered material's mesh-colors layout.
+  const Material* sampling_material = nullptr;
 
   bool Check(std::string* why) const;
 };
@@ -54,6 +60,7 @@ struct RenderOptions {
 struct PointLight {
   Eigen::Vector3d position;   // world frame.
   Eigen::Vector3d intensity;  // radiant intensity, W/sr.
+  int light_index = -1;       // dataset light index (for its intensity-scale parameter); -1 none.
 };
 
 // Everything one view needs besides the scene and material.
@@ -63,6 +70,7 @@ struct ViewSetup {
   std::vector<PointLight> point_lights;
   const EnvironmentMap* environment = nullptr;  // not owned; may be null.
   bool environment_background = false;          // camera rays that miss see the environment.
+  int environment_light_index = -1;             // dataset light index of `environment`.
   uint64_t view_index = 0;                      // part of the sample seed.
 };
 
@@ -83,6 +91,14 @@ struct RenderStats {
 // normal facing the camera; depth = camera-frame z.
 void RenderView(const RenderScene& scene, const Material& material, const ViewSetup& view,
                 const RenderOptions& options, Image* image, RenderStats* stats = nullptr);
+
+// RenderView plus derivatives of the (color pass) image from the same sample paths (see
+// derivatives.h). `num_lights` sizes the light-scale parameters (the dataset's light count).
+// `request` must pass Check().
+void RenderViewWithDerivatives(const RenderScene& scene, const Material& material,
+                               const ViewSetup& view, const RenderOptions& options,
+                               const DerivativeRequest& request, int num_lights, Image* image,
+                               DerivativeOutput* output, RenderStats* stats = nullptr);
 
 }  // namespace sft
 

@@ -108,6 +108,12 @@ TEST(DatasetRead, MinimalSceneIsParsed) {
   EXPECT_EQ(dataset.gt_mesh, "gt/mesh.ply");
   EXPECT_EQ(dataset.ground_truth["material"]["albedo"][0], 0.5);
   EXPECT_TRUE(dataset.extra.is_null());
+  ASSERT_EQ(dataset.camera_extra.size(), 1u);
+  EXPECT_TRUE(dataset.camera_extra[0].is_null());
+  EXPECT_TRUE(dataset.lights[0].extra.is_null());
+  EXPECT_TRUE(dataset.lights[1].extra.is_null());
+  EXPECT_TRUE(dataset.views[0].extra.is_null());
+  EXPECT_TRUE(dataset.views[0].cam_from_world_extra.is_null());
   const Status files = CheckDatasetFiles(dataset);
   EXPECT_TRUE(files.ok()) << files.message();
 }
@@ -156,6 +162,42 @@ TEST(DatasetRead, UnknownTopLevelKeysAreKept) {
   EXPECT_EQ(dataset.extra.size(), 2u);
   EXPECT_EQ(dataset.extra["capture_rig"], scene["capture_rig"]);
   EXPECT_EQ(dataset.extra["note"], "hello");
+}
+
+// A scene with unknown keys in a camera, both kinds of light, a view and a pose.
+json SceneWithNestedExtras() {
+  json scene = MinimalScene();
+  scene["cameras"][0]["serial"] = "A123";
+  scene["cameras"][0]["exposure"] = {{"iso", 100}, {"shutter", 0.01}};
+  scene["lights"][0]["falloff"] = "inverse_square";
+  scene["lights"][0]["image"] = "not/for/point/lights.exr";  // the other type's key: unknown.
+  scene["lights"][1]["mapping"] = "equirectangular, +Z up";
+  scene["views"][1]["timestamp"] = 12.5;
+  scene["views"][1]["tags"] = {"turntable", nullptr, 3};
+  scene["views"][0]["cam_from_world"]["covariance"] = json::array({0.1, 0.2});
+  return scene;
+}
+
+TEST(DatasetRead, UnknownNestedKeysAreKept) {
+  const json scene = SceneWithNestedExtras();
+  TempDir dir;
+  WriteJson(dir.path(), scene);
+  Dataset dataset;
+  const Status status = ReadDataset(dir.path(), &dataset);
+  ASSERT_TRUE(status.ok()) << status.message();
+  EXPECT_TRUE(dataset.extra.is_null());
+  ASSERT_EQ(dataset.camera_extra.size(), 1u);
+  EXPECT_EQ(dataset.camera_extra[0],
+            json({{"serial", "A123"}, {"exposure", scene["cameras"][0]["exposure"]}}));
+  EXPECT_EQ(dataset.lights[0].extra,
+            json({{"falloff", "inverse_square"}, {"image", "not/for/point/lights.exr"}}));
+  EXPECT_EQ(dataset.lights[0].image, "");  // not interpreted for a point light.
+  EXPECT_EQ(dataset.lights[1].extra, json({{"mapping", "equirectangular, +Z up"}}));
+  EXPECT_TRUE(dataset.views[0].extra.is_null());
+  EXPECT_EQ(dataset.views[0].cam_from_world_extra, json({{"covariance", {0.1, 0.2}}}));
+  EXPECT_EQ(dataset.views[1].extra,
+            json({{"timestamp", 12.5}, {"tags", scene["views"][1]["tags"]}}));
+  EXPECT_TRUE(dataset.views[1].cam_from_world_extra.is_null());
 }
 
 TEST(DatasetErrors, MissingSceneJson) {
@@ -496,6 +538,7 @@ void ExpectSameDataset(const Dataset& a, const Dataset& b) {
     EXPECT_EQ(a.cameras[i].height, b.cameras[i].height);
     EXPECT_EQ(a.cameras[i].params, b.cameras[i].params);
   }
+  EXPECT_EQ(a.camera_extra, b.camera_extra);
   ASSERT_EQ(a.lights.size(), b.lights.size());
   for (size_t i = 0; i < a.lights.size(); ++i) {
     EXPECT_EQ(a.lights[i].id, b.lights[i].id);
@@ -506,6 +549,7 @@ void ExpectSameDataset(const Dataset& a, const Dataset& b) {
     EXPECT_EQ(a.lights[i].image, b.lights[i].image);
     EXPECT_EQ(a.lights[i].world_from_env, b.lights[i].world_from_env);
     EXPECT_EQ(a.lights[i].scale, b.lights[i].scale);
+    EXPECT_EQ(a.lights[i].extra, b.lights[i].extra);
   }
   ASSERT_EQ(a.views.size(), b.views.size());
   for (size_t i = 0; i < a.views.size(); ++i) {
@@ -518,6 +562,8 @@ void ExpectSameDataset(const Dataset& a, const Dataset& b) {
     EXPECT_EQ(a.views[i].cam_from_world.rotation.coeffs(),
               b.views[i].cam_from_world.rotation.coeffs());
     EXPECT_EQ(a.views[i].cam_from_world.translation, b.views[i].cam_from_world.translation);
+    EXPECT_EQ(a.views[i].extra, b.views[i].extra);
+    EXPECT_EQ(a.views[i].cam_from_world_extra, b.views[i].cam_from_world_extra);
   }
   EXPECT_EQ(a.background, b.background);
   EXPECT_EQ(a.gt_mesh, b.gt_mesh);
@@ -539,6 +585,106 @@ TEST(DatasetWrite, CyclesDatasetsRoundTrip) {
     ASSERT_TRUE(status.ok()) << status.message();
     ExpectSameDataset(original, copy);
   }
+}
+
+json ReadJson(const std::string& file) {
+  std::ifstream in(file);
+  return json::parse(in);
+}
+
+// Reads DIR, writes it to a fresh directory and returns the written scene.json as JSON.
+json RoundTripJson(const std::string& dir) {
+  Dataset dataset;
+  const Status read = ReadDataset(dir, &dataset);
+  EXPECT_TRUE(read.ok()) << read.message();
+  TempDir out;
+  const Status written = WriteSceneJson(dataset, out.path());
+  EXPECT_TRUE(written.ok()) << written.message();
+  if (!read.ok() || !written.ok()) return json();
+  return ReadJson(out.Join("scene.json"));
+}
+
+// The reference datasets hold unit quaternions and every documented key explicitly, so no
+// normalization applies: the written scene.json equals the original as JSON.
+TEST(DatasetWrite, CyclesScenesRoundTripExactlyAsJson) {
+  bool saw_mapping = false;
+  for (const std::string& dir : CyclesDatasets()) {
+    SCOPED_TRACE(dir);
+    const json original = ReadJson(dir + "/scene.json");
+    const json written = RoundTripJson(dir);
+    EXPECT_EQ(written, original) << "diff: " << json::diff(original, written).dump();
+    for (const json& light : written["lights"])
+      saw_mapping = saw_mapping || light.contains("mapping");
+  }
+  EXPECT_TRUE(saw_mapping);  // sphere_env_studio's environment light.
+}
+
+TEST(DatasetWrite, NestedExtrasRoundTripExactlyAsJson) {
+  json scene = SceneWithNestedExtras();
+  scene["rig"] = {{"turntable", true}};
+  TempDir dir;
+  WriteJson(dir.path(), scene);
+  const json written = RoundTripJson(dir.path());
+  EXPECT_EQ(written, scene) << "diff: " << json::diff(scene, written).dump();
+}
+
+TEST(DatasetWrite, OnlyDocumentedNormalizations) {
+  json scene = MinimalScene();
+  scene["lights"][0].erase("frame");
+  scene["lights"][0]["intensity"] = 4.5;
+  scene["lights"][1].erase("world_from_env");
+  scene["lights"][1].erase("scale");
+  scene["views"][0]["cam_from_world"]["rotation"] = {0, 0, 0, 3};
+  scene["views"][0]["mask"] = nullptr;
+  scene["views"][1].erase("lights");
+  scene.erase("background");
+  scene["cameras"][0]["width"] = 16.0;
+  TempDir dir;
+  WriteJson(dir.path(), scene);
+  const json written = RoundTripJson(dir.path());
+
+  json expected = scene;
+  expected["lights"][0]["frame"] = "world";
+  expected["lights"][0]["intensity"] = {4.5, 4.5, 4.5};
+  expected["lights"][1]["world_from_env"] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  expected["lights"][1]["scale"] = 1.0;
+  expected["views"][0]["cam_from_world"]["rotation"] = {0, 0, 0, 1};
+  expected["views"][0].erase("mask");
+  expected["views"][1]["lights"] = json::array();
+  expected["background"] = "black";
+  EXPECT_EQ(written, expected) << "diff: " << json::diff(expected, written).dump();
+  EXPECT_TRUE(written["cameras"][0]["width"].is_number_integer());
+}
+
+TEST(DatasetWrite, DocumentedKeysWinOverExtras) {
+  TempDir dir;
+  WriteJson(dir.path(), MinimalScene());
+  Dataset dataset;
+  ASSERT_TRUE(ReadDataset(dir.path(), &dataset).ok());
+  dataset.camera_extra[0] = {{"width", 999}, {"serial", "B7"}};
+  dataset.camera_extra.push_back({{"orphan", 1}});  // beyond cameras.size(): ignored.
+  dataset.lights[0].extra = {{"type", "spot"}, {"falloff", "none"}};
+  dataset.views[1].extra = {{"camera", "c9"}, {"note", "x"}};
+  dataset.views[1].cam_from_world_extra = {{"rotation", {0, 0, 0, 1}}, {"frame", "opencv"}};
+  dataset.extra = {{"format", "other/2"}, {"rig", 1}};
+  TempDir out;
+  ASSERT_TRUE(WriteSceneJson(dataset, out.path()).ok());
+  const json written = ReadJson(out.Join("scene.json"));
+  EXPECT_EQ(written["format"], "sft-dataset/1");
+  EXPECT_EQ(written["rig"], 1);
+  EXPECT_EQ(written["cameras"][0]["width"], kWidth);
+  EXPECT_EQ(written["cameras"][0]["serial"], "B7");
+  EXPECT_EQ(written["cameras"].size(), 1u);
+  EXPECT_EQ(written["lights"][0]["type"], "point");
+  EXPECT_EQ(written["lights"][0]["falloff"], "none");
+  EXPECT_EQ(written["views"][1]["camera"], "c0");
+  EXPECT_EQ(written["views"][1]["note"], "x");
+  EXPECT_EQ(written["views"][1]["cam_from_world"]["rotation"], json({0, 1, 0, 0}));
+  EXPECT_EQ(written["views"][1]["cam_from_world"]["frame"], "opencv");
+  Dataset copy;
+  const Status status = ReadDataset(out.path(), &copy);
+  ASSERT_TRUE(status.ok()) << status.message();
+  EXPECT_EQ(copy.camera_extra[0], json({{"serial", "B7"}}));
 }
 
 TEST(DatasetWrite, RoundTripKeepsExtraKeysAndEnvironment) {

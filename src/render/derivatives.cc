@@ -1,0 +1,77 @@
+#include "src/render/derivatives.h"
+
+namespace sft {
+
+ParameterKind ParameterLayout::KindOf(int index) const {
+  if (index < AlbedoOffset()) return ParameterKind::kVertex;
+  if (index < RoughnessOffset()) return ParameterKind::kAlbedo;
+  if (index < SpecularIndex()) return ParameterKind::kRoughness;
+  if (index == SpecularIndex()) return ParameterKind::kSpecular;
+  return ParameterKind::kLight;
+}
+
+std::string ParameterLayout::Describe(int index) const {
+  static const char kAxis[] = "xyz";
+  static const char kChannel[] = "rgb";
+  switch (KindOf(index)) {
+    case ParameterKind::kVertex:
+      return "vertex[" + std::to_string(index / 3) + "]." + kAxis[index % 3];
+    case ParameterKind::kAlbedo: {
+      const int local = index - AlbedoOffset();
+      return "albedo[" + std::to_string(local / 3) + "]." + kChannel[local % 3];
+    }
+    case ParameterKind::kRoughness:
+      return "roughness[" + std::to_string(index - RoughnessOffset()) + "]";
+    case ParameterKind::kSpecular:
+      return "specular";
+    case ParameterKind::kLight:
+      return "light[" + std::to_string(index - LightOffset()) + "]";
+  }
+  return "?";
+}
+
+bool ParameterKindFromName(const std::string& name, ParameterKind* kind) {
+  if (name == "vertices") *kind = ParameterKind::kVertex;
+  else if (name == "albedo") *kind = ParameterKind::kAlbedo;
+  else if (name == "roughness") *kind = ParameterKind::kRoughness;
+  else if (name == "specular") *kind = ParameterKind::kSpecular;
+  else if (name == "light") *kind = ParameterKind::kLight;
+  else return false;
+  return true;
+}
+
+ParameterSelection ParameterSelection::Only(ParameterKind kind) {
+  ParameterSelection s;
+  s.vertices = kind == ParameterKind::kVertex;
+  s.albedo = kind == ParameterKind::kAlbedo;
+  s.roughness = kind == ParameterKind::kRoughness;
+  s.specular = kind == ParameterKind::kSpecular;
+  s.lights = kind == ParameterKind::kLight;
+  return s;
+}
+
+bool ParameterSelection::Selected(ParameterKind kind) const {
+  switch (kind) {
+    case ParameterKind::kVertex: return vertices;
+    case ParameterKind::kAlbedo: return albedo;
+    case ParameterKind::kRoughness: return roughness;
+    case ParameterKind::kSpecular: return specular;
+    case ParameterKind::kLight: return lights;
+  }
+  return false;
+}
+
+bool DerivativeRequest::Check(std::string* why) const {
+  if (params.vertices) {
+    *why = "vertices: vertex derivatives (interior terms and edge sampling) are not implemented "
+           "yet";
+    return false;
+  }
+  if (adjoint_weights != nullptr && adjoint_weights->channels < 3) {
+    *why = "adjoint weights: need 3 channels";
+    return false;
+  }
+  return true;
+}
+
+}  // namespace sft

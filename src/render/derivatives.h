@@ -1,0 +1,102 @@
+// Derivative outputs of the renderer (DESIGN.md §2.2–2.3): for one view, from the same sample
+// paths as the image, (a) sparse Jacobian rows — per pixel, the list of (parameter, ∂R, ∂G, ∂B) of
+// the pixel's expected value, duplicates merged — and/or (b) the adjoint gradient Jᵀw for a
+// per-pixel RGB weight image w, without storing the Jacobian.
+//
+// Parameters live in one flat index space (ParameterLayout): vertex coordinates, albedo texels
+// (RGB), roughness texels, the specular weight, and one intensity scale per dataset light (the
+// light's radiance/intensity is multiplied by it; derivatives are taken at scale 1).
+//
+// What is differentiated (the estimator treats sampled directions, lobe choices, pdfs and MIS
+// weights as constants — "detached sampling" — which is unbiased for the derivative of the
+// expected image because the integration domain does not depend on these parameters):
+//   albedo, roughness, specular: every BSDF factor of every path vertex, all effects; exact (no
+//     visibility depends on them);
+//   light scales: every contribution of that light;
+//   vertices: not yet (interior terms and edge sampling are the next step); requesting them is
+//     reported by Check().
+#ifndef SFT_RENDER_DERIVATIVES_H_
+#define SFT_RENDER_DERIVATIVES_H_
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "src/core/image.h"
+
+namespace sft {
+
+enum class ParameterKind { kVertex, kAlbedo, kRoughness, kSpecular, kLight };
+
+struct ParameterLayout {
+  int num_vertices = 0;
+  int num_albedo_texels = 0;
+  int num_roughness_texels = 0;
+  int num_lights = 0;
+
+  // Index ranges, in this order: vertex v coordinate k at 3v + k; albedo texel t channel c;
+  // roughness texel t; the specular weight; light l's scale.
+  int VertexOffset() const { return 0; }
+  int AlbedoOffset() const { return 3 * num_vertices; }
+  int RoughnessOffset() const { return AlbedoOffset() + 3 * num_albedo_texels; }
+  int SpecularIndex() const { return RoughnessOffset() + num_roughness_texels; }
+  int LightOffset() const { return SpecularIndex() + 1; }
+  int size() const { return LightOffset() + num_lights; }
+
+  ParameterKind KindOf(int index) const;
+  // "vertex[12].y", "albedo[40].g", "roughness[3]", "specular", "light[0]".
+  std::string Describe(int index) const;
+};
+
+bool ParameterKindFromName(const std::string& name, ParameterKind* kind);
+
+// Which parameter kinds get derivatives.
+struct ParameterSelection {
+  bool vertices = false;
+  bool albedo = true;
+  bool roughness = true;
+  bool specular = true;
+  bool lights = true;
+
+  static ParameterSelection Only(ParameterKind kind);
+  bool Selected(ParameterKind kind) const;
+};
+
+// One Jacobian entry: ∂(pixel RGB)/∂(parameter).
+struct JacobianEntry {
+  int32_t param;
+  float d[3];
+};
+
+// Sparse rows of one view, pixel-major (pixel = y·width + x): the entries of pixel p are
+// entries[offsets[p] .. offsets[p + 1]), sorted by parameter, no duplicates.
+struct JacobianRows {
+  int width = 0;
+  int height = 0;
+  std::vector<uint64_t> offsets;
+  std::vector<JacobianEntry> entries;
+
+  size_t MemoryBytes() const {
+    return offsets.capacity() * sizeof(uint64_t) + entries.capacity() * sizeof(JacobianEntry);
+  }
+};
+
+struct DerivativeRequest {
+  ParameterSelection params;
+  bool jacobian_rows = false;             // fill DerivativeOutput::rows.
+  const Image* adjoint_weights = nullptr;  // when set (width × height, ≥ 3 channels): fill
+                                           // DerivativeOutput::gradient = Σ_p Σ_c w_pc ∂I_pc/∂θ.
+
+  // Empty when valid; vertex derivatives are not implemented yet.
+  bool Check(std::string* why) const;
+};
+
+struct DerivativeOutput {
+  ParameterLayout layout;
+  JacobianRows rows;
+  std::vector<double> gradient;  // layout.size() entries when requested.
+};
+
+}  // namespace sft
+
+#endif  // SFT_RENDER_DERIVATIVES_H_
