@@ -11,6 +11,9 @@ const CommandEntry kCommands[] = {
      &SetupSynthCommand},
     {"render", "Render every view of a dataset with a given mesh and material",
      &SetupRenderCommand},
+    {"gradcheck",
+     "Compare the renderer's derivatives with finite differences for one parameter kind",
+     &SetupGradcheckCommand},
     {"bench", "Measure throughput against the limit (raw Embree rays/s)", &SetupBenchCommand},
 };
 

@@ -31,6 +31,7 @@ int RunCommandTable(int argc, char** argv);
 // One per command file.
 CommandRunner SetupSynthCommand(CLI::App* app);
 CommandRunner SetupRenderCommand(CLI::App* app);
+CommandRunner SetupGradcheckCommand(CLI::App* app);
 CommandRunner SetupBenchCommand(CLI::App* app);
 
 

@@ -153,7 +153,7 @@ Eigen::Vector3d TraceRadiance(const Context& ctx, Sampler* sampler, Eigen::Vecto
   Eigen::Vector3d radiance = Eigen::Vector3d::Zero();
   if (!hit.hit) {
     if (ctx.environment != nullptr && ctx.view.environment_background) {
-      radiance = ctx.environment->Radiance(dir);
+      radiance = ctx.view.environment_scale * ctx.environment->Radiance(dir);
       if (derivatives != nullptr && ctx.request->params.lights &&
           ctx.view.environment_light_index >= 0) {
         derivatives->emplace_back(ctx.layout->LightOffset() + ctx.view.environment_light_index,
@@ -229,7 +229,7 @@ Eigen::Vector3d TraceRadiance(const Context& ctx, Sampler* sampler, Eigen::Vecto
               // the environment is lit by light sampling alone (weight 1).
               const double weight =
                   effects.shadows ? PowerHeuristic(pdf_light, BsdfPdf(sampling, n, wo, wi)) : 1.0;
-              contribute(wi, f, le * (cos_i * weight / pdf_light),
+              contribute(wi, f, le * (ctx.view.environment_scale * cos_i * weight / pdf_light),
                          ctx.view.environment_light_index);
             }
           }
@@ -255,7 +255,9 @@ Eigen::Vector3d TraceRadiance(const Context& ctx, Sampler* sampler, Eigen::Vecto
     if (!next.hit) {
       if (bsdf_lights_environment) {
         const double weight = PowerHeuristic(sample.pdf, ctx.environment->Pdf(wi));
-        contribute(wi, f, ctx.environment->Radiance(wi) * (weight * cos_over_pdf),
+        contribute(wi, f,
+                   ctx.environment->Radiance(wi) *
+                       (ctx.view.environment_scale * weight * cos_over_pdf),
                    ctx.view.environment_light_index);
       }
       break;

@@ -71,6 +71,7 @@ struct ViewSetup {
   const EnvironmentMap* environment = nullptr;  // not owned; may be null.
   bool environment_background = false;          // camera rays that miss see the environment.
   int environment_light_index = -1;             // dataset light index of `environment`.
+  double environment_scale = 1.0;               // multiplies the environment's radiance, >= 0.
   uint64_t view_index = 0;                      // part of the sample seed.
 };
 
