@@ -3,12 +3,16 @@
 //   sft bench render   raw Embree rays/s (intersect1, intersect8, occluded1) on the renderer's own
 //                      BVH and ray set vs RenderView's rays/s, and their ratio
 //                      (src/eval/throughput.h).
+//   sft bench gradient forward-only vs forward + Jacobian rows vs forward + adjoint gradient time
+//                      over the views of one scene, and the rows' memory
+//                      (src/eval/derivative_cost.h).
 #include <cstdio>
 #include <memory>
 #include <nlohmann/json.hpp>
 
 #include "apps/commands.h"
 #include "src/core/file_util.h"
+#include "src/eval/derivative_cost.h"
 #include "src/eval/throughput.h"
 #include "src/geometry/mesh.h"
 
@@ -24,25 +28,57 @@ struct BenchRenderOptions {
   ThroughputOptions throughput;          // resolution, spp, threads, repeats.
 };
 
-Status RunBenchRender(const BenchRenderOptions& opts) {
-  std::string why;
-  if (!opts.throughput.Check(&why)) return Status::Error("--" + why);
-  if (!FileExists(opts.mesh)) {
-    if (opts.mesh == kDefaultBenchMesh) {
-      return Status::Error("--mesh: default " + opts.mesh +
+struct BenchGradientOptions {
+  std::string mesh = kDefaultBenchMesh;  // mesh to render (OBJ, PLY, OFF).
+  std::string json;                      // optional JSON report path.
+  bool quiet = false;                    // no progress lines.
+  DerivativeCostOptions cost;            // views, resolution, spp, bounces, threads, keep_rows.
+};
+
+// The mesh of --mesh, with errors that name the option.
+Status ReadBenchMesh(const std::string& path, TriMesh* mesh) {
+  if (!FileExists(path)) {
+    if (path == kDefaultBenchMesh) {
+      return Status::Error("--mesh: default " + path +
                            " not found in the current directory (run from the source tree or "
                            "pass --mesh)");
     }
-    return Status::Error("--mesh: " + opts.mesh + " not found");
+    return Status::Error("--mesh: " + path + " not found");
   }
+  return ReadMesh(path, mesh);
+}
+
+Status RunBenchRender(const BenchRenderOptions& opts) {
+  std::string why;
+  if (!opts.throughput.Check(&why)) return Status::Error("--" + why);
   TriMesh mesh;
-  SFT_RETURN_IF_ERROR(ReadMesh(opts.mesh, &mesh));
+  SFT_RETURN_IF_ERROR(ReadBenchMesh(opts.mesh, &mesh));
   ThroughputReport report;
   SFT_RETURN_IF_ERROR(MeasureMeshThroughput(mesh, opts.throughput, &report));
   std::printf("sft bench render: %s\n%s", opts.mesh.c_str(), ThroughputReportTable(report).c_str());
   std::fflush(stdout);
   if (!opts.json.empty()) {
     nlohmann::json json = ThroughputReportToJson(report);
+    json["mesh"] = opts.mesh;
+    SFT_RETURN_IF_ERROR(WriteTextFile(opts.json, json.dump(1) + "\n"));
+  }
+  return Status::Ok();
+}
+
+Status RunBenchGradient(const BenchGradientOptions& opts) {
+  std::string why;
+  if (!opts.cost.Check(&why)) return Status::Error("--" + why);
+  TriMesh mesh;
+  SFT_RETURN_IF_ERROR(ReadBenchMesh(opts.mesh, &mesh));
+  DerivativeCostOptions cost = opts.cost;
+  cost.progress = !opts.quiet;
+  DerivativeCostReport report;
+  SFT_RETURN_IF_ERROR(MeasureDerivativeCost(cost, mesh, &report));
+  std::printf("sft bench gradient: %s\n%s", opts.mesh.c_str(),
+              DerivativeCostReportTable(report).c_str());
+  std::fflush(stdout);
+  if (!opts.json.empty()) {
+    nlohmann::json json = DerivativeCostReportToJson(report);
     json["mesh"] = opts.mesh;
     SFT_RETURN_IF_ERROR(WriteTextFile(opts.json, json.dump(1) + "\n"));
   }
@@ -75,10 +111,42 @@ CommandRunner SetupBenchCommand(CLI::App* app) {
                    "Runs per measurement; the fastest is kept")
       ->capture_default_str();
   render->add_option("--json", render_opts->json, "Also write the results to this JSON file");
-  return [render, render_opts]() {
+
+  CLI::App* gradient = app->add_subcommand(
+      "gradient",
+      "Forward-only vs forward + Jacobian rows vs forward + adjoint gradient time over the views "
+      "of one scene, and the Jacobian rows' memory");
+  auto gradient_opts = std::make_shared<BenchGradientOptions>();
+  gradient
+      ->add_option("--mesh", gradient_opts->mesh,
+                   "Mesh (OBJ, PLY, OFF); the default is relative to the working directory")
+      ->capture_default_str();
+  gradient->add_option("--views", gradient_opts->cost.views, "Cameras on the Fibonacci sphere")
+      ->capture_default_str();
+  gradient->add_option("--res", gradient_opts->cost.resolution, "Image width = height, pixels")
+      ->capture_default_str();
+  gradient->add_option("--spp", gradient_opts->cost.spp, "Samples per pixel of every pass")
+      ->capture_default_str();
+  gradient
+      ->add_option("--bounces", gradient_opts->cost.bounces,
+                   "Path segments: 1 = direct light only, 2 = one indirect bounce")
+      ->capture_default_str();
+  gradient->add_option("--threads", gradient_opts->cost.threads, "Renderer threads (0 = all cores)")
+      ->capture_default_str();
+  gradient->add_option("--seed", gradient_opts->cost.seed, "Sample seed")->capture_default_str();
+  gradient->add_flag("--keep-rows", gradient_opts->cost.keep_rows,
+                     "Hold every view's Jacobian rows until the end of the pass (default: one "
+                     "view's at a time) and report the total resident memory");
+  gradient->add_option("--json", gradient_opts->json, "Also write the results to this JSON file");
+  gradient->add_flag("--quiet", gradient_opts->quiet, "No progress lines");
+  return [render, render_opts, gradient, gradient_opts]() {
     if (render->parsed()) {
       const Status status = RunBenchRender(*render_opts);
       return status.ok() ? 0 : PrintError("bench render", status);
+    }
+    if (gradient->parsed()) {
+      const Status status = RunBenchGradient(*gradient_opts);
+      return status.ok() ? 0 : PrintError("bench gradient", status);
     }
     return 2;
   };

@@ -53,16 +53,10 @@ Status RunRender(const RenderCommandOptions& opts) {
   SFT_RETURN_IF_ERROR(LoadMaterial(opts.material, mesh, &material));
   DatasetViews views;
   SFT_RETURN_IF_ERROR(MakeDatasetViews(dataset, &views));
-  std::vector<int> selected = opts.views;
-  if (selected.empty()) {
-    for (size_t v = 0; v < views.views.size(); ++v) selected.push_back(static_cast<int>(v));
-  }
-  for (int v : selected) {
-    if (v < 0 || v >= static_cast<int>(views.views.size())) {
-      return Status::Error("--views: view " + std::to_string(v) + " out of range [0, " +
-                           std::to_string(views.views.size()) + ")");
-    }
-  }
+  std::vector<int> selected;
+  const Status selection =
+      SelectViews(opts.views, static_cast<int>(views.views.size()), &selected);
+  if (!selection.ok()) return Status::Error("--" + selection.message());
   const RenderScene scene(mesh);
   Progress progress("render", static_cast<int64_t>(selected.size()), !opts.quiet);
   nlohmann::json report;

@@ -22,6 +22,7 @@
 #include "src/io/dataset.h"
 #include "src/io/image_io.h"
 #include "src/io/scene_setup.h"
+#include "src/render/camera_rig.h"
 #include "src/render/render.h"
 
 namespace sft {
@@ -49,26 +50,6 @@ struct SynthOptions {
   bool overwrite = false;
   bool quiet = false;
 };
-
-// cam_from_world for a camera at `center` looking at `target`, +y of the image pointing as close
-// to world −up as possible (COLMAP: x right, y down, z forward).
-Rigid3d LookAt(const Eigen::Vector3d& center, const Eigen::Vector3d& target,
-               const Eigen::Vector3d& up) {
-  const Eigen::Vector3d forward = (target - center).normalized();
-  Eigen::Vector3d right = forward.cross(up);
-  if (right.norm() < 1e-6) right = forward.cross(Eigen::Vector3d(0, 1, 0));
-  right.normalize();
-  const Eigen::Vector3d down = forward.cross(right);
-  Eigen::Matrix3d rotation;
-  rotation.row(0) = right;
-  rotation.row(1) = down;
-  rotation.row(2) = forward;
-  Rigid3d cam_from_world;
-  cam_from_world.rotation = Eigen::Quaterniond(rotation).normalized();
-  if (cam_from_world.rotation.w() < 0) cam_from_world.rotation.coeffs() *= -1.0;
-  cam_from_world.translation = -(rotation * center);
-  return cam_from_world;
-}
 
 Status CheckSynthOptions(const SynthOptions& o) {
   if (o.cameras < 1 || o.cameras > 10000) return Status::Error("--cameras: must be in [1, 10000]");
@@ -127,9 +108,8 @@ Status RunSynth(const SynthOptions& opts) {
   MeshBounds(mesh, &lo, &hi);
   const Eigen::Vector3d target = 0.5 * (lo + hi);
   const double radius = 0.5 * (hi - lo).norm();
-  const double tan_half = std::tan(0.5 * opts.fov_deg * M_PI / 180.0);
-  const double focal = 0.5 * opts.res / tan_half;
-  const double distance = radius / (opts.fill * tan_half);
+  const double focal = OrbitFocal(opts.res, opts.fov_deg);
+  const double distance = OrbitDistance(radius, opts.fov_deg, opts.fill);
 
   const std::string partial = opts.out + ".partial";
   fs::remove_all(partial, ec);
@@ -171,14 +151,10 @@ Status RunSynth(const SynthOptions& opts) {
     if (opts.environment_background) dataset.background = Background::kEnvironment;
   }
   const Eigen::Vector3d up(0, 0, 1);
-  const double golden = M_PI * (3.0 - std::sqrt(5.0));
   int index = 0;
   for (size_t z = 0; z < opts.zooms.size(); ++z) {
     for (int k = 0; k < opts.cameras; ++k, ++index) {
-      const double cz = 1.0 - (2.0 * k + 1.0) / opts.cameras;
-      const double r = std::sqrt(std::max(0.0, 1.0 - cz * cz));
-      const double phi = golden * k;
-      const Eigen::Vector3d dir(r * std::cos(phi), r * std::sin(phi), cz);
+      const Eigen::Vector3d dir = FibonacciSphereDirection(k, opts.cameras);
       ViewSpec view;
       char name[32];
       std::snprintf(name, sizeof(name), "%03d", index);

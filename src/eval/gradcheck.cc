@@ -77,22 +77,12 @@ Status RunGradcheck(const Dataset& dataset, const TriMesh& mesh, const Material&
   if (!request.Check(&why)) return Status::Error("--param " + why);
   DatasetViews views;
   SFT_RETURN_IF_ERROR(MakeDatasetViews(dataset, &views));
-  std::vector<int> selected = options.views;
-  if (selected.empty()) {
-    for (size_t v = 0; v < views.views.size(); ++v) selected.push_back(static_cast<int>(v));
-  }
-  for (int v : selected) {
-    if (v < 0 || v >= static_cast<int>(views.views.size())) {
-      return Status::Error("views: view " + std::to_string(v) + " out of range [0, " +
-                           std::to_string(views.views.size()) + ")");
-    }
-  }
+  std::vector<int> selected;
+  SFT_RETURN_IF_ERROR(
+      SelectViews(options.views, static_cast<int>(views.views.size()), &selected));
   const RenderScene scene(mesh);
-  ParameterLayout layout;
-  layout.num_vertices = static_cast<int>(scene.positions().size());
-  layout.num_albedo_texels = material.albedo.num_texels();
-  layout.num_roughness_texels = material.roughness.num_texels();
-  layout.num_lights = static_cast<int>(dataset.lights.size());
+  const ParameterLayout layout =
+      MakeParameterLayout(scene, material, static_cast<int>(dataset.lights.size()));
 
   std::mt19937_64 rng(options.direction_seed);
   std::uniform_real_distribution<double> uniform(-1.0, 1.0);

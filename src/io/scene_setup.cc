@@ -45,4 +45,20 @@ Status MakeDatasetViews(const Dataset& dataset, DatasetViews* out) {
   return Status::Ok();
 }
 
+Status SelectViews(const std::vector<int>& requested, int num_views, std::vector<int>* selected) {
+  selected->clear();
+  if (requested.empty()) {
+    for (int v = 0; v < num_views; ++v) selected->push_back(v);
+    return Status::Ok();
+  }
+  for (int v : requested) {
+    if (v < 0 || v >= num_views) {
+      return Status::Error("views: view " + std::to_string(v) + " out of range [0, " +
+                           std::to_string(num_views) + ")");
+    }
+    selected->push_back(v);
+  }
+  return Status::Ok();
+}
+
 }  // namespace sft

@@ -23,6 +23,10 @@ struct DatasetViews {
 // view and light.
 Status MakeDatasetViews(const Dataset& dataset, DatasetViews* out);
 
+// The view indices to work on: `requested` when non-empty (each checked against [0, num_views);
+// the error names the offending index), else all views.
+Status SelectViews(const std::vector<int>& requested, int num_views, std::vector<int>* selected);
+
 }  // namespace sft
 
 #endif  // SFT_IO_SCENE_SETUP_H_

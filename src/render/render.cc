@@ -533,17 +533,23 @@ void RenderView(const RenderScene& scene, const Material& material, const ViewSe
   RenderImpl(scene, material, view, options, nullptr, nullptr, image, nullptr, stats);
 }
 
+ParameterLayout MakeParameterLayout(const RenderScene& scene, const Material& material,
+                                    int num_lights) {
+  ParameterLayout layout;
+  layout.num_vertices = static_cast<int>(scene.positions().size());
+  layout.num_albedo_texels = material.albedo.num_texels();
+  layout.num_roughness_texels = material.roughness.num_texels();
+  layout.num_lights = num_lights;
+  return layout;
+}
+
 void RenderViewWithDerivatives(const RenderScene& scene, const Material& material,
                                const ViewSetup& view, const RenderOptions& options,
                                const DerivativeRequest& request, int num_lights, Image* image,
                                DerivativeOutput* output, RenderStats* stats) {
   std::string why;
   CHECK(request.Check(&why)) << why;
-  ParameterLayout layout;
-  layout.num_vertices = static_cast<int>(scene.positions().size());
-  layout.num_albedo_texels = material.albedo.num_texels();
-  layout.num_roughness_texels = material.roughness.num_texels();
-  layout.num_lights = num_lights;
+  const ParameterLayout layout = MakeParameterLayout(scene, material, num_lights);
   RenderImpl(scene, material, view, options, &request, &layout, image, output, stats);
 }
 

@@ -93,6 +93,10 @@ struct RenderStats {
 void RenderView(const RenderScene& scene, const Material& material, const ViewSetup& view,
                 const RenderOptions& options, Image* image, RenderStats* stats = nullptr);
 
+// The parameter index space of a scene and material with `num_lights` dataset lights.
+ParameterLayout MakeParameterLayout(const RenderScene& scene, const Material& material,
+                                    int num_lights);
+
 // RenderView plus derivatives of the (color pass) image from the same sample paths (see
 // derivatives.h). `num_lights` sizes the light-scale parameters (the dataset's light count).
 // `request` must pass Check().

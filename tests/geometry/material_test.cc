@@ -21,11 +21,6 @@ using ::testing::HasSubstr;
 std::string MeshesDir() { return testing::DataDir() + "/meshes"; }
 std::string SpotDir() { return testing::DataDir() + "/cycles/spot_textured_point/gt"; }
 
-void WriteFile(const std::string& path, const std::string& contents) {
-  std::ofstream out(path, std::ios::binary);
-  out << contents;
-}
-
 // data/meshes/quad_z0_2x2_2f.obj with per-vertex UVs: corner (x, y) of [-1, 1]² gets
 // uv = lo + (hi − lo)·((x, y) + 1)/2.
 TriMesh UvQuad(const testing::TempDir& tmp, double lo, double hi) {
@@ -41,7 +36,7 @@ TriMesh UvQuad(const testing::TempDir& tmp, double lo, double hi) {
   }
   obj += "f 1/1 2/2 3/3\nf 1/1 3/3 4/4\n";  // The fixture's faces.
   const std::string path = tmp.Join("uv_quad.obj");
-  WriteFile(path, obj);
+  testing::WriteTestFile(path, obj);
   TriMesh mesh;
   MeshReport report;
   EXPECT_TRUE(ReadMesh(path, &mesh, &report).ok());
@@ -89,7 +84,7 @@ TEST(MaterialTest, InlineAndFileJsonAgree) {
       R"({"albedo": [0.2, 0.4, 0.6], "roughness": 0.25, "specular": 0.5, "fresnel": "schlick",
           "resolution": 3})";
   testing::TempDir tmp;
-  WriteFile(tmp.Join("m.json"), json);
+  testing::WriteTestFile(tmp.Join("m.json"), json);
   Material inline_material, file_material;
   ASSERT_TRUE(LoadMaterial(json, mesh, &inline_material).ok());
   ASSERT_TRUE(LoadMaterial(tmp.Join("m.json"), mesh, &file_material).ok());
@@ -516,12 +511,12 @@ TEST(MaterialTest, ErrorsNameTheField) {
     EXPECT_EQ(status.message().find('\n'), std::string::npos);
   }
   // Errors in a JSON file name the file.
-  WriteFile(tmp.Join("bad.json"), R"({"roughness": 2})");
+  testing::WriteTestFile(tmp.Join("bad.json"), R"({"roughness": 2})");
   Material m;
   Status status = LoadMaterial(tmp.Join("bad.json"), quad, &m);
   ASSERT_FALSE(status.ok());
   EXPECT_THAT(status.message(), HasSubstr(tmp.Join("bad.json") + ": \"roughness\""));
-  WriteFile(tmp.Join("array.json"), "[1, 2]");
+  testing::WriteTestFile(tmp.Join("array.json"), "[1, 2]");
   status = LoadMaterial(tmp.Join("array.json"), quad, &m);
   ASSERT_FALSE(status.ok());
   EXPECT_THAT(status.message(), HasSubstr("JSON object"));

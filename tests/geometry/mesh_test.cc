@@ -21,15 +21,10 @@ using ::testing::HasSubstr;
 std::string MeshesDir() { return testing::DataDir() + "/meshes"; }
 std::string SpotDir() { return testing::DataDir() + "/cycles/spot_textured_point/gt"; }
 
-void WriteFile(const std::string& path, const std::string& contents) {
-  std::ofstream out(path, std::ios::binary);
-  out << contents;
-}
-
 // Reads `contents` written to a file named `name` in a fresh temporary directory.
 Status ReadString(const testing::TempDir& tmp, const std::string& name, const std::string& contents,
                   TriMesh* mesh, MeshReport* report = nullptr) {
-  WriteFile(tmp.Join(name), contents);
+  testing::WriteTestFile(tmp.Join(name), contents);
   return ReadMesh(tmp.Join(name), mesh, report);
 }
 

@@ -28,11 +28,6 @@ double SrgbDecode(double v) {
   return v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4);
 }
 
-void WriteBytes(const std::string& path, const std::string& bytes) {
-  std::ofstream out(path, std::ios::binary);
-  out << bytes;
-}
-
 std::vector<std::string> ListDir(const std::string& dir) {
   std::vector<std::string> names;
   for (const auto& entry : std::filesystem::directory_iterator(dir)) {
@@ -127,7 +122,7 @@ TEST(ImageIoExr, ReadsCyclesRender) {
 TEST(ImageIoExr, CorruptFileNamesPath) {
   TempDir dir;
   const std::string path = dir.Join("bad.exr");
-  WriteBytes(path, "this is not an OpenEXR file at all");
+  testing::WriteTestFile(path, "this is not an OpenEXR file at all");
   Image image;
   const Status status = ReadImage(path, &image);
   ASSERT_FALSE(status.ok());
@@ -142,7 +137,7 @@ TEST(ImageIoExr, TruncatedFileNamesPath) {
   std::ifstream in(good, std::ios::binary);
   std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   const std::string bad = dir.Join("truncated.exr");
-  WriteBytes(bad, bytes.substr(0, bytes.size() / 2));
+  testing::WriteTestFile(bad, bytes.substr(0, bytes.size() / 2));
   Image read;
   const Status status = ReadImage(bad, &read);
   ASSERT_FALSE(status.ok());
@@ -224,7 +219,7 @@ TEST(ImageIoPng, GreyAlphaBecomesRgba) {
       0x52, 0x50, 0x00, 0x00, 0x00, 0x00, 0x49, 0x45, 0x4e, 0x44, 0xae, 0x42, 0x60, 0x82};
   TempDir dir;
   const std::string path = dir.Join("grey_alpha.png");
-  WriteBytes(path, std::string(reinterpret_cast<const char*>(kPng), sizeof(kPng)));
+  testing::WriteTestFile(path, std::string(reinterpret_cast<const char*>(kPng), sizeof(kPng)));
   Image image;
   const Status status = ReadImage(path, &image);
   ASSERT_TRUE(status.ok()) << status.message();
@@ -312,7 +307,7 @@ TEST(ImageIoErrors, MissingFileNamesPath) {
 TEST(ImageIoErrors, UnsupportedExtensionNamesPath) {
   TempDir dir;
   const std::string path = dir.Join("photo.jpg");
-  WriteBytes(path, "x");
+  testing::WriteTestFile(path, "x");
   Image image;
   Status status = ReadImage(path, &image);
   ASSERT_FALSE(status.ok());
@@ -326,7 +321,7 @@ TEST(ImageIoErrors, UnsupportedExtensionNamesPath) {
 TEST(ImageIoErrors, CorruptPngNamesPath) {
   TempDir dir;
   const std::string path = dir.Join("corrupt.png");
-  WriteBytes(path, "\x89PNG\r\n\x1a\n garbage garbage");
+  testing::WriteTestFile(path, "\x89PNG\r\n\x1a\n garbage garbage");
   Image image;
   const Status status = ReadImage(path, &image);
   ASSERT_FALSE(status.ok());
@@ -355,7 +350,7 @@ TEST(ImageIoErrors, BadImagesAreNotWritten) {
 
 TEST(ImageIoErrors, UnwritableLocationNamesPath) {
   TempDir dir;
-  WriteBytes(dir.Join("file"), "x");
+  testing::WriteTestFile(dir.Join("file"), "x");
   const std::string path = dir.Join("file/sub/out.exr");  // parent is a regular file.
   const Status status = WriteExr(path, Image(2, 2, 3));
   ASSERT_FALSE(status.ok());

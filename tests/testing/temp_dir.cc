@@ -5,6 +5,7 @@
 #include <sys/wait.h>
 
 #include <filesystem>
+#include <fstream>
 
 namespace sft {
 namespace testing {
@@ -23,6 +24,11 @@ TempDir::~TempDir() {
 
 std::string DataDir() { return SFT_DATA_DIR; }
 std::string SftBinary() { return SFT_BINARY; }
+
+void WriteTestFile(const std::string& path, const std::string& contents) {
+  std::ofstream out(path, std::ios::binary);
+  out << contents;
+}
 
 int RunCommand(const std::string& command, std::string* output) {
   FILE* pipe = popen((command + " 2>&1").c_str(), "r");

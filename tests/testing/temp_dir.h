@@ -26,6 +26,8 @@ class TempDir {
 std::string DataDir();
 // Absolute path of the built `sft` executable (for CLI tests).
 std::string SftBinary();
+// Writes `contents` to `path` as is (binary), for fixtures written by tests.
+void WriteTestFile(const std::string& path, const std::string& contents);
 // Runs a shell command, returns its exit code; stdout+stderr captured into *output if non-null.
 int RunCommand(const std::string& command, std::string* output = nullptr);
 

@@ -1,0 +1,378 @@
+#include "src/eval/derivative_cost.h"
+
+#include <tbb/task_arena.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+#include <utility>
+#include <vector>
+
+#include "src/core/progress.h"
+#include "src/core/rng.h"
+#include "src/geometry/material.h"
+#include "src/render/camera_rig.h"
+#include "src/render/scene.h"
+
+namespace sft {
+namespace {
+
+// Camera placement and light as `sft synth`'s defaults (apps/synth_command.cc).
+constexpr double kFovDeg = 40.0;
+constexpr double kFill = 0.6;
+constexpr double kLightOffset = 0.15;  // along the camera's +x, in bounding-box diagonals.
+constexpr int kNumLights = 1;          // the one camera-attached light (light scale parameter 0).
+
+// The material: random per-texel albedo, constant roughness and specular.
+constexpr int kMaterialResolution = 2;
+constexpr double kAlbedoMin = 0.2;
+constexpr double kAlbedoMax = 0.9;
+constexpr double kRoughness = 0.4;
+constexpr double kSpecular = 0.3;
+
+// Streams of the hashed random numbers (albedo texels, adjoint weights).
+constexpr uint64_t kAlbedoStream = 0xA1BED0ull;
+constexpr uint64_t kWeightStream = 0x3E1647ull;
+
+constexpr double kAim = 3.0;  // issue 3 item 6: either derivative pass ≤ 3× the forward time.
+
+// A uniform number in [0, 1) that is a pure function of (seed, stream, index).
+double UnitHash(uint64_t seed, uint64_t stream, uint64_t index) {
+  return static_cast<double>(Mix64(Mix64(Mix64(seed) ^ stream) ^ index) >> 11) * 0x1.0p-53;
+}
+
+// A field of /proc/self/status in bytes ("VmRSS:", "VmHWM:"); 0 when unavailable.
+int64_t ProcStatusBytes(const std::string& key) {
+  std::ifstream in("/proc/self/status");
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.compare(0, key.size(), key) != 0) continue;
+    std::istringstream fields(line.substr(key.size()));
+    int64_t kilobytes = 0;
+    fields >> kilobytes;
+    return fields ? kilobytes * 1024 : 0;
+  }
+  return 0;
+}
+
+// Resets the process's peak resident set (VmHWM) to the current one (Linux ≥ 4.0).
+bool ResetPeakRss() {
+  std::ofstream out("/proc/self/clear_refs");
+  if (!out) return false;
+  out << "5";
+  out.close();
+  return !out.fail();
+}
+
+template <typename F>
+double WallSeconds(F&& f) {
+  const auto start = std::chrono::steady_clock::now();
+  f();
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+void AddRays(const RenderStats& stats, RenderStats* sum) {
+  sum->camera_rays += stats.camera_rays;
+  sum->shadow_rays += stats.shadow_rays;
+  sum->bounce_rays += stats.bounce_rays;
+  sum->seconds += stats.seconds;
+}
+
+// The cameras and lights (see the header comment).
+std::vector<ViewSetup> MakeViews(const TriMesh& mesh, const DerivativeCostOptions& options) {
+  Eigen::Vector3d lo, hi;
+  MeshBounds(mesh, &lo, &hi);
+  const Eigen::Vector3d target = 0.5 * (lo + hi);
+  const double diagonal = (hi - lo).norm();
+  const double distance = OrbitDistance(0.5 * diagonal, kFovDeg, kFill);
+  const double focal = OrbitFocal(options.resolution, kFovDeg);
+  const Eigen::Vector3d up(0, 0, 1);
+  std::vector<ViewSetup> views(options.views);
+  for (int k = 0; k < options.views; ++k) {
+    ViewSetup& view = views[k];
+    view.camera.id = "bench";
+    view.camera.model = CameraModel::kPinhole;
+    view.camera.width = view.camera.height = options.resolution;
+    view.camera.params = {focal, focal, 0.5 * options.resolution, 0.5 * options.resolution};
+    view.cam_from_world =
+        LookAt(target + distance * FibonacciSphereDirection(k, options.views), target, up);
+    view.view_index = static_cast<uint64_t>(k);
+    PointLight light;
+    light.position =
+        view.cam_from_world.Inverse() * Eigen::Vector3d(kLightOffset * diagonal, 0.0, 0.0);
+    light.intensity = Eigen::Vector3d::Constant(0.5 * M_PI * distance * distance);
+    light.light_index = 0;
+    view.point_lights.push_back(light);
+  }
+  return views;
+}
+
+Material MakeMaterial(const TriMesh& mesh, uint64_t seed) {
+  Material material = ConstantMaterial(static_cast<int>(mesh.n_faces()),
+                                       Eigen::Vector3d::Constant(0.5 * (kAlbedoMin + kAlbedoMax)),
+                                       kRoughness, kSpecular, kMaterialResolution);
+  std::vector<double>& albedo = material.albedo.values();
+  for (size_t i = 0; i < albedo.size(); ++i) {
+    albedo[i] = kAlbedoMin + (kAlbedoMax - kAlbedoMin) * UnitHash(seed, kAlbedoStream, i);
+  }
+  return material;
+}
+
+// The adjoint weights: uniform in [−1, 1] per pixel and channel.
+Image MakeWeights(int resolution, uint64_t seed) {
+  Image weights(resolution, resolution, 3);
+  for (size_t i = 0; i < weights.data.size(); ++i) {
+    weights.data[i] = static_cast<float>(2.0 * UnitHash(seed, kWeightStream, i) - 1.0);
+  }
+  return weights;
+}
+
+nlohmann::json PassJson(const DerivativePassCost& pass) {
+  return {{"seconds", pass.seconds},
+          {"ratio_to_forward", pass.ratio},
+          {"camera_rays", pass.rays.camera_rays},
+          {"shadow_rays", pass.rays.shadow_rays},
+          {"bounce_rays", pass.rays.bounce_rays},
+          {"renderer_seconds", pass.rays.seconds},
+          {"rss_before_bytes", pass.rss_before_bytes},
+          {"peak_rss_bytes", pass.peak_rss_bytes}};
+}
+
+double Megabytes(int64_t bytes) { return bytes / (1024.0 * 1024.0); }
+
+}  // namespace
+
+bool DerivativeCostOptions::Check(std::string* why) const {
+  if (views < 1 || views > 10000) {
+    *why = "views: must be in [1, 10000], got " + std::to_string(views);
+    return false;
+  }
+  if (resolution < 1 || resolution > 4096) {
+    *why = "res: must be in [1, 4096], got " + std::to_string(resolution);
+    return false;
+  }
+  RenderOptions render;
+  render.spp = spp;
+  render.bounces = bounces;
+  render.threads = threads;
+  return render.Check(why);
+}
+
+Status MeasureDerivativeCost(const DerivativeCostOptions& options, const TriMesh& mesh,
+                             DerivativeCostReport* report) {
+  std::string why;
+  if (!options.Check(&why)) return Status::Error(why);
+  if (mesh.n_faces() == 0) return Status::Error("mesh: has no faces");
+  Eigen::Vector3d lo, hi;
+  MeshBounds(mesh, &lo, &hi);
+  if (!((hi - lo).norm() > 0.0)) return Status::Error("mesh: has zero extent");
+
+  DerivativeCostReport result;
+  result.num_faces = static_cast<int>(mesh.n_faces());
+  result.num_vertices = static_cast<int>(mesh.n_vertices());
+  {
+    tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
+    arena.initialize();
+    result.threads = arena.max_concurrency();
+  }
+  result.views = options.views;
+  result.width = result.height = options.resolution;
+  result.spp = options.spp;
+  result.bounces = options.bounces;
+  result.keep_rows = options.keep_rows;
+
+  const RenderScene scene(mesh);
+  const Material material = MakeMaterial(mesh, options.seed);
+  const std::vector<ViewSetup> views = MakeViews(mesh, options);
+  const Image weights = MakeWeights(options.resolution, options.seed);
+  RenderOptions render;
+  render.spp = options.spp;
+  render.bounces = options.bounces;
+  render.seed = options.seed;
+  render.threads = options.threads;
+
+  DerivativeRequest rows_request;  // default selection: every implemented kind, no vertices.
+  rows_request.jacobian_rows = true;
+  DerivativeRequest adjoint_request;
+  adjoint_request.adjoint_weights = &weights;
+  if (!rows_request.Check(&why) || !adjoint_request.Check(&why)) {
+    return Status::Error("derivative request: " + why);
+  }
+
+  // Resets the peak before a pass and reads it after; `cost` gets both.
+  auto begin_pass = [&](DerivativePassCost* cost) {
+    result.peak_rss_reset = ResetPeakRss();
+    cost->rss_before_bytes = ProcStatusBytes("VmRSS:");
+  };
+  auto end_pass = [&](DerivativePassCost* cost) {
+    cost->peak_rss_bytes = ProcStatusBytes("VmHWM:");
+  };
+
+  // Untimed warm-up (thread pool, first touch of the scene) so the forward pass is not charged.
+  {
+    Image image;
+    RenderView(scene, material, views[0], render, &image);
+  }
+
+  // (1) Forward only.
+  {
+    begin_pass(&result.forward);
+    Progress progress("forward", options.views, options.progress);
+    for (const ViewSetup& view : views) {
+      Image image;
+      RenderStats stats;
+      result.forward.seconds +=
+          WallSeconds([&] { RenderView(scene, material, view, render, &image, &stats); });
+      AddRays(stats, &result.forward.rays);
+      for (int y = 0; y < image.height; ++y) {
+        for (int x = 0; x < image.width; ++x) result.covered_pixels += image.at(x, y, 3) > 0.f;
+      }
+      progress.Advance();
+    }
+    progress.Finish();
+    end_pass(&result.forward);
+  }
+
+  // (2) Forward + Jacobian rows; the rows of a view are freed before the next unless kept.
+  {
+    begin_pass(&result.jacobian_rows);
+    std::vector<DerivativeOutput> kept;
+    if (options.keep_rows) kept.reserve(views.size());
+    Progress progress("jacobian rows", options.views, options.progress);
+    for (const ViewSetup& view : views) {
+      Image image;
+      DerivativeOutput output;
+      RenderStats stats;
+      result.jacobian_rows.seconds += WallSeconds([&] {
+        RenderViewWithDerivatives(scene, material, view, render, rows_request, kNumLights, &image,
+                                  &output, &stats);
+      });
+      AddRays(stats, &result.jacobian_rows.rays);
+      result.num_parameters = output.layout.size();
+      result.num_differentiated = output.layout.size() - output.layout.AlbedoOffset();
+      const int64_t bytes = static_cast<int64_t>(output.rows.MemoryBytes());
+      result.jacobian_entries += static_cast<int64_t>(output.rows.entries.size());
+      result.rows_bytes_total += bytes;
+      result.rows_bytes_peak_view = std::max(result.rows_bytes_peak_view, bytes);
+      if (options.keep_rows) kept.push_back(std::move(output));
+      progress.Advance();
+    }
+    progress.Finish();
+    end_pass(&result.jacobian_rows);  // with keep_rows, every view's rows are still alive here.
+    result.rows_bytes_resident =
+        options.keep_rows ? result.rows_bytes_total : result.rows_bytes_peak_view;
+  }
+
+  // (3) Forward + adjoint gradient.
+  {
+    begin_pass(&result.adjoint);
+    std::vector<double> gradient;
+    Progress progress("adjoint", options.views, options.progress);
+    for (const ViewSetup& view : views) {
+      Image image;
+      DerivativeOutput output;
+      RenderStats stats;
+      result.adjoint.seconds += WallSeconds([&] {
+        RenderViewWithDerivatives(scene, material, view, render, adjoint_request, kNumLights,
+                                  &image, &output, &stats);
+      });
+      AddRays(stats, &result.adjoint.rays);
+      if (gradient.empty()) gradient.assign(output.gradient.size(), 0.0);
+      for (size_t i = 0; i < gradient.size() && i < output.gradient.size(); ++i) {
+        gradient[i] += output.gradient[i];
+      }
+      progress.Advance();
+    }
+    progress.Finish();
+    end_pass(&result.adjoint);
+    double sum2 = 0.0;
+    for (double g : gradient) sum2 += g * g;
+    result.gradient_norm = std::sqrt(sum2);
+  }
+
+  const double forward = result.forward.seconds;
+  result.forward.ratio = forward > 0.0 ? 1.0 : 0.0;
+  result.jacobian_rows.ratio = forward > 0.0 ? result.jacobian_rows.seconds / forward : 0.0;
+  result.adjoint.ratio = forward > 0.0 ? result.adjoint.seconds / forward : 0.0;
+  *report = result;
+  return Status::Ok();
+}
+
+nlohmann::json DerivativeCostReportToJson(const DerivativeCostReport& report) {
+  nlohmann::json json;
+  json["mesh_faces"] = report.num_faces;
+  json["mesh_vertices"] = report.num_vertices;
+  json["threads"] = report.threads;
+  json["views"] = report.views;
+  json["width"] = report.width;
+  json["height"] = report.height;
+  json["spp"] = report.spp;
+  json["bounces"] = report.bounces;
+  json["covered_pixels"] = report.covered_pixels;
+  json["parameters"] = {{"total", report.num_parameters},
+                        {"differentiated", report.num_differentiated},
+                        {"kinds", {"albedo", "roughness", "specular", "light"}},
+                        {"not_implemented", {"vertices"}}};
+  json["passes"] = {{"forward", PassJson(report.forward)},
+                    {"jacobian_rows", PassJson(report.jacobian_rows)},
+                    {"adjoint", PassJson(report.adjoint)}};
+  json["jacobian_rows"] = {{"entries", report.jacobian_entries},
+                           {"entry_bytes", sizeof(JacobianEntry)},
+                           {"bytes_total", report.rows_bytes_total},
+                           {"bytes_peak_view", report.rows_bytes_peak_view},
+                           {"bytes_resident", report.rows_bytes_resident},
+                           {"keep_rows", report.keep_rows}};
+  json["peak_rss_reset"] = report.peak_rss_reset;
+  json["gradient_norm"] = report.gradient_norm;
+  json["aim_ratio"] = kAim;
+  json["aim_met"] = report.jacobian_rows.ratio <= kAim && report.adjoint.ratio <= kAim;
+  return json;
+}
+
+std::string DerivativeCostReportTable(const DerivativeCostReport& report) {
+  std::string out;
+  char line[320];
+  auto add = [&](const char* format, auto... args) {
+    std::snprintf(line, sizeof(line), format, args...);
+    out += line;
+  };
+  add("mesh           %d faces, %d vertices\n", report.num_faces, report.num_vertices);
+  add("setup          %d views x %d x %d, %d spp, %d bounces, %d threads; %lld covered pixels\n",
+      report.views, report.width, report.height, report.spp, report.bounces, report.threads,
+      static_cast<long long>(report.covered_pixels));
+  add("parameters     %d differentiated (albedo, roughness, specular, light) of %d; vertex "
+      "derivatives are not implemented yet and not measured\n",
+      report.num_differentiated, report.num_parameters);
+  add("%-28s %10s %10s %12s %14s\n", "pass", "seconds", "x forward", "Mrays/s", "peak RSS MB");
+  auto row = [&](const char* name, const DerivativePassCost& pass) {
+    add("%-28s %10.3f %10.2f %12.2f %14.1f\n", name, pass.seconds, pass.ratio,
+        pass.seconds > 0.0 ? pass.rays.TotalRays() / pass.seconds * 1e-6 : 0.0,
+        Megabytes(pass.peak_rss_bytes));
+  };
+  row("forward (RenderView)", report.forward);
+  row("forward + Jacobian rows", report.jacobian_rows);
+  row("forward + adjoint gradient", report.adjoint);
+  const double per_pixel =
+      report.covered_pixels > 0
+          ? static_cast<double>(report.jacobian_entries) / report.covered_pixels
+          : 0.0;
+  add("Jacobian rows  %lld entries (%.1f per covered pixel, %zu bytes each); %.1f MB over all "
+      "views, %.1f MB for the largest view\n",
+      static_cast<long long>(report.jacobian_entries), per_pixel, sizeof(JacobianEntry),
+      Megabytes(report.rows_bytes_total), Megabytes(report.rows_bytes_peak_view));
+  add("rows resident  %.1f MB at once (%s)\n", Megabytes(report.rows_bytes_resident),
+      report.keep_rows ? "--keep-rows: every view's rows held" : "one view's rows at a time");
+  const bool met = report.jacobian_rows.ratio <= kAim && report.adjoint.ratio <= kAim;
+  add("aim <= %.0fx    rows %.2fx, adjoint %.2fx: %s\n", kAim, report.jacobian_rows.ratio,
+      report.adjoint.ratio, met ? "met" : "not met");
+  if (!report.peak_rss_reset) {
+    add("note           peak RSS could not be reset per pass: it is the process peak so far\n");
+  }
+  return out;
+}
+
+}  // namespace sft

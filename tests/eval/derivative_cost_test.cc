@@ -1,0 +1,160 @@
+#include "src/eval/derivative_cost.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include "src/core/file_util.h"
+#include "src/geometry/mesh.h"
+#include "tests/testing/temp_dir.h"
+
+namespace sft {
+namespace {
+
+constexpr int kViews = 2;
+constexpr int kRes = 32;
+constexpr int kSpp = 2;
+
+DerivativeCostOptions SmallOptions() {
+  DerivativeCostOptions options;
+  options.views = kViews;
+  options.resolution = kRes;
+  options.spp = kSpp;
+  return options;
+}
+
+void ExpectPassOk(const DerivativePassCost& pass, const char* name) {
+  EXPECT_GT(pass.seconds, 0.0) << name;
+  EXPECT_TRUE(std::isfinite(pass.seconds)) << name;
+  EXPECT_GT(pass.ratio, 0.0) << name;
+  EXPECT_TRUE(std::isfinite(pass.ratio)) << name;
+  EXPECT_EQ(pass.rays.camera_rays, int64_t{kViews} * kRes * kRes * kSpp) << name;
+}
+
+// Performance is not asserted: only that the passes run and the counts are consistent.
+TEST(DerivativeCostTest, SmallRunIsConsistent) {
+  TriMesh mesh;
+  ASSERT_TRUE(ReadMesh(testing::DataDir() + "/meshes/bunny_watertight_5k.obj", &mesh).ok());
+  DerivativeCostReport report;
+  const Status status = MeasureDerivativeCost(SmallOptions(), mesh, &report);
+  ASSERT_TRUE(status.ok()) << status.message();
+
+  EXPECT_EQ(report.num_faces, static_cast<int>(mesh.n_faces()));
+  EXPECT_EQ(report.views, kViews);
+  EXPECT_GE(report.threads, 1);
+  // The mesh fills ~60% of the image: seen, but not everywhere.
+  EXPECT_GT(report.covered_pixels, kViews * kRes * kRes / 20);
+  EXPECT_LT(report.covered_pixels, kViews * kRes * kRes);
+  ExpectPassOk(report.forward, "forward");
+  ExpectPassOk(report.jacobian_rows, "jacobian_rows");
+  ExpectPassOk(report.adjoint, "adjoint");
+  EXPECT_DOUBLE_EQ(report.forward.ratio, 1.0);
+  // The same sample paths in every pass.
+  EXPECT_EQ(report.jacobian_rows.rays.TotalRays(), report.forward.rays.TotalRays());
+  EXPECT_EQ(report.adjoint.rays.TotalRays(), report.forward.rays.TotalRays());
+
+  // Albedo (RGB), roughness texels at resolution 2, the specular weight, one light; no vertices.
+  const int texels = static_cast<int>(mesh.n_faces()) * 6;
+  EXPECT_EQ(report.num_differentiated, 3 * texels + texels + 1 + 1);
+  EXPECT_EQ(report.num_parameters,
+            3 * static_cast<int>(mesh.n_vertices()) + report.num_differentiated);
+
+  EXPECT_GT(report.jacobian_entries, 0);
+  EXPECT_GE(report.rows_bytes_total,
+            report.jacobian_entries * static_cast<int64_t>(sizeof(JacobianEntry)));
+  EXPECT_GE(report.rows_bytes_peak_view, report.rows_bytes_total / kViews);
+  EXPECT_LE(report.rows_bytes_peak_view, report.rows_bytes_total);
+  EXPECT_EQ(report.rows_bytes_resident, report.rows_bytes_peak_view);  // one view at a time.
+  EXPECT_GT(report.gradient_norm, 0.0);
+  EXPECT_TRUE(std::isfinite(report.gradient_norm));
+
+  const nlohmann::json json = DerivativeCostReportToJson(report);
+  EXPECT_EQ(json["jacobian_rows"]["entries"].get<int64_t>(), report.jacobian_entries);
+  EXPECT_EQ(json["parameters"]["not_implemented"][0].get<std::string>(), "vertices");
+  EXPECT_TRUE(json["passes"].contains("adjoint"));
+  const std::string table = DerivativeCostReportTable(report);
+  EXPECT_NE(table.find("vertex derivatives are not implemented"), std::string::npos) << table;
+}
+
+// Holding every view's rows: the same entries, all resident at once.
+TEST(DerivativeCostTest, KeepRowsHoldsTheTotal) {
+  TriMesh mesh;
+  ASSERT_TRUE(ReadMesh(testing::DataDir() + "/meshes/icosphere_r1_320f.obj", &mesh).ok());
+  DerivativeCostOptions options = SmallOptions();
+  DerivativeCostReport one_at_a_time, kept;
+  ASSERT_TRUE(MeasureDerivativeCost(options, mesh, &one_at_a_time).ok());
+  options.keep_rows = true;
+  ASSERT_TRUE(MeasureDerivativeCost(options, mesh, &kept).ok());
+  EXPECT_EQ(kept.jacobian_entries, one_at_a_time.jacobian_entries);  // deterministic.
+  EXPECT_EQ(kept.rows_bytes_resident, kept.rows_bytes_total);
+  EXPECT_TRUE(kept.keep_rows);
+}
+
+TEST(DerivativeCostTest, OptionsCheck) {
+  std::string why;
+  DerivativeCostOptions options;
+  EXPECT_TRUE(options.Check(&why));
+  options.views = 0;
+  EXPECT_FALSE(options.Check(&why));
+  EXPECT_NE(why.find("views"), std::string::npos);
+  options = DerivativeCostOptions();
+  options.resolution = 0;
+  EXPECT_FALSE(options.Check(&why));
+  EXPECT_NE(why.find("res"), std::string::npos);
+  options = DerivativeCostOptions();
+  options.spp = 0;
+  EXPECT_FALSE(options.Check(&why));
+  EXPECT_NE(why.find("spp"), std::string::npos);
+  options = DerivativeCostOptions();
+  options.bounces = 0;
+  EXPECT_FALSE(options.Check(&why));
+  EXPECT_NE(why.find("bounces"), std::string::npos);
+
+  TriMesh empty;
+  DerivativeCostReport report;
+  EXPECT_FALSE(MeasureDerivativeCost(DerivativeCostOptions(), empty, &report).ok());
+}
+
+TEST(BenchGradientCommandTest, BadViewsIsOneErrorLine) {
+  std::string output;
+  const int code = testing::RunCommand(testing::SftBinary() + " bench gradient --views 0", &output);
+  EXPECT_EQ(code, 1);
+  EXPECT_NE(output.find("--views"), std::string::npos) << output;
+  ASSERT_FALSE(output.empty());
+  EXPECT_EQ(output.find('\n'), output.size() - 1) << output;  // exactly one line.
+}
+
+TEST(BenchGradientCommandTest, MissingMeshIsOneErrorLine) {
+  testing::TempDir dir;
+  std::string output;
+  const int code = testing::RunCommand(
+      testing::SftBinary() + " bench gradient --mesh " + dir.Join("absent.obj"), &output);
+  EXPECT_EQ(code, 1);
+  EXPECT_NE(output.find("--mesh"), std::string::npos) << output;
+  EXPECT_EQ(output.find('\n'), output.size() - 1) << output;
+}
+
+TEST(BenchGradientCommandTest, SmallRunWritesJson) {
+  testing::TempDir dir;
+  std::string output;
+  const std::string json_path = dir.Join("gradient.json");
+  const int code =
+      testing::RunCommand(testing::SftBinary() + " bench gradient --mesh " + testing::DataDir() +
+                              "/meshes/icosphere_r1_320f.obj --views 2 --res 16 "
+                              "--spp 1 --quiet --json " +
+                              json_path,
+                          &output);
+  EXPECT_EQ(code, 0) << output;
+  EXPECT_NE(output.find("forward + Jacobian rows"), std::string::npos) << output;
+  std::string text;
+  ASSERT_TRUE(ReadTextFile(json_path, &text).ok());
+  const nlohmann::json json = nlohmann::json::parse(text);
+  EXPECT_EQ(json["mesh_faces"].get<int>(), 320);
+  EXPECT_EQ(json["views"].get<int>(), 2);
+  EXPECT_GT(json["jacobian_rows"]["entries"].get<int64_t>(), 0);
+  EXPECT_TRUE(json["passes"].contains("forward"));
+}
+
+}  // namespace
+}  // namespace sft
