@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 #include <gmock/gmock.h>
 
+#include <algorithm>
 #include <filesystem>
 
 #include "src/core/image.h"
@@ -82,6 +83,53 @@ TEST(CliTest, SynthThenRenderRoundTrip) {
     EXPECT_NEAR(sum_o / sum_t, 1.0, 0.03) << "view " << v;
   }
   EXPECT_TRUE(std::filesystem::exists(tmp.Join("r/render.json")));
+}
+
+// --envmap lights the object by a probe copied into the dataset; a procedural material gives a
+// spatially varying albedo; --pass albedo renders it back.
+TEST(CliTest, SynthWithEnvironmentAndProceduralMaterial) {
+  testing::TempDir tmp;
+  const std::string mesh = testing::DataDir() + "/meshes/icosphere_r1_320f.obj";
+  const std::string probe = testing::DataDir() + "/cycles/sphere_env_studio/probes/studio.exr";
+  std::string out;
+  ASSERT_EQ(Sft("synth --quiet --mesh " + mesh + " --out " + tmp.Join("ds") + " --envmap " + probe +
+                    " --background-environment --cameras 2 --zooms 1 --res 16 --spp 8 "
+                    "--bounces 1 --material '{\"procedural\": \"wood\", \"colors\": "
+                    "[[0.8, 0.6, 0.3], [0.3, 0.2, 0.1]], \"roughness\": 0.4, \"resolution\": 4}'",
+                &out),
+            0)
+      << out;
+  Dataset dataset;
+  ASSERT_TRUE(ReadDataset(tmp.Join("ds"), &dataset).ok());
+  ASSERT_EQ(dataset.lights.size(), 1u);
+  EXPECT_EQ(dataset.lights[0].type, LightType::kEnvironment);
+  EXPECT_EQ(dataset.background, Background::kEnvironment);
+  ASSERT_TRUE(CheckDatasetFiles(dataset).ok());
+  Image image;
+  ASSERT_TRUE(LoadViewImage(dataset, 0, &image).ok());
+  // The background shows the probe: the corner pixel is not black.
+  EXPECT_GT(image.at(0, 0, 0) + image.at(0, 0, 1) + image.at(0, 0, 2), 0.0f);
+
+  ASSERT_EQ(Sft("render --quiet --dataset " + tmp.Join("ds") + " --mesh " +
+                    tmp.Join("ds/gt/mesh.ply") + " --material " + tmp.Join("ds/gt/material.json") +
+                    " --pass albedo --spp 4 --out " + tmp.Join("r"),
+                &out),
+            0)
+      << out;
+  Image albedo;
+  ASSERT_TRUE(ReadImage(tmp.Join("r/images/000.exr"), &albedo).ok());
+  // Spatially varying: fully covered pixels do not all share one albedo.
+  float lo = 1e9f, hi = -1e9f;
+  for (int y = 0; y < albedo.height; ++y) {
+    for (int x = 0; x < albedo.width; ++x) {
+      if (albedo.at(x, y, 3) < 1.0f) continue;
+      lo = std::min(lo, albedo.at(x, y, 0));
+      hi = std::max(hi, albedo.at(x, y, 0));
+    }
+  }
+  EXPECT_GT(hi - lo, 0.05f);
+  EXPECT_LE(hi, 0.8f + 1e-4f);
+  EXPECT_GE(lo, 0.1f);
 }
 
 TEST(CliTest, BadInputGivesOneLineAndNonZeroExit) {

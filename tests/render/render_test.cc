@@ -188,13 +188,46 @@ TEST(RenderTest, HardCasesStayFinite) {
         view.point_lights.push_back({Eigen::Vector3d(0.1, 0.1, 1e-9) * scale, Eigen::Vector3d::Constant(1.0)});
         const EnvironmentMap env(Image(8, 4, 3, 1.0f), Eigen::Matrix3d::Identity(), 1.0);
         view.environment = &env;
+        view.point_lights[0].light_index = 0;
+        view.point_lights[1].light_index = 1;
+        view.environment_light_index = 2;
         RenderOptions options;
         options.spp = 4;
         options.bounces = 3;
         Image image;
-        RenderView(scene, material, view, options, &image);
+        DerivativeRequest request;
+        request.jacobian_rows = true;
+        DerivativeOutput derivatives;
+        RenderViewWithDerivatives(scene, material, view, options, request, 3, &image,
+                                  &derivatives);
         for (float v : image.data) ASSERT_TRUE(std::isfinite(v)) << "scale " << scale;
+        for (const JacobianEntry& e : derivatives.rows.entries) {
+          for (float d : e.d) ASSERT_TRUE(std::isfinite(d)) << "scale " << scale;
+        }
       }
+    }
+  }
+}
+
+// A camera inside a closed mesh sees its inside (two-sided shading) lit by a light inside too.
+TEST(RenderTest, CameraInsideClosedObject) {
+  TriMesh mesh;
+  ASSERT_TRUE(ReadMesh(testing::DataDir() + "/meshes/icosphere_r1_320f.obj", &mesh).ok());
+  const RenderScene scene(mesh);
+  const Material material =
+      ConstantMaterial(mesh.n_faces(), Eigen::Vector3d::Constant(0.5), 0.3, 0.5);
+  ViewSetup view = TopDownView(0.2, 16, 10.0);
+  view.point_lights.push_back({Eigen::Vector3d(0.1, 0.0, 0.0), Eigen::Vector3d::Constant(1.0)});
+  RenderOptions options;
+  options.spp = 4;
+  options.bounces = 3;
+  Image image;
+  RenderView(scene, material, view, options, &image);
+  for (int y = 0; y < 16; ++y) {
+    for (int x = 0; x < 16; ++x) {
+      EXPECT_FLOAT_EQ(image.at(x, y, 3), 1.0f);  // every ray hits the inside.
+      EXPECT_GT(image.at(x, y, 0), 0.0f);
+      EXPECT_TRUE(std::isfinite(image.at(x, y, 0)));
     }
   }
 }
