@@ -9,6 +9,7 @@
 #include <glog/logging.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -94,7 +95,7 @@ class PathDerivatives {
     const Eigen::Vector3d contribution = prefix.cwiseProduct(f).cwiseProduct(q);
     AddMaterial(surface, d_f, prefix.cwiseProduct(q));
     const Eigen::Vector3d f_q = f.cwiseProduct(q);
-    for (size_t j = 0; j < scatters_.size(); ++j) {
+    for (int j = 0; j < count_; ++j) {
       AddMaterial(scatters_[j].surface, scatters_[j].d_s, excluded_[j].cwiseProduct(f_q));
     }
     if (ctx_.request->params.lights && light_index >= 0) {
@@ -105,9 +106,11 @@ class PathDerivatives {
   // The path continues from the current vertex with scatter factor s (and its derivatives).
   void AddScatter(const Eigen::Vector3d& prefix, const SurfaceMaterial& surface,
                   const Eigen::Vector3d& s, const BsdfDerivatives& d_s) {
-    for (Eigen::Vector3d& e : excluded_) e = e.cwiseProduct(s);
-    excluded_.push_back(prefix);
-    scatters_.push_back({surface, d_s});
+    CHECK_LT(count_, kMaxScatters);
+    for (int j = 0; j < count_; ++j) excluded_[j] = excluded_[j].cwiseProduct(s);
+    excluded_[count_] = prefix;
+    scatters_[count_] = {surface, d_s};
+    ++count_;
   }
 
  private:
@@ -138,10 +141,13 @@ class PathDerivatives {
     }
   }
 
+  // A path scatters at most bounces − 1 ≤ 15 times (RenderOptions::Check caps bounces at 16).
+  static constexpr int kMaxScatters = 16;
   const Context& ctx_;
   DerivativeList* out_;
-  std::vector<Scatter> scatters_;
-  std::vector<Eigen::Vector3d> excluded_;
+  int count_ = 0;
+  std::array<Scatter, kMaxScatters> scatters_;
+  std::array<Eigen::Vector3d, kMaxScatters> excluded_;
 };
 
 // Radiance along the camera ray with direction `dir` whose first intersection is `hit` (traced
