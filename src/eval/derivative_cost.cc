@@ -142,7 +142,7 @@ nlohmann::json PassJson(const DerivativePassCost& pass) {
           {"peak_rss_bytes", pass.peak_rss_bytes}};
 }
 
-double Megabytes(int64_t bytes) { return bytes / (1024.0 * 1024.0); }
+double Mebibytes(int64_t bytes) { return bytes / (1024.0 * 1024.0); }
 
 }  // namespace
 
@@ -347,11 +347,11 @@ std::string DerivativeCostReportTable(const DerivativeCostReport& report) {
   add("parameters     %d differentiated (albedo, roughness, specular, light) of %d; vertex "
       "derivatives are not implemented yet and not measured\n",
       report.num_differentiated, report.num_parameters);
-  add("%-28s %10s %10s %12s %14s\n", "pass", "seconds", "x forward", "Mrays/s", "peak RSS MB");
+  add("%-28s %10s %10s %12s %14s\n", "pass", "seconds", "x forward", "Mrays/s", "peak RSS MiB");
   auto row = [&](const char* name, const DerivativePassCost& pass) {
     add("%-28s %10.3f %10.2f %12.2f %14.1f\n", name, pass.seconds, pass.ratio,
         pass.seconds > 0.0 ? pass.rays.TotalRays() / pass.seconds * 1e-6 : 0.0,
-        Megabytes(pass.peak_rss_bytes));
+        Mebibytes(pass.peak_rss_bytes));
   };
   row("forward (RenderView)", report.forward);
   row("forward + Jacobian rows", report.jacobian_rows);
@@ -360,11 +360,11 @@ std::string DerivativeCostReportTable(const DerivativeCostReport& report) {
       report.covered_pixels > 0
           ? static_cast<double>(report.jacobian_entries) / report.covered_pixels
           : 0.0;
-  add("Jacobian rows  %lld entries (%.1f per covered pixel, %zu bytes each); %.1f MB over all "
-      "views, %.1f MB for the largest view\n",
+  add("Jacobian rows  %lld entries (%.1f per covered pixel, %zu bytes each); %.1f MiB over all "
+      "views, %.1f MiB for the largest view\n",
       static_cast<long long>(report.jacobian_entries), per_pixel, sizeof(JacobianEntry),
-      Megabytes(report.rows_bytes_total), Megabytes(report.rows_bytes_peak_view));
-  add("rows resident  %.1f MB at once (%s)\n", Megabytes(report.rows_bytes_resident),
+      Mebibytes(report.rows_bytes_total), Mebibytes(report.rows_bytes_peak_view));
+  add("rows resident  %.1f MiB at once (%s)\n", Mebibytes(report.rows_bytes_resident),
       report.keep_rows ? "--keep-rows: every view's rows held" : "one view's rows at a time");
   const bool met = report.jacobian_rows.ratio <= kAim && report.adjoint.ratio <= kAim;
   add("aim <= %.0fx    rows %.2fx, adjoint %.2fx: %s\n", kAim, report.jacobian_rows.ratio,

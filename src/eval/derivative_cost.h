@@ -82,7 +82,7 @@ struct DerivativeCostReport {
 Status MeasureDerivativeCost(const DerivativeCostOptions& options, const TriMesh& mesh,
                              DerivativeCostReport* report);
 
-// The report as JSON (bytes, seconds) and as a small human-readable table (MB, s).
+// The report as JSON (bytes, seconds) and as a small human-readable table (MiB, s).
 nlohmann::json DerivativeCostReportToJson(const DerivativeCostReport& report);
 std::string DerivativeCostReportTable(const DerivativeCostReport& report);
 
