@@ -25,9 +25,10 @@ int PrintError(const std::string& command, const Status& status) {
 }
 
 int RunCommandTable(int argc, char** argv) {
-  CLI::App app{"sft — Shape from Tracing: reconstruct a mesh and its spatially varying material "
-               "from calibrated photographs with a differentiable path tracer.",
-               "sft"};
+  CLI::App app{
+      "sft — Shape from Tracing: reconstruct a mesh and its spatially varying material "
+      "from calibrated photographs with a differentiable path tracer.",
+      "sft"};
   app.require_subcommand(1);
   // One error line; no "Run with --help" epilogue.
   // One error line naming the deepest command that was parsed ("sft bench render: error: ...").

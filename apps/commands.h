@@ -5,10 +5,9 @@
 #ifndef SFT_APPS_COMMANDS_H_
 #define SFT_APPS_COMMANDS_H_
 
+#include <CLI/CLI.hpp>
 #include <functional>
 #include <string>
-
-#include <CLI/CLI.hpp>
 
 #include "src/core/status.h"
 
@@ -33,7 +32,6 @@ CommandRunner SetupSynthCommand(CLI::App* app);
 CommandRunner SetupRenderCommand(CLI::App* app);
 CommandRunner SetupGradcheckCommand(CLI::App* app);
 CommandRunner SetupBenchCommand(CLI::App* app);
-
 
 }  // namespace sft
 

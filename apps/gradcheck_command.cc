@@ -2,9 +2,8 @@
 // the expected image for one parameter kind (see src/eval/gradcheck.h). Exit 0 when the overall
 // relative error is within --tolerance (and the adjoint gradient agrees with the Jacobian rows),
 // 1 otherwise or on bad input.
-#include <nlohmann/json.hpp>
-
 #include <cstdio>
+#include <nlohmann/json.hpp>
 
 #include "apps/commands.h"
 #include "src/core/file_util.h"

@@ -1,9 +1,9 @@
 // The `sft` command line: one table of commands, one file per command (apps/<name>_command.cc).
+#include <glog/logging.h>
+
 #include <cstdio>
 #include <cstring>
 #include <string>
-
-#include <glog/logging.h>
 
 #include "apps/commands.h"
 

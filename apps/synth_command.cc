@@ -9,10 +9,9 @@
 // the bounding sphere at --fill of the half-image at zoom 1; zoom z multiplies the focal length.
 // The default light intensity gives a white Lambertian patch facing the camera at the object's
 // centre a radiance of 0.5. The dataset is written to OUT.partial and renamed to OUT at the end.
-#include <nlohmann/json.hpp>
-
 #include <cmath>
 #include <filesystem>
+#include <nlohmann/json.hpp>
 
 #include "apps/commands.h"
 #include "src/core/file_util.h"
@@ -96,9 +95,9 @@ Status RunSynth(const SynthOptions& opts) {
     if (!(diagonal > 0)) return Status::Error(opts.mesh + ": mesh has zero extent");
     for (auto vh : mesh.vertices()) {
       const auto p = mesh.point(vh);
-      mesh.set_point(vh, TriMesh::Point((p[0] - centre.x()) / diagonal,
-                                        (p[1] - centre.y()) / diagonal,
-                                        (p[2] - centre.z()) / diagonal));
+      mesh.set_point(vh,
+                     TriMesh::Point((p[0] - centre.x()) / diagonal, (p[1] - centre.y()) / diagonal,
+                                    (p[2] - centre.z()) / diagonal));
     }
   }
   Material material;
@@ -131,8 +130,8 @@ Status RunSynth(const SynthOptions& opts) {
     light.id = "flash";
     light.type = LightType::kPoint;
     light.frame = LightFrame::kCamera;
-    light.position = Eigen::Vector3d(opts.light_offset[0], opts.light_offset[1],
-                                     opts.light_offset[2]);
+    light.position =
+        Eigen::Vector3d(opts.light_offset[0], opts.light_offset[1], opts.light_offset[2]);
     const double intensity =
         opts.light_intensity >= 0 ? opts.light_intensity : 0.5 * M_PI * distance * distance;
     light.intensity = Eigen::Vector3d::Constant(intensity);
@@ -188,18 +187,16 @@ Status RunSynth(const SynthOptions& opts) {
   SFT_RETURN_IF_ERROR(WriteMesh(JoinPath(partial, "gt/mesh.ply"), mesh));
   SFT_RETURN_IF_ERROR(SaveMaterial(JoinPath(partial, "gt/material.json"), material));
   dataset.gt_mesh = "gt/mesh.ply";
-  dataset.ground_truth = {{"mesh", "gt/mesh.ply"},
-                          {"material", "gt/material.json"},
-                          {"renderer", "sft"},
-                          {"samples", render.spp},
-                          {"bounces", render.bounces},
-                          {"seed", render.seed},
+  dataset.ground_truth = {{"mesh", "gt/mesh.ply"},     {"material", "gt/material.json"},
+                          {"renderer", "sft"},         {"samples", render.spp},
+                          {"bounces", render.bounces}, {"seed", render.seed},
                           {"source_mesh", opts.mesh}};
   SFT_RETURN_IF_ERROR(WriteSceneJson(dataset, partial));
   if (fs::exists(opts.out, ec)) fs::remove_all(opts.out, ec);
   fs::rename(partial, opts.out, ec);
-  if (ec) return Status::Error(opts.out + ": cannot move the finished dataset in place (" +
-                               ec.message() + ")");
+  if (ec)
+    return Status::Error(opts.out + ": cannot move the finished dataset in place (" + ec.message() +
+                         ")");
   return Status::Ok();
 }
 

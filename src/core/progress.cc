@@ -1,7 +1,8 @@
 #include "src/core/progress.h"
 
-#include <cstdio>
 #include <unistd.h>
+
+#include <cstdio>
 
 namespace sft {
 
@@ -44,8 +45,7 @@ void Progress::Print(bool final_line) {
   const bool tty = isatty(fileno(stderr));
   std::fprintf(stderr, "%s%s: %lld/%lld (%.0f%%) elapsed %.1fs ETA %.1fs%s", tty ? "\r" : "",
                label_.c_str(), static_cast<long long>(done), static_cast<long long>(total_),
-               100.0 * fraction, elapsed, final_line ? 0.0 : eta,
-               (final_line || !tty) ? "\n" : "");
+               100.0 * fraction, elapsed, final_line ? 0.0 : eta, (final_line || !tty) ? "\n" : "");
   std::fflush(stderr);
 }
 

@@ -71,8 +71,7 @@ class Sampler {
   void Next2D(double* u1, double* u2) {
     const uint64_t hash = Mix64(pixel_key_ + 0xD1B54A32D192ED03ull * (++pair_));
     // Shuffle the index within its power-of-two block by XOR (a permutation of the block).
-    const uint32_t index =
-        static_cast<uint32_t>(sample_) ^ static_cast<uint32_t>(hash & 0xFFFFu);
+    const uint32_t index = static_cast<uint32_t>(sample_) ^ static_cast<uint32_t>(hash & 0xFFFFu);
     uint32_t x, y;
     Sobol2D(index, &x, &y);
     x = OwenScramble(x, static_cast<uint32_t>(hash >> 16));

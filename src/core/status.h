@@ -32,9 +32,9 @@ class Status {
 }  // namespace sft
 
 // Returns from the calling function when `expr` yields a failed Status.
-#define SFT_RETURN_IF_ERROR(expr)        \
-  do {                                   \
-    ::sft::Status sft_status_ = (expr);  \
+#define SFT_RETURN_IF_ERROR(expr)              \
+  do {                                         \
+    ::sft::Status sft_status_ = (expr);        \
     if (!sft_status_.ok()) return sft_status_; \
   } while (0)
 

@@ -11,11 +11,16 @@ namespace {
 
 const char* KindName(ParameterKind kind) {
   switch (kind) {
-    case ParameterKind::kVertex: return "vertices";
-    case ParameterKind::kAlbedo: return "albedo";
-    case ParameterKind::kRoughness: return "roughness";
-    case ParameterKind::kSpecular: return "specular";
-    case ParameterKind::kLight: return "light";
+    case ParameterKind::kVertex:
+      return "vertices";
+    case ParameterKind::kAlbedo:
+      return "albedo";
+    case ParameterKind::kRoughness:
+      return "roughness";
+    case ParameterKind::kSpecular:
+      return "specular";
+    case ParameterKind::kLight:
+      return "light";
   }
   return "?";
 }
@@ -78,8 +83,7 @@ Status RunGradcheck(const Dataset& dataset, const TriMesh& mesh, const Material&
   DatasetViews views;
   SFT_RETURN_IF_ERROR(MakeDatasetViews(dataset, &views));
   std::vector<int> selected;
-  SFT_RETURN_IF_ERROR(
-      SelectViews(options.views, static_cast<int>(views.views.size()), &selected));
+  SFT_RETURN_IF_ERROR(SelectViews(options.views, static_cast<int>(views.views.size()), &selected));
   const RenderScene scene(mesh);
   const ParameterLayout layout =
       MakeParameterLayout(scene, material, static_cast<int>(dataset.lights.size()));
@@ -95,8 +99,7 @@ Status RunGradcheck(const Dataset& dataset, const TriMesh& mesh, const Material&
     double mean_roughness = 0.0;
     for (double r : material.roughness.values()) mean_roughness += r;
     mean_roughness /= std::max<size_t>(1, material.roughness.values().size());
-    step = options.kind == ParameterKind::kRoughness ? 1e-4 * std::max(mean_roughness, 0.01)
-                                                     : 1e-3;
+    step = options.kind == ParameterKind::kRoughness ? 1e-4 * std::max(mean_roughness, 0.01) : 1e-3;
   }
 
   RenderOptions render = options.render;
@@ -128,8 +131,8 @@ Status RunGradcheck(const Dataset& dataset, const TriMesh& mesh, const Material&
         for (int c = 0; c < 3; ++c) analytic[c] += entry.d[c] * delta[entry.param];
       }
       for (int c = 0; c < 3; ++c) {
-        const double fd = (static_cast<double>(plus.data[4 * p + c]) - minus.data[4 * p + c]) /
-                          (2.0 * step);
+        const double fd =
+            (static_cast<double>(plus.data[4 * p + c]) - minus.data[4 * p + c]) / (2.0 * step);
         err2 += (analytic[c] - fd) * (analytic[c] - fd);
         ref2 += fd * fd;
         weighted += weights.data[3 * p + c] * analytic[c];

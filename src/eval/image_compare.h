@@ -11,19 +11,20 @@ namespace sft {
 
 struct ImageAgreement {
   int object_pixels = 0;
-  double mean_reference = 0.0;     // mean over object pixels and RGB of the reference.
+  double mean_reference = 0.0;       // mean over object pixels and RGB of the reference.
   double mean_abs_difference = 0.0;  // mean over object pixels and RGB of |ours − reference|.
   double relative_mean_abs_difference = 0.0;  // mean_abs_difference / mean_reference.
-  double relative_mean_difference = 0.0;  // (mean(ours) − mean(reference)) / mean(reference).
+  double relative_mean_difference = 0.0;      // (mean(ours) − mean(reference)) / mean(reference).
   int blocks_compared = 0;
   double max_block_relative_difference = 0.0;  // over compared blocks, on RGB block means.
   double mean_block_relative_difference = 0.0;
 };
 
 struct ImageCompareOptions {
-  int block = 8;                       // block size in pixels.
-  double min_block_coverage = 0.5;     // a block is compared when its mean mask is at least this...
-  double min_block_brightness = 0.1;   // ...and its reference mean is at least this × mean_reference.
+  int block = 8;                    // block size in pixels.
+  double min_block_coverage = 0.5;  // a block is compared when its mean mask is at least this...
+  double min_block_brightness =
+      0.1;  // ...and its reference mean is at least this × mean_reference.
 };
 
 // `ours` and `reference` have ≥ 3 channels (RGB first) and equal sizes; `mask` 1 channel, > 0.5 =

@@ -1,5 +1,6 @@
 // The spatially varying material: diffuse albedo (RGB) and GGX roughness stored as mesh colors,
-// plus a global specular weight (DESIGN.md §2.3). BSDF f = albedo/π + specular·D·G1·G1/(4|n·wi||n·wo|).
+// plus a global specular weight (DESIGN.md §2.3). BSDF f = albedo/π +
+// specular·D·G1·G1/(4|n·wi||n·wo|).
 #ifndef SFT_GEOMETRY_MATERIAL_H_
 #define SFT_GEOMETRY_MATERIAL_H_
 
@@ -14,9 +15,9 @@ namespace sft {
 enum class FresnelMode { kConstant, kSchlick };
 
 struct Material {
-  MeshColors albedo;     // 3 channels, linear, in [0, 1].
-  MeshColors roughness;  // 1 channel, in [0, 1]; GGX α = roughness².
-  double specular = 0.0; // glossy lobe weight (constant Fresnel), or F0 with Schlick.
+  MeshColors albedo;      // 3 channels, linear, in [0, 1].
+  MeshColors roughness;   // 1 channel, in [0, 1]; GGX α = roughness².
+  double specular = 0.0;  // glossy lobe weight (constant Fresnel), or F0 with Schlick.
   FresnelMode fresnel = FresnelMode::kConstant;
 };
 

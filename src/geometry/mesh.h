@@ -2,12 +2,11 @@
 #ifndef SFT_GEOMETRY_MESH_H_
 #define SFT_GEOMETRY_MESH_H_
 
+#include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
-#include <Eigen/Geometry>
 
 #include "src/core/status.h"
 
@@ -26,7 +25,7 @@ struct MeshReport {
   int num_faces = 0;
   int num_degenerate_faces = 0;  // zero area (relative to the bounding box) or repeated vertex.
   int num_isolated_vertices = 0;
-  bool has_texcoords = false;    // per-corner UVs were read (OBJ vt / PLY texcoord).
+  bool has_texcoords = false;  // per-corner UVs were read (OBJ vt / PLY texcoord).
 };
 
 // Reads OBJ, PLY (ascii/binary) or OFF by extension. Polygons are triangulated. Per-corner UVs are

@@ -16,7 +16,7 @@ namespace sft {
 
 struct DatasetViews {
   std::vector<std::unique_ptr<EnvironmentMap>> environments;  // owned; indexed like lights.
-  std::vector<ViewSetup> views;                                // point into `environments`.
+  std::vector<ViewSetup> views;                               // point into `environments`.
 };
 
 // A view may use at most one environment light (more would need summed maps). Errors name the

@@ -8,8 +8,8 @@ namespace {
 
 constexpr double kPi = M_PI;
 
-Eigen::Vector3d ToLocal(const Eigen::Vector3d& w, const Eigen::Vector3d& t, const Eigen::Vector3d& b,
-                        const Eigen::Vector3d& n) {
+Eigen::Vector3d ToLocal(const Eigen::Vector3d& w, const Eigen::Vector3d& t,
+                        const Eigen::Vector3d& b, const Eigen::Vector3d& n) {
   return {w.dot(t), w.dot(b), w.dot(n)};
 }
 
@@ -27,8 +27,8 @@ Eigen::Vector3d SampleGgxVisibleNormal(const Eigen::Vector3d& wo, double alpha, 
   // Stretch to the hemisphere configuration.
   const Eigen::Vector3d vh = Eigen::Vector3d(alpha * wo.x(), alpha * wo.y(), wo.z()).normalized();
   const double lensq = vh.x() * vh.x() + vh.y() * vh.y();
-  const Eigen::Vector3d t1 = lensq > 0 ? Eigen::Vector3d(-vh.y(), vh.x(), 0) / std::sqrt(lensq)
-                                       : Eigen::Vector3d(1, 0, 0);
+  const Eigen::Vector3d t1 =
+      lensq > 0 ? Eigen::Vector3d(-vh.y(), vh.x(), 0) / std::sqrt(lensq) : Eigen::Vector3d(1, 0, 0);
   const Eigen::Vector3d t2 = vh.cross(t1);
   const double r = std::sqrt(u1);
   const double phi = 2.0 * kPi * u2;
@@ -46,9 +46,7 @@ double Luminance(const Eigen::Vector3d& c) { return (c.x() + c.y() + c.z()) / 3.
 
 }  // namespace
 
-double BsdfParams::Alpha() const {
-  return std::max(kMinGgxAlpha, roughness * roughness);
-}
+double BsdfParams::Alpha() const { return std::max(kMinGgxAlpha, roughness * roughness); }
 
 double GgxD(double cos_h, double alpha) {
   if (cos_h <= 0.0) return 0.0;

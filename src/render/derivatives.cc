@@ -31,12 +31,18 @@ std::string ParameterLayout::Describe(int index) const {
 }
 
 bool ParameterKindFromName(const std::string& name, ParameterKind* kind) {
-  if (name == "vertices") *kind = ParameterKind::kVertex;
-  else if (name == "albedo") *kind = ParameterKind::kAlbedo;
-  else if (name == "roughness") *kind = ParameterKind::kRoughness;
-  else if (name == "specular") *kind = ParameterKind::kSpecular;
-  else if (name == "light") *kind = ParameterKind::kLight;
-  else return false;
+  if (name == "vertices")
+    *kind = ParameterKind::kVertex;
+  else if (name == "albedo")
+    *kind = ParameterKind::kAlbedo;
+  else if (name == "roughness")
+    *kind = ParameterKind::kRoughness;
+  else if (name == "specular")
+    *kind = ParameterKind::kSpecular;
+  else if (name == "light")
+    *kind = ParameterKind::kLight;
+  else
+    return false;
   return true;
 }
 
@@ -52,19 +58,25 @@ ParameterSelection ParameterSelection::Only(ParameterKind kind) {
 
 bool ParameterSelection::Selected(ParameterKind kind) const {
   switch (kind) {
-    case ParameterKind::kVertex: return vertices;
-    case ParameterKind::kAlbedo: return albedo;
-    case ParameterKind::kRoughness: return roughness;
-    case ParameterKind::kSpecular: return specular;
-    case ParameterKind::kLight: return lights;
+    case ParameterKind::kVertex:
+      return vertices;
+    case ParameterKind::kAlbedo:
+      return albedo;
+    case ParameterKind::kRoughness:
+      return roughness;
+    case ParameterKind::kSpecular:
+      return specular;
+    case ParameterKind::kLight:
+      return lights;
   }
   return false;
 }
 
 bool DerivativeRequest::Check(std::string* why) const {
   if (params.vertices) {
-    *why = "vertices: vertex derivatives (interior terms and edge sampling) are not implemented "
-           "yet";
+    *why =
+        "vertices: vertex derivatives (interior terms and edge sampling) are not implemented "
+        "yet";
     return false;
   }
   if (adjoint_weights != nullptr && adjoint_weights->channels < 3) {

@@ -83,7 +83,7 @@ struct JacobianRows {
 
 struct DerivativeRequest {
   ParameterSelection params;
-  bool jacobian_rows = false;             // fill DerivativeOutput::rows.
+  bool jacobian_rows = false;              // fill DerivativeOutput::rows.
   const Image* adjoint_weights = nullptr;  // when set (width × height, ≥ 3 channels): fill
                                            // DerivativeOutput::gradient = Σ_p Σ_c w_pc ∂I_pc/∂θ.
 

@@ -42,9 +42,9 @@ class EnvironmentMap {
   int height_ = 0;
   std::vector<Eigen::Vector3f> texels_;  // scaled, clamped radiance.
   Eigen::Matrix3d world_from_env_;
-  std::vector<double> row_cdf_;          // height_ + 1 entries, normalized.
-  std::vector<double> column_cdf_;       // height_ rows of width_ + 1 entries, normalized per row.
-  std::vector<double> texel_pdf_;        // probability of each texel (sums to 1).
+  std::vector<double> row_cdf_;     // height_ + 1 entries, normalized.
+  std::vector<double> column_cdf_;  // height_ rows of width_ + 1 entries, normalized per row.
+  std::vector<double> texel_pdf_;   // probability of each texel (sums to 1).
   bool black_ = true;
 };
 

@@ -1,12 +1,11 @@
 #include "src/render/render.h"
 
+#include <glog/logging.h>
 #include <pmmintrin.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 #include <xmmintrin.h>
-
-#include <glog/logging.h>
 
 #include <algorithm>
 #include <array>
@@ -153,8 +152,8 @@ class PathDerivatives {
 // Radiance along the camera ray with direction `dir` whose first intersection is `hit` (traced
 // by the caller, in packets). When `derivatives` is non-null, the path's parameter derivatives
 // are appended to it.
-Eigen::Vector3d TraceRadiance(const Context& ctx, Sampler* sampler, Eigen::Vector3d dir,
-                              RayHit hit, RenderStats* stats, DerivativeList* derivatives) {
+Eigen::Vector3d TraceRadiance(const Context& ctx, Sampler* sampler, Eigen::Vector3d dir, RayHit hit,
+                              RenderStats* stats, DerivativeList* derivatives) {
   const Effects& effects = ctx.options.effects;
   Eigen::Vector3d radiance = Eigen::Vector3d::Zero();
   if (!hit.hit) {
@@ -244,8 +243,7 @@ Eigen::Vector3d TraceRadiance(const Context& ctx, Sampler* sampler, Eigen::Vecto
     }
 
     const bool continue_path = depth + 1 < ctx.max_segments;
-    const bool bsdf_lights_environment =
-        ctx.environment != nullptr && lit_here && effects.shadows;
+    const bool bsdf_lights_environment = ctx.environment != nullptr && lit_here && effects.shadows;
     if (!continue_path && !bsdf_lights_environment) break;
     BsdfSample sample;
     Eigen::Vector3d u;
@@ -261,10 +259,10 @@ Eigen::Vector3d TraceRadiance(const Context& ctx, Sampler* sampler, Eigen::Vecto
     if (!next.hit) {
       if (bsdf_lights_environment) {
         const double weight = PowerHeuristic(sample.pdf, ctx.environment->Pdf(wi));
-        contribute(wi, f,
-                   ctx.environment->Radiance(wi) *
-                       (ctx.view.environment_scale * weight * cos_over_pdf),
-                   ctx.view.environment_light_index);
+        contribute(
+            wi, f,
+            ctx.environment->Radiance(wi) * (ctx.view.environment_scale * weight * cos_over_pdf),
+            ctx.view.environment_light_index);
       }
       break;
     }
@@ -285,8 +283,7 @@ Eigen::Vector3d TraceRadiance(const Context& ctx, Sampler* sampler, Eigen::Vecto
 }
 
 // First-hit auxiliary passes (albedo, roughness, normal, depth).
-Eigen::Vector3d TraceAuxiliary(const Context& ctx, const Eigen::Vector3d& dir,
-                               const RayHit& hit) {
+Eigen::Vector3d TraceAuxiliary(const Context& ctx, const Eigen::Vector3d& dir, const RayHit& hit) {
   if (!hit.hit) return Eigen::Vector3d::Zero();
   const BsdfParams params = LookUpMaterial(ctx, ctx.material, hit.face, hit.u, hit.v).params;
   switch (ctx.options.pass) {
@@ -334,12 +331,18 @@ bool Effects::Parse(const std::string& list, Effects* effects, std::string* why)
     size_t end = list.find(',', start);
     if (end == std::string::npos) end = list.size();
     const std::string name = list.substr(start, end - start);
-    if (name == "direct") parsed.direct = true;
-    else if (name == "shadows") parsed.shadows = true;
-    else if (name == "bounces") parsed.bounces = true;
-    else if (name == "specular") parsed.specular = true;
-    else if (name == "environment") parsed.environment = true;
-    else if (name == "all") parsed = Effects();
+    if (name == "direct")
+      parsed.direct = true;
+    else if (name == "shadows")
+      parsed.shadows = true;
+    else if (name == "bounces")
+      parsed.bounces = true;
+    else if (name == "specular")
+      parsed.specular = true;
+    else if (name == "environment")
+      parsed.environment = true;
+    else if (name == "all")
+      parsed = Effects();
     else if (name == "none" || name.empty()) {
     } else {
       *why = "effects: unknown effect '" + name +
@@ -353,12 +356,18 @@ bool Effects::Parse(const std::string& list, Effects* effects, std::string* why)
 }
 
 bool RenderPassFromName(const std::string& name, RenderPass* pass) {
-  if (name == "color") *pass = RenderPass::kColor;
-  else if (name == "albedo") *pass = RenderPass::kAlbedo;
-  else if (name == "roughness") *pass = RenderPass::kRoughness;
-  else if (name == "normal") *pass = RenderPass::kNormal;
-  else if (name == "depth") *pass = RenderPass::kDepth;
-  else return false;
+  if (name == "color")
+    *pass = RenderPass::kColor;
+  else if (name == "albedo")
+    *pass = RenderPass::kAlbedo;
+  else if (name == "roughness")
+    *pass = RenderPass::kRoughness;
+  else if (name == "normal")
+    *pass = RenderPass::kNormal;
+  else if (name == "depth")
+    *pass = RenderPass::kDepth;
+  else
+    return false;
   return true;
 }
 
@@ -482,8 +491,7 @@ void RenderImpl(const RenderScene& scene, const Material& material, const ViewSe
         if (!want_derivatives) continue;
         MergeDerivatives(&lists[i], inv_spp, &merged);
         if (weights != nullptr) {
-          const Eigen::Vector3d w(weights->at(x, y, 0), weights->at(x, y, 1),
-                                  weights->at(x, y, 2));
+          const Eigen::Vector3d w(weights->at(x, y, 0), weights->at(x, y, 1), weights->at(x, y, 2));
           for (const JacobianEntry& e : merged) {
             const double g = w[0] * e.d[0] + w[1] * e.d[1] + w[2] * e.d[2];
             if (g != 0.0) tile_gradients[tile].emplace_back(e.param, g);

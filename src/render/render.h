@@ -41,12 +41,12 @@ enum class RenderPass { kColor, kAlbedo, kRoughness, kNormal, kDepth };
 bool RenderPassFromName(const std::string& name, RenderPass* pass);
 
 struct RenderOptions {
-  int spp = 64;         // samples per pixel, >= 1.
-  int bounces = 2;      // path segments as in the report: 1 = direct light only, 2 = one
-                        // indirect bounce (= Cycles' max_bounces + 1); range 1..16.
+  int spp = 64;     // samples per pixel, >= 1.
+  int bounces = 2;  // path segments as in the report: 1 = direct light only, 2 = one
+                    // indirect bounce (= Cycles' max_bounces + 1); range 1..16.
   Effects effects;
-  uint64_t seed = 0;    // base seed; the image is a deterministic function of it.
-  int threads = 0;      // worker threads; 0 = all cores.
+  uint64_t seed = 0;  // base seed; the image is a deterministic function of it.
+  int threads = 0;    // worker threads; 0 = all cores.
   RenderPass pass = RenderPass::kColor;
   // Not owned. When set, path sampling (lobe choices, directions, pdfs, MIS weights) uses this
   // material while path values use the rendered one ("detached sampling"): renders of nearby

@@ -45,12 +45,12 @@ void RenderScene::Build() {
   rtcSetSceneBuildQuality(scene_, RTC_BUILD_QUALITY_MEDIUM);
   geometry_ = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
   rtcSetGeometryBuildQuality(geometry_, RTC_BUILD_QUALITY_REFIT);
-  vertex_buffer_ = static_cast<float*>(rtcSetNewGeometryBuffer(
-      geometry_, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float),
-      std::max<size_t>(1, positions_.size())));
-  unsigned* index_buffer = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
-      geometry_, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned),
-      std::max<size_t>(1, faces_.size())));
+  vertex_buffer_ = static_cast<float*>(
+      rtcSetNewGeometryBuffer(geometry_, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                              3 * sizeof(float), std::max<size_t>(1, positions_.size())));
+  unsigned* index_buffer = static_cast<unsigned*>(
+      rtcSetNewGeometryBuffer(geometry_, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                              3 * sizeof(unsigned), std::max<size_t>(1, faces_.size())));
   // An empty mesh still gets one (degenerate, never hit) primitive: Embree wants non-empty buffers.
   index_buffer[0] = index_buffer[1] = index_buffer[2] = 0;
   vertex_buffer_[0] = vertex_buffer_[1] = vertex_buffer_[2] = 0.0f;
@@ -82,8 +82,8 @@ void RenderScene::UpdateDerived() {
     const Eigen::Vector3d& p0 = positions_[faces_[f][0]];
     const Eigen::Vector3d n = (positions_[faces_[f][1]] - p0).cross(positions_[faces_[f][2]] - p0);
     const double len = n.norm();
-    face_normals_[f] = len > 0 && std::isfinite(len) ? Eigen::Vector3d(n / len)
-                                                     : Eigen::Vector3d::Zero();
+    face_normals_[f] =
+        len > 0 && std::isfinite(len) ? Eigen::Vector3d(n / len) : Eigen::Vector3d::Zero();
   }
 }
 
@@ -126,8 +126,8 @@ RayHit RenderScene::Intersect(const Eigen::Vector3d& origin, const Eigen::Vector
   return hit;
 }
 
-void RenderScene::Intersect8(const Eigen::Vector3d& origin, const Eigen::Vector3d* dirs,
-                             int count, RayHit* hits) const {
+void RenderScene::Intersect8(const Eigen::Vector3d& origin, const Eigen::Vector3d* dirs, int count,
+                             RayHit* hits) const {
   CHECK_LE(count, 8);
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
@@ -165,8 +165,8 @@ void RenderScene::Intersect8(const Eigen::Vector3d& origin, const Eigen::Vector3
   }
 }
 
-bool RenderScene::Occluded(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir,
-                           double t_near, double t_far) const {
+bool RenderScene::Occluded(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, double t_near,
+                           double t_far) const {
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
   RTCRay ray;

@@ -1,6 +1,6 @@
 // End-to-end tests of the `sft` command line: real files in and out, exit codes, one-line errors.
-#include <gtest/gtest.h>
 #include <gmock/gmock.h>
+#include <gtest/gtest.h>
 
 #include <algorithm>
 #include <filesystem>
@@ -57,8 +57,8 @@ TEST(CliTest, SynthThenRenderRoundTrip) {
   EXPECT_TRUE(std::filesystem::exists(tmp.Join("ds/gt/mesh.ply")));
   EXPECT_FALSE(std::filesystem::exists(tmp.Join("ds.partial")));
 
-  ASSERT_EQ(Sft("render --quiet --dataset " + tmp.Join("ds") + " --mesh " + tmp.Join("ds/gt/mesh.ply") +
-                    " --material " + tmp.Join("ds/gt/material.json") +
+  ASSERT_EQ(Sft("render --quiet --dataset " + tmp.Join("ds") + " --mesh " +
+                    tmp.Join("ds/gt/mesh.ply") + " --material " + tmp.Join("ds/gt/material.json") +
                     " --spp 16 --bounces 2 --seed 7 --out " + tmp.Join("r"),
                 &out),
             0)
@@ -139,9 +139,9 @@ TEST(CliTest, BadInputGivesOneLineAndNonZeroExit) {
   EXPECT_EQ(CountLines(out), 1) << out;
   EXPECT_THAT(out, HasSubstr("missing.obj"));
 
-  EXPECT_NE(Sft("render --dataset " + tmp.Join("nope") + " --mesh x.obj --out " + tmp.Join("o"),
-                &out),
-            0);
+  EXPECT_NE(
+      Sft("render --dataset " + tmp.Join("nope") + " --mesh x.obj --out " + tmp.Join("o"), &out),
+      0);
   EXPECT_EQ(CountLines(out), 1) << out;
   EXPECT_THAT(out, HasSubstr("nope"));
 

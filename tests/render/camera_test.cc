@@ -11,10 +11,18 @@ Camera MakeCamera(CameraModel model) {
   camera.width = 640;
   camera.height = 480;
   switch (model) {
-    case CameraModel::kSimplePinhole: camera.params = {500, 320, 240}; break;
-    case CameraModel::kPinhole: camera.params = {500, 520, 321, 239}; break;
-    case CameraModel::kSimpleRadial: camera.params = {500, 320, 240, -0.1}; break;
-    case CameraModel::kRadial: camera.params = {500, 320, 240, -0.1, 0.02}; break;
+    case CameraModel::kSimplePinhole:
+      camera.params = {500, 320, 240};
+      break;
+    case CameraModel::kPinhole:
+      camera.params = {500, 520, 321, 239};
+      break;
+    case CameraModel::kSimpleRadial:
+      camera.params = {500, 320, 240, -0.1};
+      break;
+    case CameraModel::kRadial:
+      camera.params = {500, 320, 240, -0.1, 0.02};
+      break;
     case CameraModel::kOpenCV:
       camera.params = {500, 510, 320, 240, -0.1, 0.02, 0.001, -0.002};
       break;
@@ -23,9 +31,9 @@ Camera MakeCamera(CameraModel model) {
 }
 
 TEST(CameraTest, ProjectUnprojectRoundTripAllModels) {
-  for (CameraModel model : {CameraModel::kSimplePinhole, CameraModel::kPinhole,
-                            CameraModel::kSimpleRadial, CameraModel::kRadial,
-                            CameraModel::kOpenCV}) {
+  for (CameraModel model :
+       {CameraModel::kSimplePinhole, CameraModel::kPinhole, CameraModel::kSimpleRadial,
+        CameraModel::kRadial, CameraModel::kOpenCV}) {
     const Camera camera = MakeCamera(model);
     std::string why;
     ASSERT_TRUE(camera.Check(&why)) << why;

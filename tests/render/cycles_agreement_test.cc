@@ -38,11 +38,12 @@ TEST_P(CyclesAgreementTest, MatchesReference) {
   std::string material_json;
   if (spec["type"] == "textured") {
     ASSERT_TRUE(ReadMesh(root + "/" + gt["mesh_uv"].get<std::string>(), &mesh).ok());
-    material_json = nlohmann::json{{"albedo_texture", root + "/" + gt["texture"].get<std::string>()},
-                                   {"colorspace", "linear"},
-                                   {"resolution", 8},
-                                   {"specular", spec.value("specular", 0.0)}}
-                        .dump();
+    material_json =
+        nlohmann::json{{"albedo_texture", root + "/" + gt["texture"].get<std::string>()},
+                       {"colorspace", "linear"},
+                       {"resolution", 8},
+                       {"specular", spec.value("specular", 0.0)}}
+            .dump();
   } else {
     ASSERT_TRUE(ReadMesh(root + "/" + gt["mesh"].get<std::string>(), &mesh).ok());
     material_json = nlohmann::json{{"albedo", spec["albedo"]},
@@ -81,13 +82,14 @@ TEST_P(CyclesAgreementTest, MatchesReference) {
               worst_block);
 }
 
-INSTANTIATE_TEST_SUITE_P(
-    Cycles, CyclesAgreementTest,
-    ::testing::Values(CyclesCase{"bunny_point_diffuse", 64, 0.02},
-                      CyclesCase{"bunny_point_ggx_gi", 512, 0.03},
-                      CyclesCase{"sphere_env_studio", 256, 0.03},
-                      CyclesCase{"spot_textured_point", 64, 0.03}),
-    [](const ::testing::TestParamInfo<CyclesCase>& info) { return std::string(info.param.name); });
+INSTANTIATE_TEST_SUITE_P(Cycles, CyclesAgreementTest,
+                         ::testing::Values(CyclesCase{"bunny_point_diffuse", 64, 0.02},
+                                           CyclesCase{"bunny_point_ggx_gi", 512, 0.03},
+                                           CyclesCase{"sphere_env_studio", 256, 0.03},
+                                           CyclesCase{"spot_textured_point", 64, 0.03}),
+                         [](const ::testing::TestParamInfo<CyclesCase>& info) {
+                           return std::string(info.param.name);
+                         });
 
 }  // namespace
 }  // namespace sft

@@ -11,12 +11,11 @@
 // specular and light scales (h = 1e-3); 4e-4–7e-4 for roughness, whose small steps (h = 1e-4·r,
 // needed at r = 0.05 where D changes on the scale of α = r²) make float32 rounding of the images
 // the dominant error.
+#include <glog/logging.h>
 #include <gtest/gtest.h>
 
 #include <memory>
 #include <random>
-
-#include <glog/logging.h>
 
 #include "src/geometry/material.h"
 #include "src/geometry/mesh.h"

@@ -18,7 +18,8 @@ ViewSetup TopDownView(double height, int res, double focal) {
   view.camera.width = view.camera.height = res;
   view.camera.params = {focal, focal, 0.5 * res, 0.5 * res};
   // Camera axes in world: x_cam = +x, y_cam = −y, z_cam = −z (a rotation of π about x).
-  view.cam_from_world.rotation = Eigen::Quaterniond(Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()));
+  view.cam_from_world.rotation =
+      Eigen::Quaterniond(Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()));
   view.cam_from_world.translation = -(view.cam_from_world.rotation * Eigen::Vector3d(0, 0, height));
   return view;
 }
@@ -85,7 +86,8 @@ TEST(RenderTest, FurnaceConvexObject) {
   ASSERT_TRUE(ReadMesh(testing::DataDir() + "/meshes/icosphere_r1_320f.obj", &mesh).ok());
   const RenderScene scene(mesh);
   const double rho = 0.6, radiance = 1.5;
-  const Material material = ConstantMaterial(mesh.n_faces(), Eigen::Vector3d::Constant(rho), 0.5, 0.0);
+  const Material material =
+      ConstantMaterial(mesh.n_faces(), Eigen::Vector3d::Constant(rho), 0.5, 0.0);
   const EnvironmentMap env(Image(32, 16, 3, 1.0f), Eigen::Matrix3d::Identity(), radiance);
   ViewSetup view = TopDownView(4.0, 48, 40.0);
   view.environment = &env;
@@ -114,7 +116,8 @@ TEST(RenderTest, DeterministicAcrossThreadCounts) {
   TriMesh mesh;
   ASSERT_TRUE(ReadMesh(testing::DataDir() + "/meshes/bunny_watertight_5k.obj", &mesh).ok());
   const RenderScene scene(mesh);
-  const Material material = ConstantMaterial(mesh.n_faces(), Eigen::Vector3d(0.6, 0.5, 0.4), 0.3, 0.4);
+  const Material material =
+      ConstantMaterial(mesh.n_faces(), Eigen::Vector3d(0.6, 0.5, 0.4), 0.3, 0.4);
   ViewSetup view = TopDownView(4.0, 32, 30.0);
   view.point_lights.push_back({Eigen::Vector3d(0.5, 0.5, 3.0), Eigen::Vector3d::Constant(10.0)});
   RenderOptions options;
@@ -136,7 +139,8 @@ TEST(RenderTest, DeterministicAcrossThreadCounts) {
 // when the shadows effect is on.
 TEST(RenderTest, ShadowsEffect) {
   std::vector<Eigen::Vector3d> positions = QuadPositions(1.0);
-  for (const Eigen::Vector3d& p : QuadPositions(0.2)) positions.push_back(p + Eigen::Vector3d(0, 0, 0.5));
+  for (const Eigen::Vector3d& p : QuadPositions(0.2))
+    positions.push_back(p + Eigen::Vector3d(0, 0, 0.5));
   std::vector<Eigen::Vector3i> faces = QuadFaces();
   faces.push_back({4, 5, 6});
   faces.push_back({4, 6, 7});
@@ -147,8 +151,7 @@ TEST(RenderTest, ShadowsEffect) {
   // Look at the plane from the side so the occluder does not hide the shadowed spot.
   view.cam_from_world.rotation =
       Eigen::Quaterniond(Eigen::AngleAxisd(M_PI * 0.8, Eigen::Vector3d::UnitX()));
-  view.cam_from_world.translation =
-      -(view.cam_from_world.rotation * Eigen::Vector3d(0, -1.5, 2.5));
+  view.cam_from_world.translation = -(view.cam_from_world.rotation * Eigen::Vector3d(0, -1.5, 2.5));
   view.point_lights.push_back({Eigen::Vector3d(0, 0, 2.0), Eigen::Vector3d::Constant(5.0)});
   RenderOptions options;
   options.spp = 4;
@@ -158,7 +161,8 @@ TEST(RenderTest, ShadowsEffect) {
   options.effects.shadows = false;
   RenderView(scene, material, view, options, &without);
   // The origin of the plane projects somewhere in the image; find it.
-  const Eigen::Vector2d px = view.camera.ImageFromCam(view.cam_from_world * Eigen::Vector3d(0, 0, 0));
+  const Eigen::Vector2d px =
+      view.camera.ImageFromCam(view.cam_from_world * Eigen::Vector3d(0, 0, 0));
   const int x = static_cast<int>(px.x()), y = static_cast<int>(px.y());
   ASSERT_TRUE(x >= 0 && x < 32 && y >= 0 && y < 32);
   EXPECT_LT(with.at(x, y, 0), 1e-6);
@@ -184,8 +188,10 @@ TEST(RenderTest, HardCasesStayFinite) {
       const Material material = ConstantMaterial(5, Eigen::Vector3d::Constant(0.9), roughness, 1.0);
       for (double height : {2.0, 1e-3, -0.5}) {  // -0.5: camera below, grazing through the plane
         ViewSetup view = TopDownView(height * scale, 16, 12.0);
-        view.point_lights.push_back({Eigen::Vector3d(0.0, 0.0, 0.0), Eigen::Vector3d::Constant(1.0)});
-        view.point_lights.push_back({Eigen::Vector3d(0.1, 0.1, 1e-9) * scale, Eigen::Vector3d::Constant(1.0)});
+        view.point_lights.push_back(
+            {Eigen::Vector3d(0.0, 0.0, 0.0), Eigen::Vector3d::Constant(1.0)});
+        view.point_lights.push_back(
+            {Eigen::Vector3d(0.1, 0.1, 1e-9) * scale, Eigen::Vector3d::Constant(1.0)});
         const EnvironmentMap env(Image(8, 4, 3, 1.0f), Eigen::Matrix3d::Identity(), 1.0);
         view.environment = &env;
         view.point_lights[0].light_index = 0;
@@ -198,8 +204,7 @@ TEST(RenderTest, HardCasesStayFinite) {
         DerivativeRequest request;
         request.jacobian_rows = true;
         DerivativeOutput derivatives;
-        RenderViewWithDerivatives(scene, material, view, options, request, 3, &image,
-                                  &derivatives);
+        RenderViewWithDerivatives(scene, material, view, options, request, 3, &image, &derivatives);
         for (float v : image.data) ASSERT_TRUE(std::isfinite(v)) << "scale " << scale;
         for (const JacobianEntry& e : derivatives.rows.entries) {
           for (float d : e.d) ASSERT_TRUE(std::isfinite(d)) << "scale " << scale;
