@@ -485,8 +485,9 @@ Status BuildMaterial(const Context& ctx, const Json& json, const std::string& ba
     std::string file;
     SFT_RETURN_IF_ERROR(ReadString(ctx, json, "albedo_texture", &file));
     file = JoinPath(base_dir, file);
-    std::string ext = FileExtension(file);
-    bool srgb = ext == "png";  // Default: PNGs are sRGB-encoded, EXRs linear (DESIGN.md §2.5).
+    // Default: texel values are albedo as stored (the issue-2 CLI contract), for PNG and EXR
+    // alike; "colorspace": "srgb" decodes sRGB-encoded textures.
+    bool srgb = false;
     if (has("colorspace")) {
       const Json& v = json["colorspace"];
       if (v != "linear" && v != "srgb") {

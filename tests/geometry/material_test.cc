@@ -290,7 +290,7 @@ TEST(MaterialTest, TextureColorspace) {
   struct Case {
     std::string extra;
     double expected;
-  } cases[] = {{"", SrgbToLinear(128.0f / 255.0f)},
+  } cases[] = {{"", 128.0 / 255.0},  // default: as stored, even for PNG (CLI contract).
                {R"(, "colorspace": "srgb")", SrgbToLinear(128.0f / 255.0f)},
                {R"(, "colorspace": "linear")", 128.0 / 255.0}};
   for (const Case& c : cases) {
