@@ -15,14 +15,16 @@
 namespace sft {
 namespace {
 
+// The command-line values of `sft gradcheck`; validated by GradcheckOptions::Check and the
+// loaders.
 struct GradcheckCommandOptions {
-  std::string dataset;
-  std::string mesh;
-  std::string material;
-  std::string param;
-  std::string effects = "all";
-  std::string json;
-  GradcheckOptions check;
+  std::string dataset;          // dataset directory: cameras, lights, views.
+  std::string mesh;             // mesh (OBJ, PLY, OFF).
+  std::string material;         // material JSON file or inline JSON; "" = default material.
+  std::string param;            // vertices | albedo | roughness | specular | light.
+  std::string effects = "all";  // enabled effects (Effects::Parse).
+  std::string json;             // optional JSON report path.
+  GradcheckOptions check;       // spp, bounces, views, step, tolerance, seeds.
 };
 
 int RunGradcheckCommand(const GradcheckCommandOptions& opts) {

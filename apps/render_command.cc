@@ -23,17 +23,18 @@
 namespace sft {
 namespace {
 
+// The command-line values of `sft render`; validated by FinishRenderOptions and the loaders.
 struct RenderCommandOptions {
-  std::string dataset;
-  std::string mesh;
-  std::string material;
-  std::string out;
-  std::string pass = "color";
-  std::string effects = "all";
-  std::vector<int> views;
-  RenderOptions render;
-  bool quiet = false;
-  bool no_report = false;  // skip the comparison with the dataset images and report.html.
+  std::string dataset;          // dataset directory (sft-dataset/1).
+  std::string mesh;             // mesh to render (OBJ, PLY, OFF).
+  std::string material;         // material JSON file or inline JSON; "" = default material.
+  std::string out;              // output directory (images/, render.json, report.html).
+  std::string pass = "color";   // color | albedo | roughness | normal | depth.
+  std::string effects = "all";  // enabled effects (Effects::Parse).
+  std::vector<int> views;       // view indices; empty = all.
+  RenderOptions render;         // spp, bounces, seed, threads.
+  bool quiet = false;           // no progress line.
+  bool no_report = false;       // skip the comparison with the dataset images and report.html.
 };
 
 constexpr char kReportFiles[] = "report_files";  // the report's PNGs, under OUT/.

@@ -29,49 +29,56 @@ namespace {
 namespace fs = std::filesystem;
 
 struct SynthOptions {
-  std::string mesh;
-  std::string out;
-  std::string material;
-  int cameras = 32;
-  std::vector<double> zooms = {1.0, 2.0};
-  int res = 128;
-  double fov_deg = 40.0;
-  double fill = 0.6;
-  std::string up_axis = "z";
-  bool normalize = true;
-  std::vector<double> light_offset = {0.15, 0.0, 0.0};
-  double light_intensity = -1.0;  // < 0: automatic (see file comment).
-  std::string envmap;
-  double envmap_scale = 1.0;
-  bool environment_background = false;
-  RenderOptions render;
-  std::string effects = "all";
-  bool overwrite = false;
-  bool quiet = false;
+  std::string mesh;                        // input mesh path (OBJ, PLY, OFF).
+  std::string out;                         // output dataset directory.
+  std::string material;                    // material JSON file or inline JSON; "" = default.
+  int cameras = 32;                        // cameras on the Fibonacci sphere, [1, 10000].
+  std::vector<double> zooms = {1.0, 2.0};  // focal-length factors, one camera per zoom, > 0.
+  int res = 128;                           // image width = height, pixels, [1, 16384].
+  double fov_deg = 40.0;                   // field of view at zoom 1, degrees, (0, 179).
+  double fill = 0.6;          // bounding-sphere radius / half image at zoom 1, (0, 10].
+  std::string up_axis = "z";  // the mesh's up axis: "z" (as is) or "y" (rotated).
+  bool normalize = true;      // centre the mesh and scale its bbox diagonal to 1.
+  std::vector<double> light_offset = {0.15, 0.0, 0.0};  // point light in the camera frame.
+  double light_intensity = -1.0;        // W/sr; < 0 = automatic (see the file comment).
+  std::string envmap;                   // equirectangular EXR probe replacing the point light.
+  double envmap_scale = 1.0;            // probe radiance scale, >= 0.
+  bool environment_background = false;  // camera rays that miss see the probe.
+  RenderOptions render;                 // spp, bounces, seed, threads of the target renders.
+  std::string effects = "all";          // enabled effects (Effects::Parse).
+  bool overwrite = false;               // replace an existing, non-empty output directory.
+  bool quiet = false;                   // no progress line.
+
+  // Errors name the command-line flag.
+  bool Check(std::string* why) const {
+    if (cameras < 1 || cameras > 10000) return Fail(why, "--cameras: must be in [1, 10000]");
+    if (zooms.empty()) return Fail(why, "--zooms: needs at least one value");
+    for (double z : zooms) {
+      if (!(z > 0) || !std::isfinite(z)) return Fail(why, "--zooms: values must be > 0");
+    }
+    if (res < 1 || res > 16384) return Fail(why, "--res: must be in [1, 16384]");
+    if (!(fov_deg > 0 && fov_deg < 179)) return Fail(why, "--fov: must be in (0, 179)");
+    if (!(fill > 0 && fill <= 10)) return Fail(why, "--fill: must be in (0, 10]");
+    if (up_axis != "y" && up_axis != "z") return Fail(why, "--up-axis: must be y or z");
+    if (light_offset.size() != 3) return Fail(why, "--light-offset: needs 3 numbers x,y,z");
+    if (!(envmap_scale >= 0)) return Fail(why, "--envmap-scale: must be >= 0");
+    if (environment_background && envmap.empty()) {
+      return Fail(why, "--background-environment: needs --envmap");
+    }
+    return true;
+  }
+
+ private:
+  static bool Fail(std::string* why, const char* message) {
+    *why = message;
+    return false;
+  }
 };
 
-Status CheckSynthOptions(const SynthOptions& o) {
-  if (o.cameras < 1 || o.cameras > 10000) return Status::Error("--cameras: must be in [1, 10000]");
-  if (o.zooms.empty()) return Status::Error("--zooms: needs at least one value");
-  for (double z : o.zooms) {
-    if (!(z > 0) || !std::isfinite(z)) return Status::Error("--zooms: values must be > 0");
-  }
-  if (o.res < 1 || o.res > 16384) return Status::Error("--res: must be in [1, 16384]");
-  if (!(o.fov_deg > 0 && o.fov_deg < 179)) return Status::Error("--fov: must be in (0, 179)");
-  if (!(o.fill > 0 && o.fill <= 10)) return Status::Error("--fill: must be in (0, 10]");
-  if (o.up_axis != "y" && o.up_axis != "z") return Status::Error("--up-axis: must be y or z");
-  if (o.light_offset.size() != 3) return Status::Error("--light-offset: needs 3 numbers x,y,z");
-  if (!(o.envmap_scale >= 0)) return Status::Error("--envmap-scale: must be >= 0");
-  if (o.environment_background && o.envmap.empty()) {
-    return Status::Error("--background-environment: needs --envmap");
-  }
-  return Status::Ok();
-}
-
 Status RunSynth(const SynthOptions& opts) {
-  SFT_RETURN_IF_ERROR(CheckSynthOptions(opts));
-  RenderOptions render = opts.render;
   std::string why;
+  if (!opts.Check(&why)) return Status::Error(why);
+  RenderOptions render = opts.render;
   if (!Effects::Parse(opts.effects, &render.effects, &why)) return Status::Error("--" + why);
   if (!render.Check(&why)) return Status::Error("--" + why);
   std::error_code ec;
