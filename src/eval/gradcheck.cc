@@ -9,22 +9,6 @@
 namespace sft {
 namespace {
 
-const char* KindName(ParameterKind kind) {
-  switch (kind) {
-    case ParameterKind::kVertex:
-      return "vertices";
-    case ParameterKind::kAlbedo:
-      return "albedo";
-    case ParameterKind::kRoughness:
-      return "roughness";
-    case ParameterKind::kSpecular:
-      return "specular";
-    case ParameterKind::kLight:
-      return "light";
-  }
-  return "?";
-}
-
 // The material and view at θ + t·δ.
 Material PerturbMaterial(const Material& base, const ParameterLayout& layout,
                          const std::vector<double>& delta, double t) {
@@ -107,7 +91,7 @@ Status RunGradcheck(const Dataset& dataset, const TriMesh& mesh, const Material&
   const Material plus_material = PerturbMaterial(material, layout, delta, step);
   const Material minus_material = PerturbMaterial(material, layout, delta, -step);
 
-  result->kind = KindName(options.kind);
+  result->kind = ParameterKindName(options.kind);
   result->views.clear();
   double total_err2 = 0.0, total_ref2 = 0.0;
   for (int v : selected) {

@@ -19,12 +19,6 @@
 namespace sft {
 namespace {
 
-// These two must match render.cc (the shadow rays are the renderer's): rays leave a surface offset
-// along the normal by this fraction of max(extent, |p|∞), and lights closer than this fraction of
-// the extent are skipped. tests/eval/throughput_test.cc checks that the counts agree.
-constexpr double kRelativeRayOffset = 2e-5;
-constexpr double kMinRelativeLightDistance = 1e-9;
-
 // Rays per TBB task (a multiple of the packet width 8); RenderView's 8×8 pixel tiles at 4 spp
 // are 256 camera rays as well.
 constexpr size_t kRaysPerTask = 256;
@@ -41,8 +35,7 @@ void SetFlushToZero() {
 
 int ArenaConcurrency(int threads) { return threads > 0 ? threads : tbb::task_arena::automatic; }
 
-// The camera rays of a pixel exactly as RenderView computes them (keep in sync with render.cc:
-// tests/eval/throughput_test.cc compares the hit and shadow-ray counts with RenderView's).
+// The camera rays of a pixel, through the renderer's own CameraSampleDirection.
 struct CameraFrame {
   Eigen::Vector3d center;
   Eigen::Matrix3d world_from_cam_rotation;
@@ -54,14 +47,9 @@ struct CameraFrame {
   // Writes the unit directions of the `spp` samples of pixel (x, y) to dirs[0, spp).
   void PixelDirections(const ViewSetup& view, uint64_t seed, int x, int y, int spp,
                        Eigen::Vector3d* dirs) const {
-    const uint64_t pixel = static_cast<uint64_t>(y) * view.camera.width + x;
-    // Sub-pixel positions exactly as RenderView draws them (first Next2D of each sample).
+    Sampler sampler;
     for (int s = 0; s < spp; ++s) {
-      Sampler sampler(seed, view.view_index, pixel, static_cast<uint64_t>(s));
-      double jitter_x, jitter_y;
-      sampler.Next2D(&jitter_x, &jitter_y);
-      const Eigen::Vector2d film(x + jitter_x, y + jitter_y);
-      dirs[s] = (world_from_cam_rotation * view.camera.CamFromImage(film)).normalized();
+      dirs[s] = CameraSampleDirection(view, world_from_cam_rotation, seed, x, y, s, &sampler);
     }
   }
 };
@@ -327,8 +315,7 @@ std::vector<BenchRay> ShadowRays(const RenderScene& scene, const ViewSetup& view
             Eigen::Vector3d n = scene.FaceNormal(hit.face);
             if (n.isZero()) continue;
             if (n.dot(-dir) < 0.0) n = -n;
-            const double offset =
-                kRelativeRayOffset * std::max(scene.extent(), p.cwiseAbs().maxCoeff());
+            const double offset = SurfaceRayOffset(scene, p);
             const Eigen::Vector3d p_off = p + offset * n;
             for (size_t l = 0; l < num_lights; ++l) {
               const Eigen::Vector3d to_light = view.point_lights[l].position - p;

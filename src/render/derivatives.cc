@@ -46,6 +46,22 @@ bool ParameterKindFromName(const std::string& name, ParameterKind* kind) {
   return true;
 }
 
+const char* ParameterKindName(ParameterKind kind) {
+  switch (kind) {
+    case ParameterKind::kVertex:
+      return "vertices";
+    case ParameterKind::kAlbedo:
+      return "albedo";
+    case ParameterKind::kRoughness:
+      return "roughness";
+    case ParameterKind::kSpecular:
+      return "specular";
+    case ParameterKind::kLight:
+      return "light";
+  }
+  return "?";
+}
+
 ParameterSelection ParameterSelection::Only(ParameterKind kind) {
   ParameterSelection s;
   s.vertices = kind == ParameterKind::kVertex;

@@ -48,7 +48,9 @@ struct ParameterLayout {
   std::string Describe(int index) const;
 };
 
+// "vertices", "albedo", "roughness", "specular", "light" (the names of `--param`).
 bool ParameterKindFromName(const std::string& name, ParameterKind* kind);
+const char* ParameterKindName(ParameterKind kind);
 
 // Which parameter kinds get derivatives.
 struct ParameterSelection {

@@ -21,14 +21,6 @@ namespace sft {
 namespace {
 
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
-// Rays leave surfaces offset along the normal by this fraction of the scene scale (the larger of
-// the mesh's extent and the point's distance from the origin, so float rounding of the hit point
-// is covered at any scale).
-constexpr double kRelativeRayOffset = 2e-5;
-// Point lights closer than this (relative to the scene extent) to a shaded point are skipped:
-// I/d² would overflow, and a light inside the surface lights nothing physical.
-constexpr double kMinRelativeLightDistance = 1e-9;
-
 double PowerHeuristic(double pdf_a, double pdf_b) {
   const double a2 = pdf_a * pdf_a;
   const double b2 = pdf_b * pdf_b;
@@ -71,7 +63,7 @@ SurfaceMaterial LookUpMaterial(const Context& ctx, const Material& material, int
 }
 
 double RayOffset(const Context& ctx, const Eigen::Vector3d& p) {
-  return kRelativeRayOffset * std::max(ctx.scene.extent(), p.cwiseAbs().maxCoeff());
+  return SurfaceRayOffset(ctx.scene, p);
 }
 
 // Per-sample derivative sink: (parameter, ∂RGB) pairs of one path, appended.
@@ -464,12 +456,8 @@ void RenderImpl(const RenderScene& scene, const Material& material, const ViewSe
         Sampler samplers[kTile];
         Eigen::Vector3d dirs[kTile];
         for (int i = 0; i < count; ++i) {
-          const uint64_t pixel = static_cast<uint64_t>(y) * width + (x0 + i);
-          samplers[i] = Sampler(options.seed, view.view_index, pixel, static_cast<uint64_t>(s));
-          double jitter_x, jitter_y;
-          samplers[i].Next2D(&jitter_x, &jitter_y);
-          const Eigen::Vector2d film(x0 + i + jitter_x, y + jitter_y);
-          dirs[i] = (world_from_cam_rotation * view.camera.CamFromImage(film)).normalized();
+          dirs[i] = CameraSampleDirection(view, world_from_cam_rotation, options.seed, x0 + i, y, s,
+                                          &samplers[i]);
         }
         RayHit first_hits[kTile];
         scene.Intersect8(center, dirs, count, first_hits);
@@ -541,6 +529,21 @@ void RenderImpl(const RenderScene& scene, const Material& material, const ViewSe
 }
 
 }  // namespace
+
+double SurfaceRayOffset(const RenderScene& scene, const Eigen::Vector3d& p) {
+  return kRelativeRayOffset * std::max(scene.extent(), p.cwiseAbs().maxCoeff());
+}
+
+Eigen::Vector3d CameraSampleDirection(const ViewSetup& view,
+                                      const Eigen::Matrix3d& world_from_cam_rotation, uint64_t seed,
+                                      int x, int y, int s, Sampler* sampler) {
+  const uint64_t pixel = static_cast<uint64_t>(y) * view.camera.width + x;
+  *sampler = Sampler(seed, view.view_index, pixel, static_cast<uint64_t>(s));
+  double jitter_x, jitter_y;
+  sampler->Next2D(&jitter_x, &jitter_y);
+  const Eigen::Vector2d film(x + jitter_x, y + jitter_y);
+  return (world_from_cam_rotation * view.camera.CamFromImage(film)).normalized();
+}
 
 void RenderView(const RenderScene& scene, const Material& material, const ViewSetup& view,
                 const RenderOptions& options, Image* image, RenderStats* stats) {

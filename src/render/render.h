@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "src/core/image.h"
+#include "src/core/rng.h"
 #include "src/core/status.h"
 #include "src/geometry/material.h"
 #include "src/render/camera.h"
@@ -90,6 +91,23 @@ struct RenderStats {
 // roughness they are the first-hit material averaged over the pixel (0 where nothing is hit,
 // i.e. premultiplied by coverage, like Cycles' DiffCol pass); normal = world-space geometric
 // normal facing the camera; depth = camera-frame z.
+// Ray conventions of the renderer, shared with benchmarks that replay its rays.
+// Rays leave surfaces offset along the normal by this fraction of the scene scale (the larger of
+// the mesh's extent and the point's distance from the origin, so float rounding of the hit point
+// is covered at any scale).
+constexpr double kRelativeRayOffset = 2e-5;
+// Point lights closer than this (relative to the scene extent) to a shaded point are skipped:
+// I/d² would overflow, and a light inside the surface lights nothing physical.
+constexpr double kMinRelativeLightDistance = 1e-9;
+// The offset for a ray leaving the surface at p.
+double SurfaceRayOffset(const RenderScene& scene, const Eigen::Vector3d& p);
+
+// Sample s of pixel (x, y): resets *sampler to that sample's stream, draws the sub-pixel position
+// (its first Next2D) and returns the unit world direction of the camera ray.
+Eigen::Vector3d CameraSampleDirection(const ViewSetup& view,
+                                      const Eigen::Matrix3d& world_from_cam_rotation, uint64_t seed,
+                                      int x, int y, int s, Sampler* sampler);
+
 void RenderView(const RenderScene& scene, const Material& material, const ViewSetup& view,
                 const RenderOptions& options, Image* image, RenderStats* stats = nullptr);
 
