@@ -1,5 +1,8 @@
 #include "src/render/derivatives.h"
 
+#include <string>
+#include <utility>
+
 namespace sft {
 
 ParameterKind ParameterLayout::KindOf(int index) const {
@@ -89,11 +92,13 @@ bool ParameterSelection::Selected(ParameterKind kind) const {
 }
 
 bool DerivativeRequest::Check(std::string* why) const {
-  if (params.vertices) {
-    *why =
-        "vertices: vertex derivatives (interior terms and edge sampling) are not implemented "
-        "yet";
-    return false;
+  for (const auto& [name, ratio] :
+       {std::pair<const char*, double>{"primary_edge_ratio", primary_edge_ratio},
+        std::pair<const char*, double>{"shadow_edge_ratio", shadow_edge_ratio}}) {
+    if (!(ratio >= 0.0 && ratio <= 16.0)) {
+      *why = std::string(name) + ": must be in [0, 16], got " + std::to_string(ratio);
+      return false;
+    }
   }
   if (adjoint_weights != nullptr && adjoint_weights->channels < 3) {
     *why = "adjoint weights: need 3 channels";

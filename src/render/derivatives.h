@@ -88,8 +88,14 @@ struct DerivativeRequest {
   bool jacobian_rows = false;              // fill DerivativeOutput::rows.
   const Image* adjoint_weights = nullptr;  // when set (width × height, ≥ 3 channels): fill
                                            // DerivativeOutput::gradient = Σ_p Σ_c w_pc ∂I_pc/∂θ.
+  // Visibility (edge) terms of vertex derivatives, sampled per view in proportion to the
+  // forward work: primary edge samples = ratio × spp × pixels (each traces two paths, one on
+  // either side of the edge); secondary (shadow) edge samples likewise. Range [0, 16]; 0 turns
+  // the edge terms off (interior terms only, a biased derivative near silhouettes/shadows).
+  double primary_edge_ratio = 0.5;
+  double shadow_edge_ratio = 0.25;
 
-  // Empty when valid; vertex derivatives are not implemented yet.
+  // True when valid; else *why names the field.
   bool Check(std::string* why) const;
 };
 
