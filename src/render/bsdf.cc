@@ -1,5 +1,7 @@
 #include "src/render/bsdf.h"
 
+#include <ceres/jet.h>
+
 #include <algorithm>
 #include <cmath>
 
@@ -40,6 +42,44 @@ Eigen::Vector3d SampleGgxVisibleNormal(const Eigen::Vector3d& wo, double alpha, 
       p1 * t1 + p2 * t2 + std::sqrt(std::max(0.0, 1.0 - p1 * p1 - p2 * p2)) * vh;
   // Unstretch.
   return Eigen::Vector3d(alpha * nh.x(), alpha * nh.y(), std::max(1e-12, nh.z())).normalized();
+}
+
+// The glossy term as a function of (n, wo, wi), templated so that ceres::Jet gives its exact
+// gradient; the same formulas as GgxD, GgxG1, SchlickFresnel and EvalBsdf below.
+template <typename T>
+T GlossyTerm(const Eigen::Matrix<T, 3, 1>& n, const Eigen::Vector3d& wo,
+             const Eigen::Matrix<T, 3, 1>& wi, double alpha, double specular, FresnelMode mode) {
+  using std::sqrt;
+  const T cos_o = n.dot(wo.cast<T>());
+  const T cos_i = n.dot(wi);
+  if (cos_o <= 0.0 || cos_i <= 0.0 || specular <= 0.0) return T(0.0);
+  const Eigen::Matrix<T, 3, 1> sum = wi + wo.cast<T>();
+  const T len = sqrt(sum.squaredNorm());
+  if (!(len > 1e-12)) return T(0.0);
+  const Eigen::Matrix<T, 3, 1> h = sum / len;
+  T fresnel(specular);
+  if (mode == FresnelMode::kSchlick) {
+    T m = 1.0 - wi.dot(h);
+    if (m < 0.0) m = T(0.0);
+    if (m > 1.0) m = T(1.0);
+    const T m2 = m * m;
+    fresnel = specular + (1.0 - specular) * m2 * m2 * m;
+  }
+  const T cos_h = n.dot(h);
+  if (cos_h <= 0.0) return T(0.0);
+  const double a2 = alpha * alpha;
+  const T cos2_h = cos_h * cos_h;
+  T sin2_h = 1.0 - cos2_h;
+  if (sin2_h < 0.0) sin2_h = T(0.0);
+  const T q = sin2_h + cos2_h * a2;
+  const T d = a2 / (kPi * q * q);
+  auto g1 = [a2](const T& c) {
+    const T c2 = c * c;
+    T s2 = 1.0 - c2;
+    if (s2 < 0.0) s2 = T(0.0);
+    return 2.0 / (1.0 + sqrt(1.0 + a2 * s2 / c2));
+  };
+  return fresnel * d * g1(cos_i) * g1(cos_o) / (4.0 * cos_i * cos_o);
 }
 
 double Luminance(const Eigen::Vector3d& c) { return (c.x() + c.y() + c.z()) / 3.0; }
@@ -153,6 +193,21 @@ BsdfDerivatives EvalBsdfDerivatives(const BsdfParams& params, const Eigen::Vecto
     d.d_roughness = fresnel * d_dgg * (2.0 * r) * inv;
   }
   return d;
+}
+
+double EvalGlossyWithGradient(const BsdfParams& params, const Eigen::Vector3d& n,
+                              const Eigen::Vector3d& wo, const Eigen::Vector3d& wi,
+                              Eigen::Vector3d* d_n, Eigen::Vector3d* d_wi) {
+  using Jet = ceres::Jet<double, 6>;
+  Eigen::Matrix<Jet, 3, 1> n_jet, wi_jet;
+  for (int k = 0; k < 3; ++k) {
+    n_jet[k] = Jet(n[k], k);
+    wi_jet[k] = Jet(wi[k], 3 + k);
+  }
+  const Jet g = GlossyTerm<Jet>(n_jet, wo, wi_jet, params.Alpha(), params.specular, params.fresnel);
+  *d_n = g.v.head<3>();
+  *d_wi = g.v.tail<3>();
+  return g.a;
 }
 
 double BsdfPdf(const BsdfParams& params, const Eigen::Vector3d& n, const Eigen::Vector3d& wo,

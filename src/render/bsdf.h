@@ -64,6 +64,14 @@ BsdfDerivatives EvalBsdfDerivatives(const BsdfParams& params, const Eigen::Vecto
                                     const Eigen::Vector3d& wo, const Eigen::Vector3d& wi,
                                     double specular_scale);
 
+// The glossy term g of f = albedo/π + g (the same in every channel; zero below the surface or
+// when specular ≤ 0), with its gradients with respect to the normal and to wi (as free 3-vectors:
+// the caller projects them onto the unit sphere's tangent space through its own chain rule).
+// Used for vertex derivatives, where n and (for point lights) wi move with the geometry.
+double EvalGlossyWithGradient(const BsdfParams& params, const Eigen::Vector3d& n,
+                              const Eigen::Vector3d& wo, const Eigen::Vector3d& wi,
+                              Eigen::Vector3d* d_n, Eigen::Vector3d* d_wi);
+
 // dD/dα and dG1/dα of the functions above (for derivative tests and EvalBsdfDerivatives).
 double GgxDAlphaDerivative(double cos_h, double alpha);
 double GgxG1AlphaDerivative(double cos_w, double alpha);

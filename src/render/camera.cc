@@ -54,6 +54,40 @@ Eigen::Vector2d Distortion(const Camera& camera, const Eigen::Vector2d& uv) {
           v * radial + 2.0 * p2 * uv_ + p1 * (r2 + 2.0 * v2)};
 }
 
+// ∂Distortion/∂(u, v) of the function above.
+Eigen::Matrix2d DistortionJacobian(const Camera& camera, const Eigen::Vector2d& uv) {
+  const std::vector<double>& p = camera.params;
+  double k1 = 0, k2 = 0, p1 = 0, p2 = 0;
+  switch (camera.model) {
+    case CameraModel::kSimplePinhole:
+    case CameraModel::kPinhole:
+      return Eigen::Matrix2d::Zero();
+    case CameraModel::kSimpleRadial:
+      k1 = p[3];
+      break;
+    case CameraModel::kRadial:
+      k1 = p[3];
+      k2 = p[4];
+      break;
+    case CameraModel::kOpenCV:
+      k1 = p[4];
+      k2 = p[5];
+      p1 = p[6];
+      p2 = p[7];
+      break;
+  }
+  const double u = uv.x(), v = uv.y();
+  const double r2 = u * u + v * v;
+  const double radial = k1 * r2 + k2 * r2 * r2;
+  const double d_radial = 2.0 * (k1 + 2.0 * k2 * r2);  // ∂radial/∂u = d_radial·u, same for v.
+  Eigen::Matrix2d j;
+  j(0, 0) = radial + u * d_radial * u + 2.0 * p1 * v + 6.0 * p2 * u;
+  j(0, 1) = u * d_radial * v + 2.0 * p1 * u + 2.0 * p2 * v;
+  j(1, 0) = v * d_radial * u + 2.0 * p2 * v + 2.0 * p1 * u;
+  j(1, 1) = radial + v * d_radial * v + 2.0 * p2 * u + 6.0 * p1 * v;
+  return j;
+}
+
 }  // namespace
 
 bool CameraModelFromName(const std::string& name, CameraModel* model) {
@@ -119,6 +153,15 @@ Eigen::Vector2d Camera::ImageFromCam(const Eigen::Vector3d& p_in_cam) const {
   const Eigen::Vector2d uv(p_in_cam.x() / p_in_cam.z(), p_in_cam.y() / p_in_cam.z());
   const Eigen::Vector2d distorted = uv + Distortion(*this, uv);
   return Focal().cwiseProduct(distorted) + Principal();
+}
+
+Eigen::Matrix<double, 2, 3> Camera::ImageFromCamJacobian(const Eigen::Vector3d& p_in_cam) const {
+  const double inv_z = 1.0 / p_in_cam.z();
+  const Eigen::Vector2d uv(p_in_cam.x() * inv_z, p_in_cam.y() * inv_z);
+  Eigen::Matrix<double, 2, 3> d_uv;
+  d_uv << inv_z, 0.0, -uv.x() * inv_z, 0.0, inv_z, -uv.y() * inv_z;
+  const Eigen::Matrix2d d_distorted = Eigen::Matrix2d::Identity() + DistortionJacobian(*this, uv);
+  return Focal().asDiagonal() * d_distorted * d_uv;
 }
 
 Eigen::Vector3d Camera::CamFromImage(const Eigen::Vector2d& pixel) const {

@@ -50,6 +50,8 @@ struct Camera {
 
   // Projects a point in the camera frame (z > 0) to image coordinates, with distortion.
   Eigen::Vector2d ImageFromCam(const Eigen::Vector3d& p_in_cam) const;
+  // ∂ImageFromCam/∂p_in_cam (2×3), analytic, distortion included (z > 0).
+  Eigen::Matrix<double, 2, 3> ImageFromCamJacobian(const Eigen::Vector3d& p_in_cam) const;
   // Inverse of ImageFromCam up to scale: a direction (x, y, 1) in the camera frame whose
   // projection is `pixel`. Distortion is inverted by Newton iterations (as COLMAP does).
   Eigen::Vector3d CamFromImage(const Eigen::Vector2d& pixel) const;

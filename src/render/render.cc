@@ -16,6 +16,7 @@
 
 #include "src/core/rng.h"
 #include "src/render/bsdf.h"
+#include "src/render/geometry_derivatives.h"
 
 namespace sft {
 namespace {
@@ -69,38 +70,114 @@ double RayOffset(const Context& ctx, const Eigen::Vector3d& p) {
 // Per-sample derivative sink: (parameter, ∂RGB) pairs of one path, appended.
 using DerivativeList = std::vector<std::pair<int, Eigen::Vector3d>>;
 
+// The light term Q of a contribution, split as Q = q·c with c the part that depends on the
+// geometry of the shading point: point light q = I, c = (n·wi)/d² (wi and d follow the point x);
+// environment (light- or BSDF-sampled, direction fixed) q = L·scale·w_MIS/pdf, c = n·wi.
+struct LightTerm {
+  Eigen::Vector3d q;
+  double c = 0.0;
+  Eigen::Vector3d dc_dn = Eigen::Vector3d::Zero();
+  bool follows_point = false;                        // point light: the next three are set.
+  Eigen::Vector3d dc_dx = Eigen::Vector3d::Zero();   // ∂c/∂x = (3(n·wi)wi − n)/d³.
+  Eigen::Matrix3d dwi_dx = Eigen::Matrix3d::Zero();  // ∂wi/∂x = −(I − wi wiᵀ)/d.
+};
+
 // Bookkeeping of one path's derivatives. A path's light contributions have the form
 //   C = (s_0 ⊙ … ⊙ s_{i−1}) ⊙ f_i(wo_i, wi) ⊙ Q,
 // with s_k = f_k(wo_k, wi_k)·|n·wi_k|/pdf_k the scatter factor of vertex k (pdf detached) and Q
 // the light term. ∂C/∂θ for a parameter of vertex j < i replaces s_j by ∂s_j/∂θ; for vertex i it
 // replaces f_i by ∂f_i/∂θ. `excluded_[j]` keeps Π_{k<i, k≠j} s_k so that no division by a
 // possibly zero factor is needed.
+//
+// Vertex coordinates enter (directions detached, so wo and sampled wi stay fixed) through the
+// normal n_k of every vertex's face — s_k, f_i and c depend on it — and, for point lights,
+// through the position x_i (wi = (L − x_i)/d, c), which moves with the faces hit before
+// (PointJacobian). Texel lookups are piecewise constant and contribute nothing.
 class PathDerivatives {
  public:
-  PathDerivatives(const Context& ctx, DerivativeList* out) : ctx_(ctx), out_(out) {}
+  PathDerivatives(const Context& ctx, DerivativeList* out)
+      : ctx_(ctx), out_(out), vertices_(ctx.request->params.vertices) {}
 
-  // A light contribution at the current vertex (index = number of scatters so far).
+  // The path reached a new vertex on face `face` (hit barycentrics `barycentrics`, ray direction
+  // `dir`), shaded with normal sign·n̂. `track_point`: keep x's Jacobian (point lights exist).
+  void SetVertex(int face, const Eigen::Vector3d& barycentrics, const Eigen::Vector3d& dir,
+                 double sign, bool track_point) {
+    if (!vertices_) return;
+    const Eigen::Vector3i& corners = ctx_.scene.faces()[face];
+    const auto& p = ctx_.scene.positions();
+    corners_ = corners;
+    normal_ = NormalChain(p[corners[0]], p[corners[1]], p[corners[2]], sign);
+    if (track_point) point_.Advance(count_ == 0, dir, normal_.unit_normal(), barycentrics, corners);
+  }
+
+  // A light contribution f ⊙ (q·c) at the current vertex (index = number of scatters so far),
+  // with shading normal n and directions wo, wi.
   void AddContribution(const Eigen::Vector3d& prefix, const SurfaceMaterial& surface,
-                       const BsdfDerivatives& d_f, const Eigen::Vector3d& f,
-                       const Eigen::Vector3d& q, int light_index) {
+                       const Eigen::Vector3d& n, const Eigen::Vector3d& wo,
+                       const Eigen::Vector3d& wi, const Eigen::Vector3d& f, const LightTerm& light,
+                       int light_index) {
+    const Eigen::Vector3d q = light.q * light.c;
     const Eigen::Vector3d contribution = prefix.cwiseProduct(f).cwiseProduct(q);
-    AddMaterial(surface, d_f, prefix.cwiseProduct(q));
+    const bool material = ctx_.request->params.albedo || ctx_.request->params.roughness ||
+                          ctx_.request->params.specular;
     const Eigen::Vector3d f_q = f.cwiseProduct(q);
-    for (int j = 0; j < count_; ++j) {
-      AddMaterial(scatters_[j].surface, scatters_[j].d_s, excluded_[j].cwiseProduct(f_q));
+    if (material) {
+      AddMaterial(surface, EvalBsdfDerivatives(surface.params, n, wo, wi, ctx_.specular_scale),
+                  prefix.cwiseProduct(q));
+      for (int j = 0; j < count_; ++j) {
+        AddMaterial(scatters_[j].surface, scatters_[j].d_s, excluded_[j].cwiseProduct(f_q));
+      }
     }
     if (ctx_.request->params.lights && light_index >= 0) {
       out_->emplace_back(ctx_.layout->LightOffset() + light_index, contribution);
     }
+    if (!vertices_) return;
+    // ∂(f ⊙ q·c) = (f ⊙ q)·∂c + c·q·∂g, g the glossy term (the diffuse term is constant).
+    Eigen::Vector3d dg_dn, dg_dwi;
+    EvalGlossyWithGradient(surface.params, n, wo, wi, &dg_dn, &dg_dwi);
+    const Eigen::Vector3d base = prefix.cwiseProduct(light.q);
+    const Eigen::Vector3d base_f = base.cwiseProduct(f);
+    const Eigen::Matrix3d d_n =
+        base_f * light.dc_dn.transpose() + light.c * base * dg_dn.transpose();
+    AddFace(corners_, normal_.Map(d_n));
+    if (light.follows_point && point_.valid) {
+      const Eigen::Matrix3d d_x =
+          base_f * light.dc_dx.transpose() + light.c * base * (dg_dwi.transpose() * light.dwi_dx);
+      for (int e = 0; e < point_.count; ++e) {
+        const Eigen::Matrix3d g = d_x * point_.m[e];
+        for (int k = 0; k < 3; ++k) Emit(3 * point_.vertex[e] + k, g.col(k));
+      }
+    }
+    for (int j = 0; j < count_; ++j) {
+      const Eigen::Vector3d w = excluded_[j].cwiseProduct(f_q);
+      AddFace(scatters_[j].corners, w.asDiagonal() * scatters_[j].ds_dcorners);
+    }
   }
 
-  // The path continues from the current vertex with scatter factor s (and its derivatives).
+  // The path continues from the current vertex with scatter factor s = f·(n·wi)/pdf.
   void AddScatter(const Eigen::Vector3d& prefix, const SurfaceMaterial& surface,
-                  const Eigen::Vector3d& s, const BsdfDerivatives& d_s) {
+                  const Eigen::Vector3d& n, const Eigen::Vector3d& wo, const Eigen::Vector3d& wi,
+                  const Eigen::Vector3d& f, double pdf) {
     CHECK_LT(count_, kMaxScatters);
+    const double cos_over_pdf = n.dot(wi) / pdf;
+    const Eigen::Vector3d s = f * cos_over_pdf;
     for (int j = 0; j < count_; ++j) excluded_[j] = excluded_[j].cwiseProduct(s);
     excluded_[count_] = prefix;
-    scatters_[count_] = {surface, d_s};
+    Scatter& scatter = scatters_[count_];
+    scatter.surface = surface;
+    scatter.d_s = EvalBsdfDerivatives(surface.params, n, wo, wi, ctx_.specular_scale);
+    scatter.d_s.d_albedo *= cos_over_pdf;
+    scatter.d_s.d_roughness *= cos_over_pdf;
+    scatter.d_s.d_specular *= cos_over_pdf;
+    if (vertices_) {
+      // ∂s/∂n = (f·wiᵀ + (n·wi)·1·∂g/∂nᵀ)/pdf.
+      Eigen::Vector3d dg_dn, dg_dwi;
+      EvalGlossyWithGradient(surface.params, n, wo, wi, &dg_dn, &dg_dwi);
+      const Eigen::Matrix3d ds_dn =
+          (f * wi.transpose() + n.dot(wi) * Eigen::Vector3d::Ones() * dg_dn.transpose()) / pdf;
+      scatter.corners = corners_;
+      scatter.ds_dcorners = normal_.Map(ds_dn);
+    }
     ++count_;
   }
 
@@ -108,7 +185,18 @@ class PathDerivatives {
   struct Scatter {
     SurfaceMaterial surface;
     BsdfDerivatives d_s;
+    Eigen::Vector3i corners;
+    Eigen::Matrix<double, 3, 9> ds_dcorners;  // ∂s/∂(corner coordinates), rows = channels.
   };
+
+  void Emit(int param, const Eigen::Vector3d& d) {
+    if (d[0] != 0.0 || d[1] != 0.0 || d[2] != 0.0) out_->emplace_back(param, d);
+  }
+  void AddFace(const Eigen::Vector3i& corners, const Eigen::Matrix<double, 3, 9>& g) {
+    for (int j = 0; j < 3; ++j) {
+      for (int k = 0; k < 3; ++k) Emit(3 * corners[j] + k, g.col(3 * j + k));
+    }
+  }
 
   // Adds base ⊙ ∂(factor)/∂θ for the material parameters of `surface`, where ∂factor/∂θ is
   // described by `d` (albedo: own channel only; roughness and specular: all channels).
@@ -136,9 +224,14 @@ class PathDerivatives {
   static constexpr int kMaxScatters = 16;
   const Context& ctx_;
   DerivativeList* out_;
+  const bool vertices_;
   int count_ = 0;
   std::array<Scatter, kMaxScatters> scatters_;
   std::array<Eigen::Vector3d, kMaxScatters> excluded_;
+  // The current vertex's face and normal chain, and its position's Jacobian.
+  Eigen::Vector3i corners_ = Eigen::Vector3i::Zero();
+  NormalChain normal_;
+  PointJacobian point_;
 };
 
 // Radiance along the camera ray with direction `dir` whose first intersection is `hit` (traced
@@ -168,7 +261,12 @@ Eigen::Vector3d TraceRadiance(const Context& ctx, Sampler* sampler, Eigen::Vecto
     Eigen::Vector3d n = ctx.scene.FaceNormal(hit.face);
     if (n.isZero()) break;  // degenerate triangle: no defined surface, nothing reflected.
     const Eigen::Vector3d wo = -dir;
-    if (n.dot(wo) < 0.0) n = -n;  // two-sided shading.
+    const double sign = n.dot(wo) < 0.0 ? -1.0 : 1.0;
+    n *= sign;  // two-sided shading.
+    if (path) {
+      path->SetVertex(hit.face, Eigen::Vector3d(1.0 - hit.u - hit.v, hit.u, hit.v), dir, sign,
+                      !ctx.view.point_lights.empty());
+    }
     const SurfaceMaterial surface = LookUpMaterial(ctx, ctx.material, hit.face, hit.u, hit.v);
     const BsdfParams& params = surface.params;
     const BsdfParams sampling =
@@ -178,15 +276,11 @@ Eigen::Vector3d TraceRadiance(const Context& ctx, Sampler* sampler, Eigen::Vecto
     const Eigen::Vector3d p_off = p + offset * n;
     const bool lit_here = depth > 0 || effects.direct;
 
-    // Adds throughput ⊙ f ⊙ q to the radiance (and its derivatives).
+    // Adds throughput ⊙ f ⊙ (q·c) to the radiance (and its derivatives).
     auto contribute = [&](const Eigen::Vector3d& wi, const Eigen::Vector3d& f,
-                          const Eigen::Vector3d& q, int light_index) {
-      radiance += throughput.cwiseProduct(f).cwiseProduct(q);
-      if (path) {
-        path->AddContribution(throughput, surface,
-                              EvalBsdfDerivatives(params, n, wo, wi, ctx.specular_scale), f, q,
-                              light_index);
-      }
+                          const LightTerm& light, int light_index) {
+      radiance += throughput.cwiseProduct(f).cwiseProduct(light.q) * light.c;
+      if (path) path->AddContribution(throughput, surface, n, wo, wi, f, light, light_index);
     };
 
     if (lit_here) {
@@ -203,9 +297,18 @@ Eigen::Vector3d TraceRadiance(const Context& ctx, Sampler* sampler, Eigen::Vecto
         if (f.isZero() && !path) continue;
         if (effects.shadows) {
           ++stats->shadow_rays;
-          if (ctx.scene.Occluded(p_off, wi, 0.0, dist - offset)) continue;
+          if (ctx.scene.Occluded(p, wi, offset, dist - offset)) continue;
         }
-        contribute(wi, f, light.intensity * (cos_i / dist2), light.light_index);
+        LightTerm term;
+        term.q = light.intensity;
+        term.c = cos_i / dist2;
+        if (path) {
+          term.dc_dn = wi / dist2;
+          term.follows_point = true;
+          term.dc_dx = (3.0 * cos_i * wi - n) / (dist2 * dist);
+          term.dwi_dx = -(Eigen::Matrix3d::Identity() - wi * wi.transpose()) / dist;
+        }
+        contribute(wi, f, term, light.light_index);
       }
       if (ctx.environment != nullptr) {
         Eigen::Vector3d wi, le;
@@ -219,15 +322,18 @@ Eigen::Vector3d TraceRadiance(const Context& ctx, Sampler* sampler, Eigen::Vecto
             bool visible = !f.isZero() || path.has_value();
             if (visible && effects.shadows) {
               ++stats->shadow_rays;
-              visible = !ctx.scene.Occluded(p_off, wi, 0.0, kInfinity);
+              visible = !ctx.scene.Occluded(p, wi, offset, kInfinity);
             }
             if (visible) {
               // Without shadows the BSDF-sampled rays cannot tell whether the light is seen, so
               // the environment is lit by light sampling alone (weight 1).
               const double weight =
                   effects.shadows ? PowerHeuristic(pdf_light, BsdfPdf(sampling, n, wo, wi)) : 1.0;
-              contribute(wi, f, le * (ctx.view.environment_scale * cos_i * weight / pdf_light),
-                         ctx.view.environment_light_index);
+              LightTerm term;
+              term.q = le * (ctx.view.environment_scale * weight / pdf_light);
+              term.c = cos_i;
+              term.dc_dn = wi;
+              contribute(wi, f, term, ctx.view.environment_light_index);
             }
           }
         }
@@ -251,22 +357,17 @@ Eigen::Vector3d TraceRadiance(const Context& ctx, Sampler* sampler, Eigen::Vecto
     if (!next.hit) {
       if (bsdf_lights_environment) {
         const double weight = PowerHeuristic(sample.pdf, ctx.environment->Pdf(wi));
-        contribute(
-            wi, f,
-            ctx.environment->Radiance(wi) * (ctx.view.environment_scale * weight * cos_over_pdf),
-            ctx.view.environment_light_index);
+        LightTerm term;
+        term.q = ctx.environment->Radiance(wi) * (ctx.view.environment_scale * weight / sample.pdf);
+        term.c = n.dot(wi);
+        term.dc_dn = wi;
+        contribute(wi, f, term, ctx.view.environment_light_index);
       }
       break;
     }
     if (!continue_path) break;
     const Eigen::Vector3d scatter = f * cos_over_pdf;
-    if (path) {
-      BsdfDerivatives d_s = EvalBsdfDerivatives(params, n, wo, wi, ctx.specular_scale);
-      d_s.d_albedo *= cos_over_pdf;
-      d_s.d_roughness *= cos_over_pdf;
-      d_s.d_specular *= cos_over_pdf;
-      path->AddScatter(throughput, surface, scatter, d_s);
-    }
+    if (path) path->AddScatter(throughput, surface, n, wo, wi, f, sample.pdf);
     throughput = throughput.cwiseProduct(scatter);
     dir = wi;
     hit = next;
@@ -381,6 +482,360 @@ bool RenderOptions::Check(std::string* why) const {
 
 namespace {
 
+// ---------------------------------------------------------------------------------------------
+// Visibility derivatives by edge sampling (Li et al. 2018, "Differentiable Monte Carlo ray
+// tracing through edge sampling", §3–4). The pixel integral I = ∫_pixel L(q) dq has, besides the
+// interior term, a boundary term wherever L jumps along a curve in the image that moves with the
+// vertices:  ∂I/∂θ += ∫_curve (L(q⁻) − L(q⁺)) · (m·∂q/∂θ) dl,  m the curve's unit normal, q± the
+// sides q ± εm. The curves handled here:
+//   primary edges: the projection of every mesh edge where the image is discontinuous —
+//     silhouettes (adjacent faces facing opposite ways from the camera), boundary and
+//     non-manifold edges, and creases (flat shading: any edge whose faces are not coplanar);
+//   shadow edges: the shadow that a silhouette edge as seen from a point light casts on the
+//     first surface behind it, as seen by the camera (the receiver's motion included).
+// Sampling: a curve is chosen with probability ∝ its length (projected length for primary
+// edges, angle subtended at the light for shadow edges), a point uniformly in its parameter s;
+// the estimator is ΔL·(m·∂q/∂θ)·|dq/ds|/pdf, credited to the pixel holding q. Both sides are
+// traced with the same random numbers, so away from a real jump ΔL is (nearly) zero.
+// Not handled (documented in derivatives.h): jumps seen through a bounce (shadows or silhouettes
+// in reflections), occlusion of the environment light and of indirect light (Li et al.'s
+// secondary edges for hemispherical integrals), texel boundaries of the albedo/roughness.
+
+// Sides of an edge point are traced this far from it (pixels).
+constexpr double kEdgeSideOffset = 1e-3;
+// Edge samples are drawn and reduced in chunks of this many (deterministic for any threads).
+constexpr int kEdgeChunk = 1024;
+// Sample streams of edge samples are told apart from pixel samples by this key.
+constexpr uint64_t kPrimaryEdgeKey = 0xE1D6E00000000000ull;
+constexpr uint64_t kShadowEdgeKey = 0xE1D6500000000000ull;
+
+// One boundary-term contribution: pixel, parameter, ∂RGB (already divided by the sample count).
+struct EdgeEntry {
+  int pixel;
+  int param;
+  Eigen::Vector3d d;
+};
+
+// A curve to sample: mesh edge `edge` over the parameter range [s0, s1], with sampling weight.
+struct EdgeCandidate {
+  int edge;
+  double s0, s1;
+  double weight;
+};
+
+// Picks a candidate ∝ weight from the cumulative weights.
+int PickCandidate(const std::vector<double>& cumulative, double u) {
+  const double target = u * cumulative.back();
+  const auto it = std::upper_bound(cumulative.begin(), cumulative.end(), target);
+  return std::min<int>(static_cast<int>(it - cumulative.begin()),
+                       static_cast<int>(cumulative.size()) - 1);
+}
+
+// Normalized image-plane bounds (x/z, y/z) of the view, with a margin, for clipping edges.
+struct FrustumBounds {
+  double u_min, u_max, v_min, v_max;
+  double z_min;
+};
+
+FrustumBounds ViewFrustum(const Context& ctx) {
+  const Camera& camera = ctx.view.camera;
+  FrustumBounds b{kInfinity, -kInfinity, kInfinity, -kInfinity, 0.0};
+  constexpr int kSteps = 16;
+  for (int i = 0; i <= kSteps; ++i) {
+    const double t = static_cast<double>(i) / kSteps;
+    for (const Eigen::Vector2d& pixel :
+         {Eigen::Vector2d(t * camera.width, 0.0), Eigen::Vector2d(t * camera.width, camera.height),
+          Eigen::Vector2d(0.0, t * camera.height),
+          Eigen::Vector2d(camera.width, t * camera.height)}) {
+      const Eigen::Vector3d ray = camera.CamFromImage(pixel);
+      b.u_min = std::min(b.u_min, ray.x());
+      b.u_max = std::max(b.u_max, ray.x());
+      b.v_min = std::min(b.v_min, ray.y());
+      b.v_max = std::max(b.v_max, ray.y());
+    }
+  }
+  const double mu = 0.05 * (b.u_max - b.u_min), mv = 0.05 * (b.v_max - b.v_min);
+  b.u_min -= mu;
+  b.u_max += mu;
+  b.v_min -= mv;
+  b.v_max += mv;
+  b.z_min = 1e-7 * ctx.scene.extent();
+  return b;
+}
+
+// Clips the camera-frame segment a + s(b − a), s ∈ [0, 1], to the frustum; false when empty.
+bool ClipSegment(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const FrustumBounds& f,
+                 double* s0, double* s1) {
+  *s0 = 0.0;
+  *s1 = 1.0;
+  // Half-spaces h(p) ≥ 0, each linear in p.
+  auto clip = [&](double ha, double hb) {
+    if (ha >= 0.0 && hb >= 0.0) return true;
+    if (ha < 0.0 && hb < 0.0) return false;
+    const double s = ha / (ha - hb);
+    if (ha < 0.0)
+      *s0 = std::max(*s0, s);
+    else
+      *s1 = std::min(*s1, s);
+    return *s0 < *s1;
+  };
+  return clip(a.z() - f.z_min, b.z() - f.z_min) &&
+         clip(a.x() - f.u_min * a.z(), b.x() - f.u_min * b.z()) &&
+         clip(f.u_max * a.z() - a.x(), f.u_max * b.z() - b.x()) &&
+         clip(a.y() - f.v_min * a.z(), b.y() - f.v_min * b.z()) &&
+         clip(f.v_max * a.z() - a.y(), f.v_max * b.z() - b.y()) && *s1 - *s0 > 0.0;
+}
+
+// Whether flat-shaded radiance can jump across the edge as seen from `eye`: boundary,
+// non-manifold or degenerate-neighbour edges always; else silhouettes w.r.t. eye and (when
+// `creases`) edges between faces that are not coplanar.
+bool IsDiscontinuityEdge(const RenderScene& scene, const MeshEdge& edge, const Eigen::Vector3d& eye,
+                         bool creases) {
+  if (edge.num_faces != 2) return true;
+  const Eigen::Vector3d n0 = scene.FaceNormal(edge.f0), n1 = scene.FaceNormal(edge.f1);
+  if (n0.isZero() || n1.isZero()) return true;
+  const Eigen::Vector3d to_eye = eye - scene.positions()[edge.v0];
+  if ((n0.dot(to_eye) > 0.0) != (n1.dot(to_eye) > 0.0)) return true;
+  return creases && std::abs(n0.dot(n1)) < 1.0 - 1e-12;
+}
+
+// L(q − εm) − L(q + εm) for camera paths through image points on either side of q, with the
+// same random numbers on both sides.
+Eigen::Vector3d RadianceJump(const Context& ctx, const Eigen::Matrix3d& world_from_cam_rotation,
+                             const Eigen::Vector3d& center, const Eigen::Vector2d& q,
+                             const Eigen::Vector2d& m, const Sampler& sampler, RenderStats* stats) {
+  Eigen::Vector3d jump = Eigen::Vector3d::Zero();
+  for (const double side : {-1.0, 1.0}) {
+    const Eigen::Vector3d dir =
+        (world_from_cam_rotation * ctx.view.camera.CamFromImage(q + side * kEdgeSideOffset * m))
+            .normalized();
+    const RayHit hit = ctx.scene.Intersect(center, dir, 0.0, kInfinity);
+    ++stats->camera_rays;
+    Sampler copy = sampler;
+    const Eigen::Vector3d radiance = TraceRadiance(ctx, &copy, dir, hit, stats, nullptr);
+    if (!radiance.allFinite()) return Eigen::Vector3d::Zero();
+    jump -= side * radiance;
+  }
+  return jump;
+}
+
+// Appends the entries jump·(row_j·∂q/∂vertex_j) for the moving vertices of one sample.
+void EmitBoundary(const Context& ctx, int pixel, const Eigen::Vector3d& jump, double scale,
+                  const int* vertices, const Eigen::Vector3d* rows, int count,
+                  std::vector<EdgeEntry>* out) {
+  (void)ctx;
+  for (int j = 0; j < count; ++j) {
+    for (int k = 0; k < 3; ++k) {
+      const double w = rows[j][k] * scale;
+      if (w == 0.0 || !std::isfinite(w)) continue;
+      out->push_back({pixel, 3 * vertices[j] + k, jump * w});
+    }
+  }
+}
+
+// Draws `num_samples` samples over the candidates in parallel chunks and returns the entries in
+// chunk order. `sample_one(candidate, s, sampler, out)` evaluates one sample at parameter s.
+template <typename SampleOne>
+void SampleCandidates(const RenderOptions& options, const std::vector<EdgeCandidate>& candidates,
+                      int64_t num_samples, uint64_t key, uint64_t view_index,
+                      const SampleOne& sample_one, std::vector<EdgeEntry>* entries) {
+  if (candidates.empty() || num_samples <= 0) return;
+  std::vector<double> cumulative(candidates.size());
+  double total = 0.0;
+  for (size_t i = 0; i < candidates.size(); ++i) cumulative[i] = total += candidates[i].weight;
+  if (!(total > 0.0) || !std::isfinite(total)) return;
+  const int64_t num_chunks = (num_samples + kEdgeChunk - 1) / kEdgeChunk;
+  std::vector<std::vector<EdgeEntry>> chunks(num_chunks);
+  tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
+  arena.execute([&] {
+    tbb::parallel_for(int64_t{0}, num_chunks, [&](int64_t chunk) {
+      _MM_SET_FLUSH_ZERO_MODE(_MM_FLUSH_ZERO_ON);
+      _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
+      const int64_t end = std::min(num_samples, (chunk + 1) * kEdgeChunk);
+      for (int64_t i = chunk * kEdgeChunk; i < end; ++i) {
+        Sampler sampler(options.seed, view_index, key + static_cast<uint64_t>(i), 0);
+        // Stratified over the concatenated curves: sample i lies in the i-th of N equal slices
+        // of the total weight, so the points are spread evenly along all edges (the per-edge
+        // integrals, which often cancel between opposite edges, then converge like a
+        // quadrature rather than like independent Monte Carlo).
+        const double u = (static_cast<double>(i) + sampler.Next1D()) / num_samples;
+        const int c = PickCandidate(cumulative, u);
+        const EdgeCandidate& candidate = candidates[c];
+        const double before = c > 0 ? cumulative[c - 1] : 0.0;
+        const double local = std::clamp((u * total - before) / candidate.weight, 0.0, 1.0);
+        const double s = candidate.s0 + local * (candidate.s1 - candidate.s0);
+        // 1/pdf of (candidate, s) over the number of samples.
+        const double inv_pdf = total / candidate.weight * (candidate.s1 - candidate.s0) /
+                               static_cast<double>(num_samples);
+        sample_one(candidate, s, inv_pdf, sampler, &chunks[chunk]);
+      }
+    });
+  });
+  for (const auto& chunk : chunks) entries->insert(entries->end(), chunk.begin(), chunk.end());
+}
+
+// Boundary terms of one view (primary and point-light shadow edges), pixel-major lists of
+// entries scaled for MergeDerivatives' 1/spp.
+void AddEdgeTerms(const Context& ctx, std::vector<DerivativeList>* pixel_lists,
+                  RenderStats* stats) {
+  const RenderScene& scene = ctx.scene;
+  const ViewSetup& view = ctx.view;
+  const Camera& camera = view.camera;
+  const RenderOptions& options = ctx.options;
+  const DerivativeRequest& request = *ctx.request;
+  const Rigid3d world_from_cam = view.cam_from_world.Inverse();
+  const Eigen::Vector3d center = world_from_cam.translation;
+  const Eigen::Matrix3d world_from_cam_rotation = world_from_cam.rotation.toRotationMatrix();
+  const Eigen::Matrix3d cam_from_world_rotation = world_from_cam_rotation.transpose();
+  const auto& positions = scene.positions();
+  const auto& edges = scene.edges();
+  const double pixels = static_cast<double>(camera.width) * camera.height;
+  std::vector<EdgeEntry> entries;
+  tbb::enumerable_thread_specific<RenderStats> thread_stats;
+
+  // Image point and m·∂q/∂y of a world point y (false when behind the camera or off the image).
+  auto project = [&](const Eigen::Vector3d& y, Eigen::Vector2d* q,
+                     Eigen::Matrix<double, 2, 3>* d_q_d_y, int* pixel) {
+    const Eigen::Vector3d p_in_cam = view.cam_from_world * y;
+    if (!(p_in_cam.z() > 0.0)) return false;
+    *q = camera.ImageFromCam(p_in_cam);
+    if (!(q->x() >= 0.0 && q->y() >= 0.0 && q->x() < camera.width && q->y() < camera.height)) {
+      return false;
+    }
+    *d_q_d_y = camera.ImageFromCamJacobian(p_in_cam) * cam_from_world_rotation;
+    *pixel = static_cast<int>(q->y()) * camera.width + static_cast<int>(q->x());
+    return true;
+  };
+
+  // Primary edges.
+  const double primary_ratio = request.primary_edge_ratio;
+  const double shadow_ratio = request.shadow_edge_ratio;
+  if (primary_ratio > 0.0) {
+    const FrustumBounds frustum = ViewFrustum(ctx);
+    std::vector<EdgeCandidate> candidates;
+    for (size_t e = 0; e < edges.size(); ++e) {
+      const MeshEdge& edge = edges[e];
+      const Eigen::Vector3d& a = positions[edge.v0];
+      const Eigen::Vector3d& b = positions[edge.v1];
+      if (a == b || !IsDiscontinuityEdge(scene, edge, center, /*creases=*/true)) continue;
+      const Eigen::Vector3d a_cam = view.cam_from_world * a, b_cam = view.cam_from_world * b;
+      double s0, s1;
+      if (!ClipSegment(a_cam, b_cam, frustum, &s0, &s1)) continue;
+      const Eigen::Vector2d q0 = camera.ImageFromCam(a_cam + s0 * (b_cam - a_cam));
+      const Eigen::Vector2d q1 = camera.ImageFromCam(a_cam + s1 * (b_cam - a_cam));
+      const double length = (q1 - q0).norm();
+      if (!std::isfinite(length)) continue;
+      candidates.push_back({static_cast<int>(e), s0, s1, length + 1e-3});
+    }
+    const auto sample_primary = [&](const EdgeCandidate& candidate, double s, double inv_pdf,
+                                    const Sampler& sampler, std::vector<EdgeEntry>* out) {
+      RenderStats& local = thread_stats.local();
+      const MeshEdge& edge = edges[candidate.edge];
+      const Eigen::Vector3d& a = positions[edge.v0];
+      const Eigen::Vector3d& b = positions[edge.v1];
+      const Eigen::Vector3d y = a + s * (b - a);
+      Eigen::Vector2d q;
+      Eigen::Matrix<double, 2, 3> d_q;
+      int pixel;
+      if (!project(y, &q, &d_q, &pixel)) return;
+      const Eigen::Vector2d tangent = d_q * (b - a);  // dq/ds
+      const double speed = tangent.norm();
+      if (!(speed > 0.0) || !std::isfinite(speed)) return;
+      const Eigen::Vector2d m(-tangent.y() / speed, tangent.x() / speed);
+      const Eigen::Vector3d jump =
+          RadianceJump(ctx, world_from_cam_rotation, center, q, m, sampler, &local);
+      if (jump.isZero()) return;
+      const Eigen::Vector3d m_row = d_q.transpose() * m;  // m·∂q/∂y
+      const int vertices[2] = {edge.v0, edge.v1};
+      const Eigen::Vector3d rows[2] = {(1.0 - s) * m_row, s * m_row};
+      EmitBoundary(ctx, pixel, jump, speed * inv_pdf * options.spp, vertices, rows, 2, out);
+    };
+    const int64_t num_samples =
+        static_cast<int64_t>(std::ceil(primary_ratio * options.spp * pixels));
+    SampleCandidates(options, candidates, num_samples, kPrimaryEdgeKey, view.view_index,
+                     sample_primary, &entries);
+  }
+
+  // Shadow edges of point lights, on surfaces the camera sees directly.
+  if (shadow_ratio > 0.0 && options.effects.shadows && options.effects.direct) {
+    for (size_t l = 0; l < view.point_lights.size(); ++l) {
+      const Eigen::Vector3d light = view.point_lights[l].position;
+      std::vector<EdgeCandidate> candidates;
+      for (size_t e = 0; e < edges.size(); ++e) {
+        const MeshEdge& edge = edges[e];
+        const Eigen::Vector3d a = positions[edge.v0] - light, b = positions[edge.v1] - light;
+        if (a == b || !IsDiscontinuityEdge(scene, edge, light, /*creases=*/false)) continue;
+        const double angle = std::atan2(a.cross(b).norm(), a.dot(b));
+        if (!(angle > 0.0) || !std::isfinite(angle)) continue;
+        candidates.push_back({static_cast<int>(e), 0.0, 1.0, angle});
+      }
+      const auto sample_shadow = [&](const EdgeCandidate& candidate, double s, double inv_pdf,
+                                     const Sampler& sampler, std::vector<EdgeEntry>* out) {
+        RenderStats& local = thread_stats.local();
+        const MeshEdge& edge = edges[candidate.edge];
+        const Eigen::Vector3d& a = positions[edge.v0];
+        const Eigen::Vector3d& b = positions[edge.v1];
+        const Eigen::Vector3d point = a + s * (b - a);
+        const Eigen::Vector3d d = point - light;
+        const double dist = d.norm();
+        if (!(dist > kMinRelativeLightDistance * scene.extent())) return;
+        const Eigen::Vector3d dir = d / dist;
+        const double offset = SurfaceRayOffset(scene, point);
+        // The light must reach the edge, and the ray grazing it must land on a receiver.
+        ++local.shadow_rays;
+        if (scene.Occluded(light, dir, 0.0, dist - offset)) return;
+        ++local.shadow_rays;
+        const RayHit hit = scene.Intersect(point, dir, offset, kInfinity);
+        if (!hit.hit || hit.face == edge.f0 || hit.face == edge.f1) return;
+        const Eigen::Vector3d n_r = scene.FaceNormal(hit.face);
+        const double cosine = n_r.dot(dir);
+        if (!(std::abs(cosine) > kMinHitCosine)) return;
+        const Eigen::Vector3d y = scene.Point(hit.face, hit.u, hit.v);
+        Eigen::Vector2d q;
+        Eigen::Matrix<double, 2, 3> d_q;
+        int pixel;
+        if (!project(y, &q, &d_q, &pixel)) return;
+
+        // y = light + τ·d on the receiver's plane, τ = (dist + t)/dist:
+        //   ∂y/∂point = τ(I − d n_rᵀ/(n_r·d)),  ∂y/∂p_j = b_j·d n_rᵀ/(n_r·d) (receiver corners).
+        const double tau = (dist + hit.t) / dist;
+        const Eigen::Matrix3d along = dir * n_r.transpose() / cosine;
+        const Eigen::Matrix3d d_y_d_point = tau * (Eigen::Matrix3d::Identity() - along);
+        const Eigen::Vector2d tangent = d_q * d_y_d_point * (b - a);
+        const double speed = tangent.norm();
+        if (!(speed > 0.0) || !std::isfinite(speed)) return;
+        const Eigen::Vector2d m(-tangent.y() / speed, tangent.x() / speed);
+        const Eigen::Vector3d jump =
+            RadianceJump(ctx, world_from_cam_rotation, center, q, m, sampler, &local);
+        if (jump.isZero()) return;
+        const Eigen::Vector3d m_row = d_q.transpose() * m;  // m·∂q/∂y
+        const Eigen::Vector3d point_row = d_y_d_point.transpose() * m_row;
+        const Eigen::Vector3d receiver_row = along.transpose() * m_row;
+        const Eigen::Vector3i& corners = scene.faces()[hit.face];
+        const double barycentrics[3] = {1.0 - hit.u - hit.v, hit.u, hit.v};
+        const int vertices[5] = {edge.v0, edge.v1, corners[0], corners[1], corners[2]};
+        const Eigen::Vector3d rows[5] = {
+            (1.0 - s) * point_row, s * point_row, barycentrics[0] * receiver_row,
+            barycentrics[1] * receiver_row, barycentrics[2] * receiver_row};
+        EmitBoundary(ctx, pixel, jump, speed * inv_pdf * options.spp, vertices, rows, 5, out);
+      };
+      const int64_t num_samples =
+          static_cast<int64_t>(std::ceil(shadow_ratio * options.spp * pixels));
+      SampleCandidates(options, candidates, num_samples, kShadowEdgeKey + (l << 40),
+                       view.view_index, sample_shadow, &entries);
+    }
+  }
+
+  for (const EdgeEntry& entry : entries) {
+    (*pixel_lists)[entry.pixel].emplace_back(entry.param, entry.d);
+  }
+  for (const RenderStats& s : thread_stats) {
+    stats->camera_rays += s.camera_rays;
+    stats->shadow_rays += s.shadow_rays;
+    stats->bounce_rays += s.bounce_rays;
+  }
+}
+
 // Sorts a pixel's derivative list by parameter and merges duplicates, scaling by `scale`.
 void MergeDerivatives(DerivativeList* list, double scale, std::vector<JacobianEntry>* merged) {
   merged->clear();
@@ -435,6 +890,13 @@ void RenderImpl(const RenderScene& scene, const Material& material, const ViewSe
   std::vector<std::vector<std::pair<int, double>>> tile_gradients(weights != nullptr ? num_tiles
                                                                                      : 0);
   tbb::enumerable_thread_specific<RenderStats> thread_stats;
+  // Boundary (edge) terms of vertex derivatives land at random pixels: gathered first, per pixel.
+  std::vector<DerivativeList> edge_lists;
+  RenderStats edge_stats;
+  if (want_derivatives && request->params.vertices && options.pass == RenderPass::kColor) {
+    edge_lists.resize(static_cast<size_t>(width) * height);
+    AddEdgeTerms(ctx, &edge_lists, &edge_stats);
+  }
   auto render_tile = [&](int tile) {
     // Embree wants flush-to-zero / denormals-are-zero in every tracing thread.
     _MM_SET_FLUSH_ZERO_MODE(_MM_FLUSH_ZERO_ON);
@@ -477,6 +939,10 @@ void RenderImpl(const RenderScene& scene, const Material& material, const ViewSe
         for (int c = 0; c < 3; ++c) image->at(x, y, c) = static_cast<float>(sums[i][c] * inv_spp);
         image->at(x, y, 3) = static_cast<float>(hits[i] * inv_spp);
         if (!want_derivatives) continue;
+        if (!edge_lists.empty()) {
+          const DerivativeList& edge = edge_lists[static_cast<size_t>(y) * width + x];
+          lists[i].insert(lists[i].end(), edge.begin(), edge.end());
+        }
         MergeDerivatives(&lists[i], inv_spp, &merged);
         if (weights != nullptr) {
           const Eigen::Vector3d w(weights->at(x, y, 0), weights->at(x, y, 1), weights->at(x, y, 2));
@@ -517,7 +983,7 @@ void RenderImpl(const RenderScene& scene, const Material& material, const ViewSe
     }
   }
   if (stats != nullptr) {
-    *stats = RenderStats();
+    *stats = edge_stats;
     for (const RenderStats& s : thread_stats) {
       stats->camera_rays += s.camera_rays;
       stats->shadow_rays += s.shadow_rays;

@@ -2,6 +2,8 @@
 
 #include <glog/logging.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <mutex>
@@ -60,11 +62,41 @@ void RenderScene::Build() {
       index_buffer[3 * f + k] = static_cast<unsigned>(faces_[f][k]);
     }
   }
+  BuildEdges();
   UpdateDerived();
   rtcCommitGeometry(geometry_);
   rtcAttachGeometry(scene_, geometry_);
   rtcReleaseGeometry(geometry_);  // the scene holds the reference.
   rtcCommitScene(scene_);
+}
+
+void RenderScene::BuildEdges() {
+  // (v0, v1, face) triples sorted by edge, then grouped.
+  std::vector<std::array<int, 3>> half_edges;
+  half_edges.reserve(3 * faces_.size());
+  for (size_t f = 0; f < faces_.size(); ++f) {
+    for (int k = 0; k < 3; ++k) {
+      const int a = faces_[f][k], b = faces_[f][(k + 1) % 3];
+      if (a == b) continue;
+      half_edges.push_back({std::min(a, b), std::max(a, b), static_cast<int>(f)});
+    }
+  }
+  std::sort(half_edges.begin(), half_edges.end());
+  edges_.clear();
+  for (size_t i = 0; i < half_edges.size();) {
+    MeshEdge edge;
+    edge.v0 = half_edges[i][0];
+    edge.v1 = half_edges[i][1];
+    for (; i < half_edges.size() && half_edges[i][0] == edge.v0 && half_edges[i][1] == edge.v1;
+         ++i) {
+      const int face = half_edges[i][2];
+      if (edge.num_faces > 0 && face == edge.f0) continue;  // a face listing the edge twice.
+      if (edge.num_faces == 0) edge.f0 = face;
+      if (edge.num_faces == 1) edge.f1 = face;
+      ++edge.num_faces;
+    }
+    edges_.push_back(edge);
+  }
 }
 
 void RenderScene::UpdateDerived() {

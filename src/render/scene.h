@@ -24,6 +24,13 @@ struct RayHit {
   double u = 0.0, v = 0.0;  // barycentrics: p = (1 − u − v)·p0 + u·p1 + v·p2 (Embree's).
 };
 
+// An edge of the mesh and the faces containing it (for edge sampling of visibility derivatives).
+struct MeshEdge {
+  int v0 = 0, v1 = 0;    // vertex indices, v0 < v1.
+  int f0 = -1, f1 = -1;  // the first two faces containing the edge; -1 = none.
+  int num_faces = 0;     // 1 = boundary edge, 2 = manifold, > 2 = non-manifold.
+};
+
 // One process-wide Embree device (its thread settings are process-wide anyway).
 RTCDevice EmbreeDevice();
 
@@ -56,17 +63,22 @@ class RenderScene {
 
   const std::vector<Eigen::Vector3d>& positions() const { return positions_; }
   const std::vector<Eigen::Vector3i>& faces() const { return faces_; }
+  // Unique edges (topology only, fixed by construction); edges of faces with repeated vertex
+  // indices are left out (they have no length).
+  const std::vector<MeshEdge>& edges() const { return edges_; }
   // Length of the bounding box diagonal, for scale-relative ray offsets.
   double extent() const { return extent_; }
   RTCScene embree_scene() const { return scene_; }
 
  private:
   void Build();
+  void BuildEdges();
   void UpdateDerived();
 
   std::vector<Eigen::Vector3d> positions_;
   std::vector<Eigen::Vector3i> faces_;
   std::vector<Eigen::Vector3d> face_normals_;
+  std::vector<MeshEdge> edges_;
   double extent_ = 1.0;
   RTCScene scene_ = nullptr;
   RTCGeometry geometry_ = nullptr;
