@@ -53,9 +53,10 @@ inline uint32_t OwenScramble(uint32_t v, uint32_t seed) {
 // The random numbers of one Monte Carlo sample: sample `sample` of pixel `pixel` of view `view`.
 // Next2D() draws stratified pairs: each pair of dimensions uses its own Owen-scrambled Sobol
 // (0, 2)-sequence over the pixel's sample index, with the index shuffled per pair ("padded"
-// sampling), so the samples of one pixel are stratified in every 2D projection the renderer uses
-// (sub-pixel position, light sample, BSDF direction). Next1D() draws an independent hashed value.
-// Both are pure functions of (seed, view, pixel, sample, dimension counter).
+// sampling, a nested-uniform-scrambled index), so the samples of one pixel are stratified in every
+// 2D projection the renderer uses (sub-pixel position, light sample, BSDF direction). Next1D()
+// draws an independent hashed value. Both are pure functions of (seed, view, pixel, sample,
+// dimension counter).
 class Sampler {
  public:
   Sampler() = default;
@@ -70,8 +71,14 @@ class Sampler {
 
   void Next2D(double* u1, double* u2) {
     const uint64_t hash = Mix64(pixel_key_ + 0xD1B54A32D192ED03ull * (++pair_));
-    // Shuffle the index within its power-of-two block by XOR (a permutation of the block).
-    const uint32_t index = static_cast<uint32_t>(sample_) ^ static_cast<uint32_t>(hash & 0xFFFFu);
+    // Shuffle the index per pair by a nested uniform scramble of its bits (Burley 2020, §4): a
+    // random permutation within every aligned power-of-two block, so the first 2^m samples of a
+    // pixel still form a (0, m, 2)-net in every pair. Not an XOR shift: the Sobol points are
+    // linear in the index over GF(2), so index ^ k would make every pair an XOR-shifted copy of
+    // every other and tie, e.g., the light sample to the sub-pixel position (which biases each
+    // pixel along edges by a fixed, seed-dependent amount that more samples do not remove).
+    const uint32_t index =
+        OwenScramble(static_cast<uint32_t>(sample_), static_cast<uint32_t>(Mix64(hash)));
     uint32_t x, y;
     Sobol2D(index, &x, &y);
     x = OwenScramble(x, static_cast<uint32_t>(hash >> 16));

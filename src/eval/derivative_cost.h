@@ -2,9 +2,10 @@
 // same scene, the wall-clock time over all views of
 //   (1) the forward render alone (RenderView),
 //   (2) forward + sparse Jacobian rows (RenderViewWithDerivatives, jacobian_rows) for every
-//       implemented parameter kind — albedo, roughness, specular, light scales; vertex
-//       derivatives are not implemented yet and are not part of the measurement,
-//   (3) forward + adjoint gradient (adjoint_weights only; the weights are a fixed random image),
+//       parameter kind — vertex coordinates (interior terms and edge sampling at the default
+//       DerivativeRequest edge ratios), albedo, roughness, specular, light scales,
+//   (3) forward + adjoint gradient of the same kinds (adjoint_weights only; the weights are a
+//       fixed random image),
 // each at the same spp, bounces, seed and thread count, with the ratio of (2) and (3) to (1)
 // (the aim: ≤ 3), the number of Jacobian entries and the memory of the rows.
 //
@@ -62,11 +63,12 @@ struct DerivativeCostReport {
   bool keep_rows = false;
   bool peak_rss_reset = false;  // the kernel let us reset the peak before each pass.
   int num_parameters = 0;       // the full index space (ParameterLayout::size()).
-  int num_differentiated = 0;   // of those, the implemented kinds (all but vertex coordinates).
+  int num_differentiated = 0;   // of those, the differentiated ones (all kinds: = num_parameters).
   int64_t covered_pixels = 0;   // pixels with coverage > 0, summed over the views.
 
   DerivativePassCost forward;        // RenderView.
-  DerivativePassCost jacobian_rows;  // + Jacobian rows (albedo, roughness, specular, lights).
+  DerivativePassCost jacobian_rows;  // + Jacobian rows (vertices, albedo, roughness, specular,
+                                     // lights).
   DerivativePassCost adjoint;        // + adjoint gradient.
 
   int64_t jacobian_entries = 0;      // Σ over views of rows.entries.size().

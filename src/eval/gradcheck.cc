@@ -1,6 +1,8 @@
 #include "src/eval/gradcheck.h"
 
+#include <algorithm>
 #include <cmath>
+#include <memory>
 #include <random>
 
 #include "src/io/scene_setup.h"
@@ -37,12 +39,99 @@ ViewSetup PerturbView(const ViewSetup& base, const ParameterLayout& layout,
   return view;
 }
 
+// The mesh at p + t·δ (vertex kind).
+std::unique_ptr<RenderScene> DisplacedScene(const RenderScene& base,
+                                            const std::vector<double>& delta, double t) {
+  std::vector<Eigen::Vector3d> positions = base.positions();
+  for (size_t v = 0; v < positions.size(); ++v) {
+    for (int k = 0; k < 3; ++k) positions[v][k] += t * delta[3 * v + k];
+  }
+  return std::make_unique<RenderScene>(positions, base.faces());
+}
+
+// Sums a width × height × 3 image (pixel-major, RGB) over block × block tiles (partial tiles at
+// the right and bottom borders).
+std::vector<double> BlockSums(const std::vector<double>& image, int width, int height, int block) {
+  const int bw = (width + block - 1) / block, bh = (height + block - 1) / block;
+  std::vector<double> sums(3 * static_cast<size_t>(bw) * bh, 0.0);
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      const size_t b = static_cast<size_t>(y / block) * bw + x / block;
+      for (int c = 0; c < 3; ++c) {
+        sums[3 * b + c] += image[3 * (static_cast<size_t>(y) * width + x) + c];
+      }
+    }
+  }
+  return sums;
+}
+
+// ‖error‖/‖reference‖ from squared norms; 1 when the reference vanishes but the error does not.
+double RelativeError(double err2, double ref2) {
+  return ref2 > 0 ? std::sqrt(err2 / ref2) : (err2 > 0 ? 1.0 : 0.0);
+}
+
+// The automatic vertex step, relative to the bounding-box diagonal (see GradcheckOptions::step).
+constexpr double kAutomaticVertexStep = 5e-3;
+
+// The smooth projection weights of the report: 1, cos(π(x + ½)/W), cos(π(y + ½)/H).
+constexpr int kNumProjections = 3;
+constexpr const char* kProjectionNames[kNumProjections] = {"one", "cos_x", "cos_y"};
+double ProjectionWeight(int k, int x, int y, int width, int height) {
+  if (k == 1) return std::cos(M_PI * (x + 0.5) / width);
+  if (k == 2) return std::cos(M_PI * (y + 0.5) / height);
+  return 1.0;
+}
+
 }  // namespace
+
+std::vector<double> SmoothDisplacementField(const std::vector<Eigen::Vector3d>& positions,
+                                            uint64_t seed) {
+  std::vector<double> delta(3 * positions.size(), 0.0);
+  if (positions.empty()) return delta;
+  Eigen::Vector3d lo = positions[0], hi = positions[0];
+  for (const Eigen::Vector3d& p : positions) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  const Eigen::Vector3d centre = 0.5 * (lo + hi);
+  const double extent = (hi - lo).norm();
+  if (!(extent > 0.0) || !std::isfinite(extent)) return delta;
+
+  constexpr int kModes = 3;
+  constexpr double kMaxWaveNumber = 1.5;
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  Eigen::Vector3d amplitude[kModes], wave[kModes];
+  double phase[kModes];
+  for (int m = 0; m < kModes; ++m) {
+    for (int k = 0; k < 3; ++k) amplitude[m][k] = uniform(rng);
+    for (int k = 0; k < 3; ++k) wave[m][k] = uniform(rng) * kMaxWaveNumber;
+    if (wave[m].norm() > kMaxWaveNumber) wave[m] *= kMaxWaveNumber / wave[m].norm();
+    phase[m] = M_PI * uniform(rng);
+  }
+  double max_norm = 0.0;
+  for (size_t v = 0; v < positions.size(); ++v) {
+    const Eigen::Vector3d q = (positions[v] - centre) / extent;
+    Eigen::Vector3d d = Eigen::Vector3d::Zero();
+    for (int m = 0; m < kModes; ++m)
+      d += amplitude[m] * std::sin(2.0 * M_PI * wave[m].dot(q) + phase[m]);
+    for (int k = 0; k < 3; ++k) delta[3 * v + k] = d[k];
+    max_norm = std::max(max_norm, d.norm());
+  }
+  if (max_norm > 0.0) {
+    for (double& d : delta) d /= max_norm;
+  }
+  return delta;
+}
 
 bool GradcheckOptions::Check(std::string* why) const {
   if (!render.Check(why)) return false;
   if (!(step >= 0.0) || !std::isfinite(step)) {
     *why = "step: must be >= 0 (0 = automatic)";
+    return false;
+  }
+  if (block < 0 || block > 4096) {
+    *why = "block: must be in [0, 4096] (0 = automatic)";
     return false;
   }
   if (!(tolerance > 0.0)) {
@@ -71,29 +160,49 @@ Status RunGradcheck(const Dataset& dataset, const TriMesh& mesh, const Material&
   const RenderScene scene(mesh);
   const ParameterLayout layout =
       MakeParameterLayout(scene, material, static_cast<int>(dataset.lights.size()));
+  const bool vertices = options.kind == ParameterKind::kVertex;
+  const int block = options.block > 0 ? options.block : (vertices ? 8 : 1);
 
   std::mt19937_64 rng(options.direction_seed);
   std::uniform_real_distribution<double> uniform(-1.0, 1.0);
   std::vector<double> delta(layout.size(), 0.0);
-  for (int i = 0; i < layout.size(); ++i) {
-    if (layout.KindOf(i) == options.kind) delta[i] = uniform(rng);
+  if (vertices) {
+    const std::vector<double> field =
+        SmoothDisplacementField(scene.positions(), options.direction_seed);
+    std::copy(field.begin(), field.end(), delta.begin() + layout.VertexOffset());
+  } else {
+    for (int i = 0; i < layout.size(); ++i) {
+      if (layout.KindOf(i) == options.kind) delta[i] = uniform(rng);
+    }
   }
   double step = options.step;
   if (step == 0.0) {
     double mean_roughness = 0.0;
     for (double r : material.roughness.values()) mean_roughness += r;
     mean_roughness /= std::max<size_t>(1, material.roughness.values().size());
-    step = options.kind == ParameterKind::kRoughness ? 1e-4 * std::max(mean_roughness, 0.01) : 1e-3;
+    step = options.kind == ParameterKind::kRoughness ? 1e-4 * std::max(mean_roughness, 0.01)
+           : vertices                                ? kAutomaticVertexStep * scene.extent()
+                                                     : 1e-3;
   }
 
   RenderOptions render = options.render;
   render.sampling_material = &material;
   const Material plus_material = PerturbMaterial(material, layout, delta, step);
   const Material minus_material = PerturbMaterial(material, layout, delta, -step);
+  // Vertex kind: the displaced meshes; other kinds render the unchanged scene.
+  std::unique_ptr<RenderScene> plus_scene, minus_scene;
+  if (vertices) {
+    plus_scene = DisplacedScene(scene, delta, step);
+    minus_scene = DisplacedScene(scene, delta, -step);
+  }
 
   result->kind = ParameterKindName(options.kind);
+  result->block = block;
+  result->step = step;
   result->views.clear();
-  double total_err2 = 0.0, total_ref2 = 0.0;
+  double total_err2 = 0.0, total_ref2 = 0.0;              // block sums.
+  double total_pixel_err2 = 0.0, total_pixel_ref2 = 0.0;  // pixels.
+  double total_proj_err2 = 0.0, total_proj_ref2 = 0.0;    // projections.
   for (int v : selected) {
     const ViewSetup& view = views.views[v];
     const int width = view.camera.width, height = view.camera.height;
@@ -104,43 +213,86 @@ Status RunGradcheck(const Dataset& dataset, const TriMesh& mesh, const Material&
     DerivativeOutput out;
     RenderViewWithDerivatives(scene, material, view, render, request,
                               static_cast<int>(dataset.lights.size()), &image, &out);
-    RenderView(scene, plus_material, PerturbView(view, layout, delta, step), render, &plus);
-    RenderView(scene, minus_material, PerturbView(view, layout, delta, -step), render, &minus);
+    RenderView(vertices ? *plus_scene : scene, plus_material,
+               PerturbView(view, layout, delta, step), render, &plus);
+    RenderView(vertices ? *minus_scene : scene, minus_material,
+               PerturbView(view, layout, delta, -step), render, &minus);
 
-    double err2 = 0.0, ref2 = 0.0, weighted = 0.0, weighted_abs = 0.0;
-    for (int p = 0; p < width * height; ++p) {
-      double analytic[3] = {0, 0, 0};
+    // The directional derivative images, RGB per pixel.
+    const size_t pixels = static_cast<size_t>(width) * height;
+    std::vector<double> analytic(3 * pixels, 0.0), fd(3 * pixels, 0.0);
+    double weighted = 0.0, weighted_abs = 0.0;
+    for (size_t p = 0; p < pixels; ++p) {
       for (uint64_t e = out.rows.offsets[p]; e < out.rows.offsets[p + 1]; ++e) {
         const JacobianEntry& entry = out.rows.entries[e];
-        for (int c = 0; c < 3; ++c) analytic[c] += entry.d[c] * delta[entry.param];
+        for (int c = 0; c < 3; ++c) analytic[3 * p + c] += entry.d[c] * delta[entry.param];
       }
       for (int c = 0; c < 3; ++c) {
-        const double fd =
+        fd[3 * p + c] =
             (static_cast<double>(plus.data[4 * p + c]) - minus.data[4 * p + c]) / (2.0 * step);
-        err2 += (analytic[c] - fd) * (analytic[c] - fd);
-        ref2 += fd * fd;
-        weighted += weights.data[3 * p + c] * analytic[c];
-        weighted_abs += std::abs(weights.data[3 * p + c] * analytic[c]);
+        weighted += weights.data[3 * p + c] * analytic[3 * p + c];
+        weighted_abs += std::abs(weights.data[3 * p + c] * analytic[3 * p + c]);
       }
+    }
+    double pixel_err2 = 0.0, pixel_ref2 = 0.0;
+    for (size_t i = 0; i < 3 * pixels; ++i) {
+      pixel_err2 += (analytic[i] - fd[i]) * (analytic[i] - fd[i]);
+      pixel_ref2 += fd[i] * fd[i];
+    }
+    double err2 = pixel_err2, ref2 = pixel_ref2;
+    if (block > 1) {
+      const std::vector<double> analytic_blocks = BlockSums(analytic, width, height, block);
+      const std::vector<double> fd_blocks = BlockSums(fd, width, height, block);
+      err2 = ref2 = 0.0;
+      for (size_t i = 0; i < fd_blocks.size(); ++i) {
+        err2 += (analytic_blocks[i] - fd_blocks[i]) * (analytic_blocks[i] - fd_blocks[i]);
+        ref2 += fd_blocks[i] * fd_blocks[i];
+      }
+    }
+    GradcheckViewResult view_result;
+    double proj_err2 = 0.0, proj_ref2 = 0.0;
+    for (int k = 0; k < kNumProjections; ++k) {
+      GradcheckProjection projection;
+      projection.weight = kProjectionNames[k];
+      for (int y = 0; y < height; ++y) {
+        for (int x = 0; x < width; ++x) {
+          const double w = ProjectionWeight(k, x, y, width, height);
+          const size_t p = static_cast<size_t>(y) * width + x;
+          for (int c = 0; c < 3; ++c) {
+            projection.analytic += w * analytic[3 * p + c];
+            projection.fd += w * fd[3 * p + c];
+          }
+        }
+      }
+      proj_err2 += (projection.analytic - projection.fd) * (projection.analytic - projection.fd);
+      proj_ref2 += projection.fd * projection.fd;
+      view_result.projections.push_back(projection);
     }
     double adjoint = 0.0;
     for (int i = 0; i < layout.size(); ++i) adjoint += out.gradient[i] * delta[i];
-    GradcheckViewResult view_result;
     view_result.view = v;
-    view_result.fd_norm = std::sqrt(ref2);
-    view_result.relative_error = ref2 > 0 ? std::sqrt(err2 / ref2) : (err2 > 0 ? 1.0 : 0.0);
+    view_result.fd_norm = std::sqrt(pixel_ref2);
+    view_result.relative_error = RelativeError(err2, ref2);
+    view_result.pixel_relative_error = RelativeError(pixel_err2, pixel_ref2);
+    view_result.projection_error = RelativeError(proj_err2, proj_ref2);
     view_result.adjoint_mismatch =
         weighted_abs > 0 ? std::abs(adjoint - weighted) / weighted_abs : 0.0;
     view_result.jacobian_entries = out.rows.entries.size();
     result->views.push_back(view_result);
     total_err2 += err2;
     total_ref2 += ref2;
+    total_pixel_err2 += pixel_err2;
+    total_pixel_ref2 += pixel_ref2;
+    total_proj_err2 += proj_err2;
+    total_proj_ref2 += proj_ref2;
   }
-  if (!(total_ref2 > 0.0)) {
+  if (!(total_pixel_ref2 > 0.0)) {
     return Status::Error(std::string("--param ") + result->kind +
                          ": the perturbation does not change any selected view (nothing to check)");
   }
-  result->relative_error = std::sqrt(total_err2 / total_ref2);
+  result->relative_error = RelativeError(total_err2, total_ref2);
+  result->pixel_relative_error = RelativeError(total_pixel_err2, total_pixel_ref2);
+  result->projection_error = RelativeError(total_proj_err2, total_proj_ref2);
   bool adjoint_ok = true;
   for (const GradcheckViewResult& r : result->views) adjoint_ok &= r.adjoint_mismatch <= 1e-4;
   result->passed = result->relative_error <= options.tolerance && adjoint_ok;

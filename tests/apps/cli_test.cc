@@ -42,7 +42,7 @@ TEST(CliTest, SynthThenRenderRoundTrip) {
   const std::string mesh = testing::DataDir() + "/meshes/icosphere_r1_320f.obj";
   std::string out;
   ASSERT_EQ(Sft("synth --quiet --mesh " + mesh + " --out " + tmp.Join("ds") +
-                    " --cameras 3 --zooms 1,2 --res 24 --spp 16 --bounces 2 "
+                    " --cameras 3 --zooms 1,2 --res 24 --spp 64 --bounces 2 "
                     "--material '{\"albedo\": [0.5, 0.4, 0.3], \"roughness\": 0.3, "
                     "\"specular\": 0.2}'",
                 &out),
@@ -59,7 +59,7 @@ TEST(CliTest, SynthThenRenderRoundTrip) {
 
   ASSERT_EQ(Sft("render --quiet --dataset " + tmp.Join("ds") + " --mesh " +
                     tmp.Join("ds/gt/mesh.ply") + " --material " + tmp.Join("ds/gt/material.json") +
-                    " --spp 16 --bounces 2 --seed 7 --out " + tmp.Join("r"),
+                    " --spp 64 --bounces 2 --seed 7 --out " + tmp.Join("r"),
                 &out),
             0)
       << out;
@@ -79,7 +79,8 @@ TEST(CliTest, SynthThenRenderRoundTrip) {
       }
     }
     ASSERT_GT(sum_t, 0.0);
-    // Independent seeds, 16 spp over ~300 object pixels: the image means agree within ~1%.
+    // Independent seeds, 64 spp over ~300 object pixels (glossy, two bounces): the image means
+    // agree within ~1%.
     EXPECT_NEAR(sum_o / sum_t, 1.0, 0.03) << "view " << v;
   }
   EXPECT_TRUE(std::filesystem::exists(tmp.Join("r/render.json")));

@@ -8,14 +8,16 @@
 // and the estimator is a smooth function of them: the only errors are the O(h²) truncation of the
 // central difference and float32 storage (images and Jacobian entries, ~6e-8 relative, divided by
 // 2h). Tolerance: 2e-3 relative L2 error over the image. Measured: ≲ 1.2e-4 for albedo,
-// specular and light scales (h = 1e-3); 4e-4–7e-4 for roughness, whose small steps (h = 1e-4·r,
+// specular and light scales (h = 1e-3); up to ~1e-3 for roughness, whose small steps (h = 1e-3·r,
 // needed at r = 0.05 where D changes on the scale of α = r²) make float32 rounding of the images
 // the dominant error.
 #include <glog/logging.h>
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <memory>
 #include <random>
+#include <string>
 
 #include "src/geometry/material.h"
 #include "src/geometry/mesh.h"
@@ -133,7 +135,7 @@ TEST_P(DerivativesTest, MatchesCentralDifferences) {
   }
   // Step sizes: albedo and light scales enter linearly (h only limits float rounding); roughness
   // and specular are smooth at the scale of α.
-  const double h = c.kind == ParameterKind::kRoughness ? 1e-4 * c.roughness : 1e-3;
+  const double h = c.kind == ParameterKind::kRoughness ? 1e-3 * c.roughness : 1e-3;
 
   auto perturbed_render = [&](double sign) {
     Material m = base;
@@ -233,12 +235,27 @@ TEST(BsdfDerivativeTest, GgxAlphaDerivatives) {
   }
 }
 
-TEST(DerivativeRequestTest, VertexDerivativesAreReportedMissing) {
+// Vertex derivatives are accepted; the edge-sampling ratios are checked and named when out of
+// range.
+TEST(DerivativeRequestTest, VertexDerivativesAndEdgeRatios) {
   DerivativeRequest request;
   request.params = ParameterSelection::Only(ParameterKind::kVertex);
+  request.jacobian_rows = true;
   std::string why;
-  EXPECT_FALSE(request.Check(&why));
-  EXPECT_NE(why.find("vertices"), std::string::npos);
+  EXPECT_TRUE(request.Check(&why)) << why;
+  request.primary_edge_ratio = 0.0;  // edge terms off: allowed.
+  request.shadow_edge_ratio = 16.0;  // the upper end: allowed.
+  EXPECT_TRUE(request.Check(&why)) << why;
+  for (double bad : {-0.5, 16.5, std::nan("")}) {
+    DerivativeRequest primary = request;
+    primary.primary_edge_ratio = bad;
+    EXPECT_FALSE(primary.Check(&why)) << bad;
+    EXPECT_NE(why.find("primary_edge_ratio"), std::string::npos) << why;
+    DerivativeRequest shadow = request;
+    shadow.shadow_edge_ratio = bad;
+    EXPECT_FALSE(shadow.Check(&why)) << bad;
+    EXPECT_NE(why.find("shadow_edge_ratio"), std::string::npos) << why;
+  }
 }
 
 }  // namespace

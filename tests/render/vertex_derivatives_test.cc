@@ -1,0 +1,641 @@
+// Vertex derivatives of rendered images (interior terms through hit points and normals, primary
+// edge sampling of silhouettes, shadow-edge sampling), against an analytic silhouette derivative
+// and against central finite differences of the displaced meshes.
+//
+// Finite differences of geometry: the renders at p ± h·δ use the same seeds (common random
+// numbers) and detached sampling, but a camera or shadow sample that crosses a moving edge
+// switches discontinuously, so the difference quotient of one pixel is quantised by the samples
+// that cross (noise ∝ 1/√(h·spp)) while edge sampling puts the analytic edge term at random
+// points along the edge. Both are unbiased for the derivative of the expected image and agree on
+// sums over pixel blocks: the comparisons below are on 8×8 block sums (and global sums), at the
+// 5% the issue asks for. Scenes are small (64² pixels) so each test stays under ~10 s on 2 cores
+// (Release).
+//
+// Faces are shaded with their geometric normal, so an edge between two non-coplanar faces is a
+// shading discontinuity even when both faces are seen; the displacement fields of the interior
+// tests keep initially coplanar faces coplanar to first order where that matters (a flat grid,
+// whose jumps across edges vanish at h = 0).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "src/eval/gradcheck.h"
+#include "src/geometry/material.h"
+#include "src/geometry/mesh.h"
+#include "src/render/camera_rig.h"
+#include "src/render/derivatives.h"
+#include "src/render/environment.h"
+#include "src/render/render.h"
+#include "src/render/scene.h"
+#include "tests/testing/temp_dir.h"
+
+namespace sft {
+namespace {
+
+struct Geometry {
+  std::vector<Eigen::Vector3d> positions;
+  std::vector<Eigen::Vector3i> faces;
+
+  // Appends `other` (its indices shifted); returns the index of its first vertex.
+  int Append(const Geometry& other) {
+    const int base = static_cast<int>(positions.size());
+    positions.insert(positions.end(), other.positions.begin(), other.positions.end());
+    for (const Eigen::Vector3i& f : other.faces)
+      faces.push_back(f + Eigen::Vector3i::Constant(base));
+    return base;
+  }
+};
+
+Geometry FromMesh(const std::string& file) {
+  TriMesh mesh;
+  EXPECT_TRUE(ReadMesh(testing::DataDir() + "/meshes/" + file, &mesh).ok()) << file;
+  Geometry g;
+  for (auto vh : mesh.vertices()) {
+    const auto& p = mesh.point(vh);
+    g.positions.emplace_back(p[0], p[1], p[2]);
+  }
+  for (auto fh : mesh.faces()) {
+    Eigen::Vector3i f;
+    int k = 0;
+    for (auto vh : mesh.fv_range(fh)) f[k++] = vh.idx();
+    g.faces.push_back(f);
+  }
+  return g;
+}
+
+// An n × n grid of squares (2 triangles each, counter-clockwise seen from +z) over
+// [−half, half]² in the plane z = 0.
+Geometry Grid(int n, double half) {
+  Geometry g;
+  for (int j = 0; j <= n; ++j) {
+    for (int i = 0; i <= n; ++i) {
+      g.positions.emplace_back(-half + 2.0 * half * i / n, -half + 2.0 * half * j / n, 0.0);
+    }
+  }
+  for (int j = 0; j < n; ++j) {
+    for (int i = 0; i < n; ++i) {
+      const int a = j * (n + 1) + i, b = a + 1, c = a + n + 1, d = c + 1;
+      g.faces.emplace_back(a, b, d);
+      g.faces.emplace_back(a, d, c);
+    }
+  }
+  return g;
+}
+
+// A pinhole camera at `eye` looking at `target` (world +z up).
+ViewSetup LookAtView(const Eigen::Vector3d& eye, const Eigen::Vector3d& target, int res,
+                     double focal) {
+  ViewSetup view;
+  view.camera.model = CameraModel::kPinhole;
+  view.camera.width = view.camera.height = res;
+  view.camera.params = {focal, focal, 0.5 * res, 0.5 * res};
+  view.cam_from_world = LookAt(eye, target, Eigen::Vector3d::UnitZ());
+  return view;
+}
+
+Material Lambert(const Geometry& g, double albedo) {
+  return ConstantMaterial(static_cast<int>(g.faces.size()), Eigen::Vector3d::Constant(albedo), 0.5,
+                          0.0);
+}
+
+// δ·(p) → the directional derivative image Σ_θ J_θ·δ_θ (RGB per pixel) from the rows.
+std::vector<double> RowsTimes(const DerivativeOutput& out, const std::vector<double>& delta) {
+  const size_t pixels = static_cast<size_t>(out.rows.width) * out.rows.height;
+  std::vector<double> image(3 * pixels, 0.0);
+  for (size_t p = 0; p < pixels; ++p) {
+    for (uint64_t e = out.rows.offsets[p]; e < out.rows.offsets[p + 1]; ++e) {
+      const JacobianEntry& entry = out.rows.entries[e];
+      EXPECT_EQ(out.layout.KindOf(entry.param), ParameterKind::kVertex);
+      for (int c = 0; c < 3; ++c) image[3 * p + c] += entry.d[c] * delta[entry.param];
+    }
+  }
+  return image;
+}
+
+// (I(p + hδ) − I(p − hδ))/(2h), RGB per pixel, same seeds, detached sampling.
+std::vector<double> CentralDifference(const Geometry& g, const std::vector<double>& delta, double h,
+                                      const Material& material, const ViewSetup& view,
+                                      const RenderOptions& options) {
+  Image image[2];
+  for (int s = 0; s < 2; ++s) {
+    std::vector<Eigen::Vector3d> positions = g.positions;
+    const double t = s == 0 ? h : -h;
+    for (size_t v = 0; v < positions.size(); ++v) {
+      for (int k = 0; k < 3; ++k) positions[v][k] += t * delta[3 * v + k];
+    }
+    const RenderScene scene(positions, g.faces);
+    RenderView(scene, material, view, options, &image[s]);
+  }
+  std::vector<double> fd(3 * static_cast<size_t>(image[0].width) * image[0].height);
+  for (size_t p = 0; p < fd.size() / 3; ++p) {
+    for (int c = 0; c < 3; ++c) {
+      fd[3 * p + c] =
+          (static_cast<double>(image[0].data[4 * p + c]) - image[1].data[4 * p + c]) / (2 * h);
+    }
+  }
+  return fd;
+}
+
+std::vector<double> BlockSums(const std::vector<double>& image, int res, int block) {
+  const int nb = (res + block - 1) / block;
+  std::vector<double> sums(3 * nb * nb, 0.0);
+  for (int y = 0; y < res; ++y) {
+    for (int x = 0; x < res; ++x) {
+      for (int c = 0; c < 3; ++c) {
+        sums[3 * ((y / block) * nb + x / block) + c] += image[3 * (y * res + x) + c];
+      }
+    }
+  }
+  return sums;
+}
+
+double RelativeError(const std::vector<double>& a, const std::vector<double>& ref) {
+  double err2 = 0.0, ref2 = 0.0;
+  for (size_t i = 0; i < a.size(); ++i) {
+    err2 += (a[i] - ref[i]) * (a[i] - ref[i]);
+    ref2 += ref[i] * ref[i];
+  }
+  return ref2 > 0.0 ? std::sqrt(err2 / ref2) : (err2 > 0.0 ? 1.0 : 0.0);
+}
+
+double Sum(const std::vector<double>& v) {
+  double s = 0.0;
+  for (double x : v) s += x;
+  return s;
+}
+
+struct Comparison {
+  double block_error = 0.0;  // 8×8 block sums, RGB.
+  double sum_error = 0.0;    // |Σ analytic − Σ fd| / |Σ fd| over the image and RGB.
+  double adjoint_mismatch = 0.0;
+  bool finite = true;
+};
+
+// Renders the derivative rows (and the adjoint for random weights) at p and the central difference
+// along δ with step h; compares them on 8×8 block sums.
+Comparison CompareWithFiniteDifferences(const Geometry& g, const std::vector<double>& delta,
+                                        double h, const Material& material, const ViewSetup& view,
+                                        RenderOptions options, const char* name) {
+  options.sampling_material = &material;
+  const int res = view.camera.width;
+  Image weights(res, res, 3);
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (float& w : weights.data) w = static_cast<float>(u(rng));
+  DerivativeRequest request;
+  request.params = ParameterSelection::Only(ParameterKind::kVertex);
+  request.jacobian_rows = true;
+  request.adjoint_weights = &weights;
+  const RenderScene scene(g.positions, g.faces);
+  Image image;
+  DerivativeOutput out;
+  RenderViewWithDerivatives(scene, material, view, options, request, 1, &image, &out);
+  const std::vector<double> analytic = RowsTimes(out, delta);
+  const std::vector<double> fd = CentralDifference(g, delta, h, material, view, options);
+  Comparison result;
+  double adjoint = 0.0, weighted = 0.0, weighted_abs = 0.0;
+  for (size_t i = 0; i < out.gradient.size(); ++i) {
+    result.finite &= std::isfinite(out.gradient[i]);
+    if (i < delta.size()) adjoint += out.gradient[i] * delta[i];
+  }
+  for (size_t i = 0; i < analytic.size(); ++i) {
+    result.finite &= std::isfinite(analytic[i]);
+    weighted += weights.data[i] * analytic[i];
+    weighted_abs += std::abs(weights.data[i] * analytic[i]);
+  }
+  result.adjoint_mismatch = weighted_abs > 0.0 ? std::abs(adjoint - weighted) / weighted_abs : 0.0;
+  result.block_error = RelativeError(BlockSums(analytic, res, 8), BlockSums(fd, res, 8));
+  const double fd_sum = Sum(fd);
+  result.sum_error = std::abs(Sum(analytic) - fd_sum) / std::max(std::abs(fd_sum), 1e-300);
+  std::printf(
+      "%s: block error %.4f, pixel error %.4f, sum error %.4f (fd sum %.5g), adjoint "
+      "mismatch %.1e\n",
+      name, result.block_error, RelativeError(analytic, fd), result.sum_error, fd_sum,
+      result.adjoint_mismatch);
+  return result;
+}
+
+// ---------------------------------------------------------------------------------------------
+// (a) Silhouette of a sphere: analytic derivative of the projected area.
+
+// Area in pixels of the image of a convex polyhedron (all of it in front of the camera): the
+// convex hull of its projected vertices (Andrew's monotone chain).
+double ProjectedConvexArea(const std::vector<Eigen::Vector3d>& positions, const ViewSetup& view) {
+  std::vector<Eigen::Vector2d> q;
+  for (const Eigen::Vector3d& p : positions) {
+    q.push_back(view.camera.ImageFromCam(view.cam_from_world * p));
+  }
+  std::sort(q.begin(), q.end(), [](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+    return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y());
+  });
+  auto cross = [](const Eigen::Vector2d& o, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+    return (a - o).x() * (b - o).y() - (a - o).y() * (b - o).x();
+  };
+  std::vector<Eigen::Vector2d> hull(2 * q.size());
+  size_t k = 0;
+  for (size_t i = 0; i < q.size(); ++i) {
+    while (k >= 2 && cross(hull[k - 2], hull[k - 1], q[i]) <= 0) --k;
+    hull[k++] = q[i];
+  }
+  for (size_t i = q.size() - 1, lower = k + 1; i-- > 0;) {
+    while (k >= lower && cross(hull[k - 2], hull[k - 1], q[i]) <= 0) --k;
+    hull[k++] = q[i];
+  }
+  double area = 0.0;
+  for (size_t i = 0; i + 1 < k; ++i)
+    area += hull[i].x() * hull[i + 1].y() - hull[i + 1].x() * hull[i].y();
+  return 0.5 * std::abs(area);
+}
+
+// A unit icosphere (1280 faces) at the origin seen from (0, 0, D) under a constant white
+// environment (no visible background), Lambert albedo ρ, direct light only. A convex Lambertian
+// object under constant radiance L reflects ρ·L in every direction, so the image is ρ·L times the
+// pixel coverage and its sum is ρ·L·A, A the projected area in pixels: for a sphere of radius r,
+// A(r) = π f² r²/(D² − r²) (the silhouette cone has half-angle asin(r/D)), and
+// dA/dr = π f² · 2 r D²/(D² − r²)². The radial field δ(v) = v scales the sphere, dr/dt = r = 1,
+// and changes no shading (uniform scaling keeps every normal, the radiance stays ρ·L), so the
+// whole derivative is the silhouette term of primary edge sampling, and the derivative of the
+// image sum (adjoint weights 1) is ρ·L·dA/dt.
+//
+// Tolerances. The polyhedron is inscribed in the unit sphere (edges ≈ 0.15, chord sagitta
+// ≈ 0.003): its projected area is 0.47% below the sphere's and its area derivative 0.17% below
+// (both computed exactly below from the convex hull of the projected vertices). Against the
+// sphere's formula the renderer is allowed 3% (the polyhedral difference plus edge-sampling
+// noise, ≈ 0.5% at 256 spp); against the polyhedron's exact derivative and the finite difference
+// of the rendered sum, 3% (see the measured bias below). The finite difference (h = 5e-2: the sum
+// is a smooth function of the scale, central-difference truncation ≈ 4e-4; the samples crossing the
+// moving silhouette leave ≈ 0.5% noise at 256 spp) is itself checked against the polyhedron
+// at 1.5%.
+TEST(VertexDerivativesTest, SphereSilhouetteMatchesAnalyticAreaDerivative) {
+  const Geometry sphere = FromMesh("icosphere_r1_1280f.obj");
+  const double albedo = 0.5, radiance = 1.0, distance = 4.0, focal = 100.0;
+  const int res = 96;
+  const Material material = Lambert(sphere, albedo);
+  const EnvironmentMap env(Image(32, 16, 3, 1.0f), Eigen::Matrix3d::Identity(), radiance);
+  ViewSetup view = LookAtView(Eigen::Vector3d(0, 0, distance), Eigen::Vector3d::Zero(), res, focal);
+  view.environment = &env;
+  view.environment_background = false;
+  RenderOptions options;
+  options.spp = 256;
+  options.bounces = 1;
+  options.effects.shadows = false;
+  options.effects.bounces = false;
+  options.effects.specular = false;
+  options.sampling_material = &material;
+
+  std::vector<double> delta(3 * sphere.positions.size());
+  for (size_t v = 0; v < sphere.positions.size(); ++v) {
+    for (int k = 0; k < 3; ++k) delta[3 * v + k] = sphere.positions[v][k];
+  }
+  Image ones(res, res, 3, 1.0f);
+  DerivativeRequest request;
+  request.params = ParameterSelection::Only(ParameterKind::kVertex);
+  request.adjoint_weights = &ones;
+  const RenderScene scene(sphere.positions, sphere.faces);
+  Image image;
+  DerivativeOutput out;
+  RenderViewWithDerivatives(scene, material, view, options, request, 0, &image, &out);
+  double image_sum = 0.0;
+  for (int y = 0; y < res; ++y) {
+    for (int x = 0; x < res; ++x) {
+      for (int c = 0; c < 3; ++c) image_sum += image.at(x, y, c);
+    }
+  }
+  double derivative = 0.0;
+  for (size_t i = 0; i < delta.size(); ++i) derivative += out.gradient[i] * delta[i];
+
+  const double r = 1.0, d2 = distance * distance;
+  const double area = M_PI * focal * focal * r * r / (d2 - r * r);
+  const double darea = M_PI * focal * focal * 2.0 * r * d2 / ((d2 - r * r) * (d2 - r * r));
+  const double expected_sum = 3.0 * albedo * radiance * area;
+  const double expected_derivative = 3.0 * albedo * radiance * darea * r;
+  // The polyhedron's own projected area and its derivative under scaling (exact geometry).
+  auto scaled_area = [&](double t) {
+    std::vector<Eigen::Vector3d> p = sphere.positions;
+    for (Eigen::Vector3d& x : p) x *= 1.0 + t;
+    return ProjectedConvexArea(p, view);
+  };
+  const double poly_sum = 3.0 * albedo * radiance * scaled_area(0.0);
+  const double poly_derivative =
+      3.0 * albedo * radiance * (scaled_area(1e-5) - scaled_area(-1e-5)) / 2e-5;
+
+  const double h = 5e-2;
+  const std::vector<double> fd = CentralDifference(sphere, delta, h, material, view, options);
+  const double fd_derivative = Sum(fd);
+  std::printf(
+      "sphere silhouette: derivative %.6g, finite difference %.6g, polyhedron %.6g, "
+      "sphere %.6g; sum %.6g, polyhedron %.6g, sphere %.6g\n",
+      derivative, fd_derivative, poly_derivative, expected_derivative, image_sum, poly_sum,
+      expected_sum);
+  // The setup: the polyhedron is close to the sphere, the render's sum is its area.
+  EXPECT_NEAR(poly_sum, expected_sum, 0.01 * expected_sum);
+  EXPECT_NEAR(poly_derivative, expected_derivative, 0.01 * expected_derivative);
+  EXPECT_NEAR(image_sum, poly_sum, 0.005 * poly_sum);
+  EXPECT_NEAR(fd_derivative, poly_derivative, 0.015 * poly_derivative);
+  // The renderer's silhouette derivative.
+  EXPECT_NEAR(derivative, expected_derivative, 0.03 * expected_derivative);
+  // 3%: the edge estimate has been measured +1.7% above the polyhedron's exact derivative on
+  // average over 4 seeds at 256 spp (+2.2% here), while the finite difference agrees within
+  // 0.1%: a small bias of the primary-edge term that is not yet explained (see
+  // docs/design-notes.md, "Vertex derivatives: known gaps").
+  EXPECT_NEAR(derivative, poly_derivative, 0.03 * poly_derivative);
+  EXPECT_NEAR(derivative, fd_derivative, 0.03 * std::abs(fd_derivative));
+}
+
+// ---------------------------------------------------------------------------------------------
+// (b) Directional derivatives against finite differences, per effect.
+
+// A smooth bump field over the grid, zero on its border: δ(p) = b(p)·(0.3, −0.2, 1) with
+// b = sin(π(x + H)/2H)·sin(π(y + H)/2H)·(1 + 0.5 sin(2.1x + 0.4)).
+std::vector<double> BumpField(const Geometry& g, double half) {
+  std::vector<double> delta(3 * g.positions.size());
+  const Eigen::Vector3d dir(0.3, -0.2, 1.0);
+  for (size_t v = 0; v < g.positions.size(); ++v) {
+    const Eigen::Vector3d& p = g.positions[v];
+    const double b = std::sin(M_PI * (p.x() + half) / (2 * half)) *
+                     std::sin(M_PI * (p.y() + half) / (2 * half)) *
+                     (1.0 + 0.5 * std::sin(2.1 * p.x() + 0.4));
+    for (int k = 0; k < 3; ++k) delta[3 * v + k] = b * dir[k];
+  }
+  return delta;
+}
+
+// The interior plane scene: a 16 × 16 grid over [−2, 2]² seen from (0, 0, 2) straight down with
+// a view of [−1, 1]² (no border, no silhouette in view), lit by a point light above.
+struct PlaneScene {
+  Geometry grid = Grid(16, 2.0);
+  std::vector<double> delta = BumpField(grid, 2.0);
+  ViewSetup view = LookAtView(Eigen::Vector3d(0, 0, 2), Eigen::Vector3d::Zero(), 64, 64.0);
+
+  PlaneScene(const Eigen::Vector3d& light) {
+    view.point_lights.push_back({light, Eigen::Vector3d(4.0, 3.0, 2.0), -1});
+  }
+};
+
+// (i) Interior terms only: hit points, normals, cos θ and 1/d² of the light move with the plane;
+// the bump changes no visibility in view. The grid's faces are coplanar at h = 0, so the shading
+// jumps across its edges vanish to first order and no edge term contributes.
+TEST(VertexDerivativesTest, InteriorPlaneUnderPointLight) {
+  PlaneScene s(Eigen::Vector3d(0.4, -0.3, 1.5));
+  const Material material = Lambert(s.grid, 0.7);
+  RenderOptions options;
+  options.spp = 16;
+  options.bounces = 1;
+  options.effects.shadows = false;
+  options.effects.bounces = false;
+  options.effects.environment = false;
+  options.effects.specular = false;
+  const Comparison c =
+      CompareWithFiniteDifferences(s.grid, s.delta, 1e-3, material, s.view, options, "interior");
+  EXPECT_TRUE(c.finite);
+  EXPECT_LT(c.block_error, 0.05);
+  EXPECT_LT(c.sum_error, 0.05);
+  EXPECT_LT(c.adjoint_mismatch, 1e-4);
+}
+
+// The finite-difference step of scenes with moving edges, relative to the moving object's
+// bounding-box diagonal (the field's max length is 1). Measured seed-to-seed noise of the
+// finite difference's 8×8 block sums at 256 spp: 1.1% (shadows), 1.9% (two bounces), 1.6%
+// (environment) at this step; 2.2%, 4.3% and 2.4% at half of it. Larger steps add truncation
+// error (block sums kink as edges cross pixel and block boundaries). These numbers assume a
+// sampler whose 2D pairs are independent across dimensions.
+constexpr double kEdgeStep = 1e-2;
+
+// The shadow scene: a cube of half-size 0.25 at (0, 0, 0.5) above a 12 × 12 ground quad (its
+// border out of view), seen obliquely, lit by a point light that throws the cube's shadow onto
+// the ground in view. δ moves the cube only (a smooth field over its vertices): its silhouette
+// (primary edges), its shadow boundary on the ground (shadow edges) and its shading (interior).
+struct CubeScene {
+  Geometry geometry;
+  std::vector<double> delta;
+  ViewSetup view = LookAtView(Eigen::Vector3d(0.5, -2.0, 2.0), Eigen::Vector3d(0, 0.3, 0.2), 64,
+                              OrbitFocal(64, 40.0));
+  double cube_extent = 0.0;
+
+  CubeScene() {
+    Geometry ground;
+    ground.positions = {{-6, -6, 0}, {6, -6, 0}, {6, 6, 0}, {-6, 6, 0}};
+    ground.faces = {{0, 1, 2}, {0, 2, 3}};
+    geometry.Append(ground);
+    Geometry cube = FromMesh("cube_2x2x2_12f.obj");
+    // Turned to a generic orientation: no face normal with n.z = 0, where the sampling frame of
+    // bounce directions (OrthonormalBasis) switches branch, so the renders at ±h would sample
+    // different directions from the cube's side faces and the finite difference of the indirect
+    // light would be noise.
+    const Eigen::Matrix3d turn =
+        Eigen::AngleAxisd(0.35, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+    for (Eigen::Vector3d& p : cube.positions) p = 0.25 * (turn * p) + Eigen::Vector3d(0, 0, 0.5);
+    const int base = geometry.Append(cube);
+    cube_extent = 0.5 * std::sqrt(3.0);
+    delta.assign(3 * geometry.positions.size(), 0.0);
+    const std::vector<double> field = SmoothDisplacementField(cube.positions, 5);
+    std::copy(field.begin(), field.end(), delta.begin() + 3 * base);
+    view.point_lights.push_back({Eigen::Vector3d(-1.0, 0.8, 2.5), Eigen::Vector3d(6, 6, 6), -1});
+  }
+};
+
+// (ii) Direct light with shadows.
+TEST(VertexDerivativesTest, CubeShadowDirect) {
+  CubeScene s;
+  const Material material = Lambert(s.geometry, 0.6);
+  RenderOptions options;
+  options.spp = 256;
+  options.bounces = 1;
+  options.effects.bounces = false;
+  options.effects.environment = false;
+  options.effects.specular = false;
+  const Comparison c = CompareWithFiniteDifferences(s.geometry, s.delta, kEdgeStep * s.cube_extent,
+                                                    material, s.view, options, "shadows");
+  EXPECT_TRUE(c.finite);
+  EXPECT_LT(c.block_error, 0.05);
+  EXPECT_LT(c.sum_error, 0.05);
+  EXPECT_LT(c.adjoint_mismatch, 1e-4);
+}
+
+// (iii) Two bounces: light reflected between the cube and the ground. Disabled: visibility
+// changes seen from bounce vertices (Li et al.'s secondary edges for hemispherical integrals) are
+// not sampled yet, and this scene measures the gap: block error 4.6% but image-sum error 14%,
+// while direct light alone agrees to 0.4%. Enable when secondary edges land (issue 3).
+TEST(VertexDerivativesTest, DISABLED_CubeShadowTwoBounces) {
+  CubeScene s;
+  const Material material = Lambert(s.geometry, 0.8);
+  RenderOptions options;
+  options.spp = 256;
+  options.bounces = 2;
+  options.effects.environment = false;
+  options.effects.specular = false;
+  const Comparison c = CompareWithFiniteDifferences(s.geometry, s.delta, kEdgeStep * s.cube_extent,
+                                                    material, s.view, options, "two bounces");
+  EXPECT_TRUE(c.finite);
+  EXPECT_LT(c.block_error, 0.05);
+  EXPECT_LT(c.sum_error, 0.05);
+  EXPECT_LT(c.adjoint_mismatch, 1e-4);
+}
+
+// (iv) Environment light: an icosphere (320 faces; convex, so it shadows none of its own lit
+// hemisphere) under an environment with a bright patch, a smooth random field; silhouettes and
+// interior terms of the environment-lit shading.
+TEST(VertexDerivativesTest, SphereUnderEnvironmentLong) {
+  const Geometry sphere = FromMesh("icosphere_r1_320f.obj");
+  Image env_image(32, 16, 3, 0.3f);
+  for (int y = 3; y < 7; ++y) {
+    for (int x = 10; x < 15; ++x) env_image.at(x, y, 0) = env_image.at(x, y, 1) = 5.f;
+  }
+  const EnvironmentMap env(env_image, Eigen::Matrix3d::Identity(), 1.0);
+  ViewSetup view =
+      LookAtView(Eigen::Vector3d(1.0, -3.5, 1.2), Eigen::Vector3d::Zero(), 64, OrbitFocal(64, 40));
+  view.environment = &env;
+  const Material material = Lambert(sphere, 0.6);
+  RenderOptions options;
+  options.spp = 4096;
+  options.bounces = 1;
+  options.effects.specular = false;
+  options.effects.bounces = false;
+  options.effects.shadows = false;
+  const std::vector<double> delta = SmoothDisplacementField(sphere.positions, 3);
+  const Comparison c = CompareWithFiniteDifferences(sphere, delta, kEdgeStep * 2.0 * std::sqrt(3.0),
+                                                    material, view, options, "environment");
+  EXPECT_TRUE(c.finite);
+  EXPECT_LT(c.block_error, 0.05);
+  EXPECT_LT(c.sum_error, 0.05);
+  EXPECT_LT(c.adjoint_mismatch, 1e-4);
+}
+
+// (v) Glossy lobe (specular 0.5) on the interior plane scene with the light near the camera so
+// the highlight is in view; roughness 0.05 (α = 0.0025: the normal must turn by ≪ α, hence the
+// small step), 0.3 and 1.0.
+TEST(VertexDerivativesTest, GlossyPlane) {
+  for (double roughness : {0.05, 0.3, 1.0}) {
+    PlaneScene s(Eigen::Vector3d(0.25, 0.15, 2.0));
+    const Material material = ConstantMaterial(static_cast<int>(s.grid.faces.size()),
+                                               Eigen::Vector3d::Constant(0.4), roughness, 0.5);
+    RenderOptions options;
+    options.spp = 16;
+    options.bounces = 1;
+    options.effects.shadows = false;
+    options.effects.bounces = false;
+    options.effects.environment = false;
+    const double h = roughness < 0.1 ? 2e-5 : 1e-3;
+    const std::string name = "glossy roughness " + std::to_string(roughness);
+    const Comparison c =
+        CompareWithFiniteDifferences(s.grid, s.delta, h, material, s.view, options, name.c_str());
+    EXPECT_TRUE(c.finite) << name;
+    EXPECT_LT(c.block_error, 0.05) << name;
+    EXPECT_LT(c.sum_error, 0.05) << name;
+    EXPECT_LT(c.adjoint_mismatch, 1e-4) << name;
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// (c) Hard cases: every Jacobian entry and gradient component finite, no crash.
+
+// Renders rows and an adjoint gradient of vertex derivatives (all effects, a point light and an
+// environment, two bounces) and checks that everything is finite.
+void ExpectFiniteDerivatives(const Geometry& g, const ViewSetup& base_view, double roughness,
+                             const char* name) {
+  const Material material = ConstantMaterial(static_cast<int>(g.faces.size()),
+                                             Eigen::Vector3d(0.6, 0.5, 0.4), roughness, 0.4);
+  const EnvironmentMap env(Image(16, 8, 3, 0.5f), Eigen::Matrix3d::Identity(), 1.0);
+  ViewSetup view = base_view;
+  if (view.point_lights.empty()) {
+    view.point_lights.push_back({Eigen::Vector3d(0.5, 0.5, 3.0), Eigen::Vector3d(5, 5, 5), -1});
+  }
+  view.environment = &env;
+  const int res = view.camera.width;
+  Image weights(res, res, 3, 1.0f);
+  DerivativeRequest request;
+  request.params = ParameterSelection::Only(ParameterKind::kVertex);
+  request.jacobian_rows = true;
+  request.adjoint_weights = &weights;
+  RenderOptions options;
+  options.spp = 4;
+  options.bounces = 2;
+  const RenderScene scene(g.positions, g.faces);
+  Image image;
+  DerivativeOutput out;
+  RenderViewWithDerivatives(scene, material, view, options, request, 1, &image, &out);
+  for (float v : image.data) ASSERT_TRUE(std::isfinite(v)) << name << ": image";
+  ASSERT_EQ(out.gradient.size(), static_cast<size_t>(out.layout.size())) << name;
+  for (size_t i = 0; i < out.gradient.size(); ++i) {
+    ASSERT_TRUE(std::isfinite(out.gradient[i])) << name << ": gradient " << out.layout.Describe(i);
+  }
+  ASSERT_EQ(out.rows.offsets.size(), static_cast<size_t>(res * res + 1)) << name;
+  for (const JacobianEntry& e : out.rows.entries) {
+    ASSERT_GE(e.param, 0) << name;
+    ASSERT_LT(e.param, out.layout.size()) << name;
+    for (int c = 0; c < 3; ++c) {
+      ASSERT_TRUE(std::isfinite(e.d[c])) << name << ": " << out.layout.Describe(e.param);
+    }
+  }
+}
+
+ViewSetup SmallView(const Eigen::Vector3d& eye, const Eigen::Vector3d& target) {
+  return LookAtView(eye, target, 32, OrbitFocal(32, 40.0));
+}
+
+TEST(VertexDerivativesTest, GrazingCameraRaysStayFinite) {
+  const Geometry quad = FromMesh("quad_z0_2x2_2f.obj");
+  ExpectFiniteDerivatives(quad, SmallView(Eigen::Vector3d(0, -3, 1e-3), Eigen::Vector3d(0, 0, 0)),
+                          0.3, "grazing");
+  ExpectFiniteDerivatives(quad, SmallView(Eigen::Vector3d(0, -3, 0), Eigen::Vector3d(0, 0, 0)), 0.3,
+                          "edge-on");
+}
+
+TEST(VertexDerivativesTest, DegenerateTrianglesStayFinite) {
+  Geometry g = FromMesh("quad_z0_2x2_2f.obj");
+  // A zero-area triangle (collinear corners) and a sliver (height 1e-9) standing on the quad, and
+  // a triangle with two coincident vertices (distinct indices, same position).
+  g.positions.push_back({-0.5, 0, 0.2});
+  g.positions.push_back({0, 0, 0.2});
+  g.positions.push_back({0.5, 0, 0.2});
+  g.faces.emplace_back(4, 5, 6);
+  g.positions.push_back({-0.5, 0.3, 0.3});
+  g.positions.push_back({0.5, 0.3, 0.3});
+  g.positions.push_back({0, 0.3, 0.3 + 1e-9});
+  g.faces.emplace_back(7, 8, 9);
+  g.positions.push_back({0.2, -0.4, 0.4});
+  g.positions.push_back({0.2, -0.4, 0.4});
+  g.positions.push_back({0.6, -0.2, 0.1});
+  g.faces.emplace_back(10, 11, 12);
+  ExpectFiniteDerivatives(g, SmallView(Eigen::Vector3d(0.3, -1.5, 2), Eigen::Vector3d(0, 0, 0.1)),
+                          0.3, "degenerate");
+}
+
+TEST(VertexDerivativesTest, NearMirrorRoughnessStaysFinite) {
+  PlaneScene s(Eigen::Vector3d(0.25, 0.15, 2.0));
+  ExpectFiniteDerivatives(s.grid, s.view, 0.001, "roughness 0.001");
+}
+
+TEST(VertexDerivativesTest, PointLightOnTheSurfaceStaysFinite) {
+  const Geometry quad = FromMesh("quad_z0_2x2_2f.obj");
+  ViewSetup view = SmallView(Eigen::Vector3d(0.2, -1.0, 2.0), Eigen::Vector3d(0, 0, 0));
+  view.point_lights.push_back({Eigen::Vector3d(0.3, 0.2, 0.0), Eigen::Vector3d(5, 5, 5), -1});
+  ExpectFiniteDerivatives(quad, view, 0.3, "light on surface");
+  // And on a vertex.
+  view.point_lights[0].position = Eigen::Vector3d(1, 1, 0);
+  ExpectFiniteDerivatives(quad, view, 0.3, "light on vertex");
+}
+
+TEST(VertexDerivativesTest, CameraInsideClosedMeshStaysFinite) {
+  const Geometry sphere = FromMesh("icosphere_r1_320f.obj");
+  ViewSetup view = SmallView(Eigen::Vector3d(0.1, 0.05, 0), Eigen::Vector3d(1, 0, 0));
+  view.point_lights.push_back({Eigen::Vector3d(0, 0, 0.2), Eigen::Vector3d(1, 1, 1), -1});
+  ExpectFiniteDerivatives(sphere, view, 0.3, "camera inside");
+}
+
+TEST(VertexDerivativesTest, FlippedTrianglesStayFinite) {
+  Geometry sphere = FromMesh("icosphere_r1_320f.obj");
+  for (size_t f = 0; f < sphere.faces.size(); f += 3)
+    std::swap(sphere.faces[f][1], sphere.faces[f][2]);
+  ExpectFiniteDerivatives(sphere, SmallView(Eigen::Vector3d(0.5, -3, 1), Eigen::Vector3d::Zero()),
+                          0.3, "flipped");
+}
+
+}  // namespace
+}  // namespace sft
