@@ -13,8 +13,21 @@
 //   albedo, roughness, specular: every BSDF factor of every path vertex, all effects; exact (no
 //     visibility depends on them);
 //   light scales: every contribution of that light;
-//   vertices: not yet (interior terms and edge sampling are the next step); requesting them is
-//     reported by Check().
+//   vertices, interior terms (geometry_derivatives.h): through every path vertex's face normal
+//     (BSDF, cosines) and, for point lights, its position (light direction and 1/d²), chained
+//     through the hit points of earlier bounces; all effects;
+//   vertices, boundary terms (edge sampling, render.cc): see the table.
+//
+// Vertex derivative terms present per Effects setting (✓ present, — not needed, ✗ missing):
+//   effect on        interior   primary edges   point-light shadow   env/indirect visibility
+//   direct           ✓          ✓               —                    —
+//   + shadows        ✓          ✓               ✓ (directly seen)    ✗ env-light occlusion
+//   + bounces        ✓          ✓               ✗ seen via bounce    ✗ (secondary edges)
+//   + environment    ✓          ✓ (vs background)  —                 ✗ (with shadows)
+//   + specular       ✓          ✓               as above             as above
+// Primary edges cover silhouettes, boundary and non-manifold edges and, because shading is flat,
+// creases between non-coplanar faces. Also missing for every setting: jumps at texel boundaries
+// of piecewise-constant albedo/roughness (mesh colors), which move with the vertices.
 #ifndef SFT_RENDER_DERIVATIVES_H_
 #define SFT_RENDER_DERIVATIVES_H_
 
