@@ -25,28 +25,36 @@ const ModelInfo& Info(CameraModel model) {
   return kModels[1];
 }
 
-// COLMAP's distortion offsets (du, dv) of normalized coordinates (u, v).
-Eigen::Vector2d Distortion(const Camera& camera, const Eigen::Vector2d& uv) {
+// The distortion coefficients (k1, k2, p1, p2) of the model, zero where it has none; false for
+// the pinhole models (no distortion at all).
+bool DistortionCoefficients(const Camera& camera, double* k1, double* k2, double* p1, double* p2) {
   const std::vector<double>& p = camera.params;
-  double k1 = 0, k2 = 0, p1 = 0, p2 = 0;
+  *k1 = *k2 = *p1 = *p2 = 0.0;
   switch (camera.model) {
     case CameraModel::kSimplePinhole:
     case CameraModel::kPinhole:
-      return Eigen::Vector2d::Zero();
+      return false;
     case CameraModel::kSimpleRadial:
-      k1 = p[3];
+      *k1 = p[3];
       break;
     case CameraModel::kRadial:
-      k1 = p[3];
-      k2 = p[4];
+      *k1 = p[3];
+      *k2 = p[4];
       break;
     case CameraModel::kOpenCV:
-      k1 = p[4];
-      k2 = p[5];
-      p1 = p[6];
-      p2 = p[7];
+      *k1 = p[4];
+      *k2 = p[5];
+      *p1 = p[6];
+      *p2 = p[7];
       break;
   }
+  return true;
+}
+
+// COLMAP's distortion offsets (du, dv) of normalized coordinates (u, v).
+Eigen::Vector2d Distortion(const Camera& camera, const Eigen::Vector2d& uv) {
+  double k1, k2, p1, p2;
+  if (!DistortionCoefficients(camera, &k1, &k2, &p1, &p2)) return Eigen::Vector2d::Zero();
   const double u = uv.x(), v = uv.y();
   const double u2 = u * u, v2 = v * v, uv_ = u * v, r2 = u2 + v2;
   const double radial = k1 * r2 + k2 * r2 * r2;
@@ -56,26 +64,8 @@ Eigen::Vector2d Distortion(const Camera& camera, const Eigen::Vector2d& uv) {
 
 // ∂Distortion/∂(u, v) of the function above.
 Eigen::Matrix2d DistortionJacobian(const Camera& camera, const Eigen::Vector2d& uv) {
-  const std::vector<double>& p = camera.params;
-  double k1 = 0, k2 = 0, p1 = 0, p2 = 0;
-  switch (camera.model) {
-    case CameraModel::kSimplePinhole:
-    case CameraModel::kPinhole:
-      return Eigen::Matrix2d::Zero();
-    case CameraModel::kSimpleRadial:
-      k1 = p[3];
-      break;
-    case CameraModel::kRadial:
-      k1 = p[3];
-      k2 = p[4];
-      break;
-    case CameraModel::kOpenCV:
-      k1 = p[4];
-      k2 = p[5];
-      p1 = p[6];
-      p2 = p[7];
-      break;
-  }
+  double k1, k2, p1, p2;
+  if (!DistortionCoefficients(camera, &k1, &k2, &p1, &p2)) return Eigen::Matrix2d::Zero();
   const double u = uv.x(), v = uv.y();
   const double r2 = u * u + v * v;
   const double radial = k1 * r2 + k2 * r2 * r2;
