@@ -620,10 +620,8 @@ Eigen::Vector3d RadianceJump(const Context& ctx, const Eigen::Matrix3d& world_fr
 }
 
 // Appends the entries jump·(row_j·∂q/∂vertex_j) for the moving vertices of one sample.
-void EmitBoundary(const Context& ctx, int pixel, const Eigen::Vector3d& jump, double scale,
-                  const int* vertices, const Eigen::Vector3d* rows, int count,
-                  std::vector<EdgeEntry>* out) {
-  (void)ctx;
+void EmitBoundary(int pixel, const Eigen::Vector3d& jump, double scale, const int* vertices,
+                  const Eigen::Vector3d* rows, int count, std::vector<EdgeEntry>* out) {
   for (int j = 0; j < count; ++j) {
     for (int k = 0; k < 3; ++k) {
       const double w = rows[j][k] * scale;
@@ -748,7 +746,7 @@ void AddEdgeTerms(const Context& ctx, std::vector<DerivativeList>* pixel_lists,
       const Eigen::Vector3d m_row = d_q.transpose() * m;  // m·∂q/∂y
       const int vertices[2] = {edge.v0, edge.v1};
       const Eigen::Vector3d rows[2] = {(1.0 - s) * m_row, s * m_row};
-      EmitBoundary(ctx, pixel, jump, speed * inv_pdf * options.spp, vertices, rows, 2, out);
+      EmitBoundary(pixel, jump, speed * inv_pdf * options.spp, vertices, rows, 2, out);
     };
     const int64_t num_samples =
         static_cast<int64_t>(std::ceil(primary_ratio * options.spp * pixels));
@@ -817,7 +815,7 @@ void AddEdgeTerms(const Context& ctx, std::vector<DerivativeList>* pixel_lists,
         const Eigen::Vector3d rows[5] = {
             (1.0 - s) * point_row, s * point_row, barycentrics[0] * receiver_row,
             barycentrics[1] * receiver_row, barycentrics[2] * receiver_row};
-        EmitBoundary(ctx, pixel, jump, speed * inv_pdf * options.spp, vertices, rows, 5, out);
+        EmitBoundary(pixel, jump, speed * inv_pdf * options.spp, vertices, rows, 5, out);
       };
       const int64_t num_samples =
           static_cast<int64_t>(std::ceil(shadow_ratio * options.spp * pixels));

@@ -40,6 +40,18 @@ ViewSetup MakeView(const Eigen::Vector3d& center, const Eigen::Vector3d& target,
   return view;
 }
 
+// A dim uniform environment with one bright patch above the horizon.
+const EnvironmentMap& PatchEnvironment() {
+  static const EnvironmentMap* env = [] {
+    Image image(32, 16, 3, 0.3f);
+    for (int y = 3; y < 7; ++y) {
+      for (int x = 10; x < 15; ++x) image.at(x, y, 0) = image.at(x, y, 1) = 5.f;
+    }
+    return new EnvironmentMap(image, Eigen::Matrix3d::Identity(), 1.0);
+  }();
+  return *env;
+}
+
 // Sum over pixels and channels of w(x, y)·image, w = 1 or a smooth ramp.
 double Project(const Image& image, int weight) {
   double sum = 0.0;
@@ -201,12 +213,7 @@ TEST(EdgeSamplingTest, InteriorOnlyEnvironment) {
     s.delta.push_back(0.3 * p.x() + 0.2 * p.y() + 0.5);
   }
   s.view = MakeView({1, 0.5, 3}, {0, 0, 0}, 64, 150);
-  static Image env_image(32, 16, 3, 0.3f);
-  for (int y = 3; y < 7; ++y) {
-    for (int x = 10; x < 15; ++x) env_image.at(x, y, 0) = env_image.at(x, y, 1) = 5.f;
-  }
-  static const EnvironmentMap env(env_image, Eigen::Matrix3d::Identity(), 1.0);
-  s.view.environment = &env;
+  s.view.environment = &PatchEnvironment();
   RenderOptions options;
   options.spp = 16;
   options.bounces = 1;
@@ -250,12 +257,7 @@ TEST(EdgeSamplingTest, CreaseUnderPointLight) {
 // sample was tied to the sub-pixel position and the finite difference stalled at 6% for any spp.
 TEST(EdgeSamplingTest, CreaseUnderEnvironment) {
   EdgeScene s = TentScene();
-  static Image env_image(32, 16, 3, 0.3f);
-  for (int y = 3; y < 7; ++y) {
-    for (int x = 10; x < 15; ++x) env_image.at(x, y, 0) = env_image.at(x, y, 1) = 5.f;
-  }
-  static const EnvironmentMap env(env_image, Eigen::Matrix3d::Identity(), 1.0);
-  s.view.environment = &env;
+  s.view.environment = &PatchEnvironment();
   RenderOptions options;
   options.spp = 256;
   options.bounces = 1;
