@@ -67,6 +67,39 @@ double RayOffset(const Context& ctx, const Eigen::Vector3d& p) {
   return SurfaceRayOffset(ctx.scene, p);
 }
 
+// Direction, distance, cosine and BSDF value of a point light seen from the shading point p
+// (normal n, outgoing direction wo).
+struct PointLightSample {
+  Eigen::Vector3d wi;
+  double dist = 0.0;
+  double cos_i = 0.0;
+  Eigen::Vector3d f;
+};
+
+// False when the light is below the surface or closer than kMinRelativeLightDistance (the
+// contribution is then zero).
+bool SamplePointLight(const Context& ctx, const PointLight& light, const Eigen::Vector3d& p,
+                      const Eigen::Vector3d& n, const Eigen::Vector3d& wo,
+                      const BsdfParams& params, PointLightSample* sample) {
+  const Eigen::Vector3d to_light = light.position - p;
+  const double dist2 = to_light.squaredNorm();
+  const double min_dist = kMinRelativeLightDistance * ctx.scene.extent();
+  if (!(dist2 > min_dist * min_dist)) return false;
+  sample->dist = std::sqrt(dist2);
+  sample->wi = to_light / sample->dist;
+  sample->cos_i = n.dot(sample->wi);
+  if (sample->cos_i <= 0.0) return false;
+  sample->f = EvalBsdf(params, n, wo, sample->wi);
+  return true;
+}
+
+// Whether the shadow ray from p (started `offset` along it) reaches the light.
+bool PointLightVisible(const Context& ctx, const Eigen::Vector3d& p, double offset,
+                       const PointLightSample& sample, RenderStats* stats) {
+  ++stats->shadow_rays;
+  return !ctx.scene.Occluded(p, sample.wi, offset, sample.dist - offset);
+}
+
 // Per-sample derivative sink: (parameter, ∂RGB) pairs of one path, appended.
 using DerivativeList = std::vector<std::pair<int, Eigen::Vector3d>>;
 
@@ -285,30 +318,21 @@ Eigen::Vector3d TraceRadiance(const Context& ctx, Sampler* sampler, Eigen::Vecto
 
     if (lit_here) {
       for (const PointLight& light : ctx.view.point_lights) {
-        const Eigen::Vector3d to_light = light.position - p;
-        const double dist2 = to_light.squaredNorm();
-        const double min_dist = kMinRelativeLightDistance * ctx.scene.extent();
-        if (!(dist2 > min_dist * min_dist)) continue;
-        const double dist = std::sqrt(dist2);
-        const Eigen::Vector3d wi = to_light / dist;
-        const double cos_i = n.dot(wi);
-        if (cos_i <= 0.0) continue;
-        const Eigen::Vector3d f = EvalBsdf(params, n, wo, wi);
-        if (f.isZero() && !path) continue;
-        if (effects.shadows) {
-          ++stats->shadow_rays;
-          if (ctx.scene.Occluded(p, wi, offset, dist - offset)) continue;
-        }
+        PointLightSample ls;
+        if (!SamplePointLight(ctx, light, p, n, wo, params, &ls)) continue;
+        if (ls.f.isZero() && !path) continue;
+        if (effects.shadows && !PointLightVisible(ctx, p, offset, ls, stats)) continue;
         LightTerm term;
         term.q = light.intensity;
-        term.c = cos_i / dist2;
+        term.c = ls.cos_i / (ls.dist * ls.dist);
         if (path) {
-          term.dc_dn = wi / dist2;
+          const double dist2 = ls.dist * ls.dist;
+          term.dc_dn = ls.wi / dist2;
           term.follows_point = true;
-          term.dc_dx = (3.0 * cos_i * wi - n) / (dist2 * dist);
-          term.dwi_dx = -(Eigen::Matrix3d::Identity() - wi * wi.transpose()) / dist;
+          term.dc_dx = (3.0 * ls.cos_i * ls.wi - n) / (dist2 * ls.dist);
+          term.dwi_dx = -(Eigen::Matrix3d::Identity() - ls.wi * ls.wi.transpose()) / ls.dist;
         }
-        contribute(wi, f, term, light.light_index);
+        contribute(ls.wi, ls.f, term, light.light_index);
       }
       if (ctx.environment != nullptr) {
         Eigen::Vector3d wi, le;
@@ -599,24 +623,69 @@ bool IsDiscontinuityEdge(const RenderScene& scene, const MeshEdge& edge, const E
   return creases && std::abs(n0.dot(n1)) < 1.0 - 1e-12;
 }
 
-// L(q − εm) − L(q + εm) for camera paths through image points on either side of q, with the
-// same random numbers on both sides.
-Eigen::Vector3d RadianceJump(const Context& ctx, const Eigen::Matrix3d& world_from_cam_rotation,
-                             const Eigen::Vector3d& center, const Eigen::Vector2d& q,
-                             const Eigen::Vector2d& m, const Sampler& sampler, RenderStats* stats) {
+// Directions of the camera rays through the two sides q ∓ εm of an edge point q (index 0: −).
+void SideDirections(const Context& ctx, const Eigen::Matrix3d& world_from_cam_rotation,
+                    const Eigen::Vector2d& q, const Eigen::Vector2d& m, Eigen::Vector3d dirs[2]) {
+  for (int i = 0; i < 2; ++i) {
+    const double side = i == 0 ? -1.0 : 1.0;
+    dirs[i] = (world_from_cam_rotation * ctx.view.camera.CamFromImage(q + side * kEdgeSideOffset * m))
+                  .normalized();
+  }
+}
+
+// L(q − εm) − L(q + εm) across a primary edge, for camera paths with the same random numbers on
+// both sides. Zero without tracing paths when both sides see the same face (or nothing): the
+// edge is hidden there, and the remaining difference is interior variation, not a jump.
+Eigen::Vector3d PrimaryJump(const Context& ctx, const Eigen::Matrix3d& world_from_cam_rotation,
+                            const Eigen::Vector3d& center, const Eigen::Vector2d& q,
+                            const Eigen::Vector2d& m, const Sampler& sampler, RenderStats* stats) {
+  Eigen::Vector3d dirs[2];
+  SideDirections(ctx, world_from_cam_rotation, q, m, dirs);
+  RayHit hits[2];
+  for (int i = 0; i < 2; ++i) hits[i] = ctx.scene.Intersect(center, dirs[i], 0.0, kInfinity);
+  stats->camera_rays += 2;
+  if (hits[0].hit == hits[1].hit && (!hits[0].hit || hits[0].face == hits[1].face)) {
+    return Eigen::Vector3d::Zero();
+  }
   Eigen::Vector3d jump = Eigen::Vector3d::Zero();
-  for (const double side : {-1.0, 1.0}) {
-    const Eigen::Vector3d dir =
-        (world_from_cam_rotation * ctx.view.camera.CamFromImage(q + side * kEdgeSideOffset * m))
-            .normalized();
-    const RayHit hit = ctx.scene.Intersect(center, dir, 0.0, kInfinity);
-    ++stats->camera_rays;
+  for (int i = 0; i < 2; ++i) {
     Sampler copy = sampler;
-    const Eigen::Vector3d radiance = TraceRadiance(ctx, &copy, dir, hit, stats, nullptr);
+    const Eigen::Vector3d radiance = TraceRadiance(ctx, &copy, dirs[i], hits[i], stats, nullptr);
     if (!radiance.allFinite()) return Eigen::Vector3d::Zero();
-    jump -= side * radiance;
+    jump += i == 0 ? radiance : -radiance;
   }
   return jump;
+}
+
+// The jump across the shadow that point light `light` casts on face `receiver` seen directly
+// at image point q: only that light's direct term at the first vertex is discontinuous there
+// (the rest of the paths varies smoothly with the same random numbers), so the jump is
+// C(y⁻)V(y⁻) − C(y⁺)V(y⁺) with C the unshadowed direct term and V the shadow ray's visibility at
+// the receiver points y± seen through q ∓ εm. Zero when a side does not see the receiver (the
+// shadow boundary meets a primary edge there: a set of measure zero).
+Eigen::Vector3d ShadowJump(const Context& ctx, const Eigen::Matrix3d& world_from_cam_rotation,
+                           const Eigen::Vector3d& center, const PointLight& light, int receiver,
+                           const Eigen::Vector2d& q, const Eigen::Vector2d& m,
+                           RenderStats* stats) {
+  Eigen::Vector3d dirs[2];
+  SideDirections(ctx, world_from_cam_rotation, q, m, dirs);
+  Eigen::Vector3d jump = Eigen::Vector3d::Zero();
+  for (int i = 0; i < 2; ++i) {
+    const RayHit hit = ctx.scene.Intersect(center, dirs[i], 0.0, kInfinity);
+    ++stats->camera_rays;
+    if (!hit.hit || hit.face != receiver) return Eigen::Vector3d::Zero();
+    const Eigen::Vector3d p = ctx.scene.Point(hit.face, hit.u, hit.v);
+    Eigen::Vector3d n = ctx.scene.FaceNormal(hit.face);
+    const Eigen::Vector3d wo = -dirs[i];
+    if (n.dot(wo) < 0.0) n = -n;
+    const BsdfParams params = LookUpMaterial(ctx, ctx.material, hit.face, hit.u, hit.v).params;
+    PointLightSample ls;
+    if (!SamplePointLight(ctx, light, p, n, wo, params, &ls)) continue;
+    if (!PointLightVisible(ctx, p, RayOffset(ctx, p), ls, stats)) continue;
+    const Eigen::Vector3d c = ls.f.cwiseProduct(light.intensity) * (ls.cos_i / (ls.dist * ls.dist));
+    jump += i == 0 ? c : -c;
+  }
+  return jump.allFinite() ? jump : Eigen::Vector3d::Zero();
 }
 
 // Appends the entries jump·(row_j·∂q/∂vertex_j) for the moving vertices of one sample.
@@ -741,7 +810,7 @@ void AddEdgeTerms(const Context& ctx, std::vector<DerivativeList>* pixel_lists,
       if (!(speed > 0.0) || !std::isfinite(speed)) return;
       const Eigen::Vector2d m(-tangent.y() / speed, tangent.x() / speed);
       const Eigen::Vector3d jump =
-          RadianceJump(ctx, world_from_cam_rotation, center, q, m, sampler, &local);
+          PrimaryJump(ctx, world_from_cam_rotation, center, q, m, sampler, &local);
       if (jump.isZero()) return;
       const Eigen::Vector3d m_row = d_q.transpose() * m;  // m·∂q/∂y
       const int vertices[2] = {edge.v0, edge.v1};
@@ -803,8 +872,8 @@ void AddEdgeTerms(const Context& ctx, std::vector<DerivativeList>* pixel_lists,
         const double speed = tangent.norm();
         if (!(speed > 0.0) || !std::isfinite(speed)) return;
         const Eigen::Vector2d m(-tangent.y() / speed, tangent.x() / speed);
-        const Eigen::Vector3d jump =
-            RadianceJump(ctx, world_from_cam_rotation, center, q, m, sampler, &local);
+        const Eigen::Vector3d jump = ShadowJump(ctx, world_from_cam_rotation, center,
+                                                view.point_lights[l], hit.face, q, m, &local);
         if (jump.isZero()) return;
         const Eigen::Vector3d m_row = d_q.transpose() * m;  // m·∂q/∂y
         const Eigen::Vector3d point_row = d_y_d_point.transpose() * m_row;
