@@ -24,18 +24,35 @@ inline uint32_t ReverseBits32(uint32_t v) {
   return (v >> 16) | (v << 16);
 }
 
-// The first two dimensions of the Sobol sequence as 32-bit fractions: dimension 0 is the van der
-// Corput sequence (bit reversal), dimension 1 has direction numbers v_k = v_{k−1} ^ (v_{k−1} >> 1)
-// (primitive polynomial x + 1). Together they form a (0, 2)-sequence: every power-of-two prefix
-// is stratified in every elementary interval.
-inline void Sobol2D(uint32_t index, uint32_t* x, uint32_t* y) {
-  *x = ReverseBits32(index);
-  uint32_t result = 0, v = 0x80000000u;
-  for (uint32_t i = index; i != 0; i >>= 1) {
-    if (i & 1u) result ^= v;
-    v ^= v >> 1;
+// The second Sobol dimension's generator matrix (direction numbers v_k = v_{k−1} ^ (v_{k−1} >> 1),
+// v_0 = 2^31; primitive polynomial x + 1), applied to the index over GF(2) one byte at a time:
+// table[b][x] is the XOR of the direction numbers of the set bits of byte value x at byte b.
+struct SobolDimension1Table {
+  uint32_t table[4][256];
+  SobolDimension1Table() {
+    uint32_t v[32];
+    v[0] = 0x80000000u;
+    for (int k = 1; k < 32; ++k) v[k] = v[k - 1] ^ (v[k - 1] >> 1);
+    for (int b = 0; b < 4; ++b) {
+      for (uint32_t x = 0; x < 256; ++x) {
+        uint32_t result = 0;
+        for (int bit = 0; bit < 8; ++bit) {
+          if (x & (1u << bit)) result ^= v[8 * b + bit];
+        }
+        table[b][x] = result;
+      }
+    }
   }
-  *y = result;
+};
+
+// The first two dimensions of the Sobol sequence as 32-bit fractions: dimension 0 is the van der
+// Corput sequence (bit reversal), dimension 1 the sequence of SobolDimension1Table. Together they
+// form a (0, 2)-sequence: every power-of-two prefix is stratified in every elementary interval.
+inline void Sobol2D(uint32_t index, uint32_t* x, uint32_t* y) {
+  static const SobolDimension1Table kTable;
+  *x = ReverseBits32(index);
+  *y = kTable.table[0][index & 0xFFu] ^ kTable.table[1][(index >> 8) & 0xFFu] ^
+       kTable.table[2][(index >> 16) & 0xFFu] ^ kTable.table[3][index >> 24];
 }
 
 // A nested uniform (Owen) scramble of a 32-bit fraction by a hash (Laine & Karras 2011, with

@@ -103,10 +103,13 @@ struct DerivativeRequest {
                                            // DerivativeOutput::gradient = Σ_p Σ_c w_pc ∂I_pc/∂θ.
   // Visibility (edge) terms of vertex derivatives, sampled per view in proportion to the
   // forward work: primary edge samples = ratio × spp × pixels (each traces two paths, one on
-  // either side of the edge); secondary (shadow) edge samples likewise. Range [0, 16]; 0 turns
-  // the edge terms off (interior terms only, a biased derivative near silhouettes/shadows).
-  double primary_edge_ratio = 0.5;
-  double shadow_edge_ratio = 0.25;
+  // either side of the edge, unless both sides see the same face); point-light shadow edge
+  // samples likewise (each traces up to four rays). Range [0, 16]; 0 turns the edge terms off
+  // (interior terms only, a biased derivative near silhouettes/shadows). The defaults keep the
+  // derivative pass within a few times the forward pass (`sft bench gradient`); raise them when
+  // the edge terms' noise dominates (e.g. few views, large silhouette derivatives).
+  double primary_edge_ratio = 0.25;
+  double shadow_edge_ratio = 0.125;
 
   // True when valid; else *why names the field.
   bool Check(std::string* why) const;

@@ -100,8 +100,74 @@ bool PointLightVisible(const Context& ctx, const Eigen::Vector3d& p, double offs
   return !ctx.scene.Occluded(p, sample.wi, offset, sample.dist - offset);
 }
 
-// Per-sample derivative sink: (parameter, ∂RGB) pairs of one path, appended.
+// (parameter, ∂RGB) pairs, in arrival order (edge terms of one pixel).
 using DerivativeList = std::vector<std::pair<int, Eigen::Vector3d>>;
+
+// One pixel's derivatives, summed per parameter as they arrive: an open-addressing hash table
+// (linear probing, load ≤ 1/2) over the parameters touched so far. A pixel's paths touch the same
+// few faces and texels over and over (every contribution re-emits the corners of the faces behind
+// it), so summing on arrival keeps the work per entry O(1) and sorts only the distinct parameters.
+class RowAccumulator {
+ public:
+  RowAccumulator() { Resize(64); }
+
+  void Add(int param, const Eigen::Vector3d& d) {
+    uint32_t slot = Hash(param) & mask_;
+    while (true) {
+      const int key = keys_[slot];
+      if (key == param) {
+        values_[slot] += d;
+        return;
+      }
+      if (key < 0) break;
+      slot = (slot + 1) & mask_;
+    }
+    keys_[slot] = param;
+    values_[slot] = d;
+    used_.push_back(slot);
+    if (2 * used_.size() > keys_.size()) Grow();
+  }
+
+  // Writes the sums (finite ones, times `scale`) sorted by parameter, and empties the table.
+  void Flush(double scale, std::vector<JacobianEntry>* merged) {
+    merged->clear();
+    std::sort(used_.begin(), used_.end(),
+              [this](uint32_t a, uint32_t b) { return keys_[a] < keys_[b]; });
+    for (const uint32_t slot : used_) {
+      const Eigen::Vector3d& sum = values_[slot];
+      if (sum.allFinite()) {
+        merged->push_back({keys_[slot],
+                           {static_cast<float>(sum[0] * scale), static_cast<float>(sum[1] * scale),
+                            static_cast<float>(sum[2] * scale)}});
+      }
+      keys_[slot] = -1;
+    }
+    used_.clear();
+  }
+
+ private:
+  static uint32_t Hash(int param) { return static_cast<uint32_t>(param) * 2654435761u; }
+
+  void Resize(size_t capacity) {
+    keys_.assign(capacity, -1);
+    values_.resize(capacity);
+    mask_ = static_cast<uint32_t>(capacity - 1);
+  }
+
+  void Grow() {
+    std::vector<std::pair<int, Eigen::Vector3d>> entries;
+    entries.reserve(used_.size());
+    for (const uint32_t slot : used_) entries.emplace_back(keys_[slot], values_[slot]);
+    used_.clear();
+    Resize(2 * keys_.size());
+    for (const auto& [param, d] : entries) Add(param, d);
+  }
+
+  std::vector<int> keys_;  // −1: empty.
+  std::vector<Eigen::Vector3d> values_;
+  std::vector<uint32_t> used_;  // occupied slots, in insertion order.
+  uint32_t mask_ = 0;
+};
 
 // The light term Q of a contribution, split as Q = q·c with c the part that depends on the
 // geometry of the shading point: point light q = I, c = (n·wi)/d² (wi and d follow the point x);
@@ -128,8 +194,18 @@ struct LightTerm {
 // (PointJacobian). Texel lookups are piecewise constant and contribute nothing.
 class PathDerivatives {
  public:
-  PathDerivatives(const Context& ctx, DerivativeList* out)
-      : ctx_(ctx), out_(out), vertices_(ctx.request->params.vertices) {}
+  explicit PathDerivatives(const Context& ctx)
+      : ctx_(ctx), vertices_(ctx.request->params.vertices) {}
+
+  // Starts a new path whose derivatives go to `out`. (One object serves many paths: its
+  // per-scatter storage is large and needs no initialization.)
+  void Reset(RowAccumulator* out) {
+    out_ = out;
+    count_ = 0;
+    point_.count = 0;
+    point_.valid = true;
+  }
+  RowAccumulator* out() const { return out_; }
 
   // The path reached a new vertex on face `face` (hit barycentrics `barycentrics`, ray direction
   // `dir`), shaded with normal sign·n̂. `track_point`: keep x's Jacobian (point lights exist).
@@ -162,7 +238,7 @@ class PathDerivatives {
       }
     }
     if (ctx_.request->params.lights && light_index >= 0) {
-      out_->emplace_back(ctx_.layout->LightOffset() + light_index, contribution);
+      out_->Add(ctx_.layout->LightOffset() + light_index, contribution);
     }
     if (!vertices_) return;
     // ∂(f ⊙ q·c) = (f ⊙ q)·∂c + c·q·∂g, g the glossy term (the diffuse term is constant).
@@ -223,7 +299,7 @@ class PathDerivatives {
   };
 
   void Emit(int param, const Eigen::Vector3d& d) {
-    if (d[0] != 0.0 || d[1] != 0.0 || d[2] != 0.0) out_->emplace_back(param, d);
+    if (d[0] != 0.0 || d[1] != 0.0 || d[2] != 0.0) out_->Add(param, d);
   }
   void AddFace(const Eigen::Vector3i& corners, const Eigen::Matrix<double, 3, 9>& g) {
     for (int j = 0; j < 3; ++j) {
@@ -242,24 +318,24 @@ class PathDerivatives {
       for (int c = 0; c < 3; ++c) {
         Eigen::Vector3d v = Eigen::Vector3d::Zero();
         v[c] = base[c] * d.d_albedo;
-        out_->emplace_back(first + c, v);
+        out_->Add(first + c, v);
       }
     }
     if (sel.roughness && d.d_roughness != 0.0) {
-      out_->emplace_back(layout.RoughnessOffset() + surface.roughness_texel, base * d.d_roughness);
+      out_->Add(layout.RoughnessOffset() + surface.roughness_texel, base * d.d_roughness);
     }
     if (sel.specular && d.d_specular != 0.0) {
-      out_->emplace_back(layout.SpecularIndex(), base * d.d_specular);
+      out_->Add(layout.SpecularIndex(), base * d.d_specular);
     }
   }
 
   // A path scatters at most bounces − 1 ≤ 15 times (RenderOptions::Check caps bounces at 16).
   static constexpr int kMaxScatters = 16;
   const Context& ctx_;
-  DerivativeList* out_;
+  RowAccumulator* out_ = nullptr;
   const bool vertices_;
   int count_ = 0;
-  std::array<Scatter, kMaxScatters> scatters_;
+  Scatter scatters_[kMaxScatters];
   std::array<Eigen::Vector3d, kMaxScatters> excluded_;
   // The current vertex's face and normal chain, and its position's Jacobian.
   Eigen::Vector3i corners_ = Eigen::Vector3i::Zero();
@@ -268,26 +344,23 @@ class PathDerivatives {
 };
 
 // Radiance along the camera ray with direction `dir` whose first intersection is `hit` (traced
-// by the caller, in packets). When `derivatives` is non-null, the path's parameter derivatives
-// are appended to it.
+// by the caller, in packets). When `path` is non-null (its Reset called by the caller), the
+// path's parameter derivatives are added to its accumulator.
 Eigen::Vector3d TraceRadiance(const Context& ctx, Sampler* sampler, Eigen::Vector3d dir, RayHit hit,
-                              RenderStats* stats, DerivativeList* derivatives) {
+                              RenderStats* stats, PathDerivatives* path) {
   const Effects& effects = ctx.options.effects;
   Eigen::Vector3d radiance = Eigen::Vector3d::Zero();
   if (!hit.hit) {
     if (ctx.environment != nullptr && ctx.view.environment_background) {
       radiance = ctx.view.environment_scale * ctx.environment->Radiance(dir);
-      if (derivatives != nullptr && ctx.request->params.lights &&
+      if (path != nullptr && ctx.request->params.lights &&
           ctx.view.environment_light_index >= 0) {
-        derivatives->emplace_back(ctx.layout->LightOffset() + ctx.view.environment_light_index,
-                                  radiance);
+        path->out()->Add(ctx.layout->LightOffset() + ctx.view.environment_light_index, radiance);
       }
     }
     return radiance;
   }
   const bool detached = &ctx.sampling_material != &ctx.material;
-  std::optional<PathDerivatives> path;
-  if (derivatives != nullptr) path.emplace(ctx, derivatives);
   Eigen::Vector3d throughput = Eigen::Vector3d::Ones();
   for (int depth = 0;; ++depth) {
     const Eigen::Vector3d p = ctx.scene.Point(hit.face, hit.u, hit.v);
@@ -343,7 +416,7 @@ Eigen::Vector3d TraceRadiance(const Context& ctx, Sampler* sampler, Eigen::Vecto
           const double cos_i = n.dot(wi);
           if (cos_i > 0.0) {
             const Eigen::Vector3d f = EvalBsdf(params, n, wo, wi);
-            bool visible = !f.isZero() || path.has_value();
+            bool visible = !f.isZero() || path != nullptr;
             if (visible && effects.shadows) {
               ++stats->shadow_rays;
               visible = !ctx.scene.Occluded(p, wi, offset, kInfinity);
@@ -633,6 +706,22 @@ void SideDirections(const Context& ctx, const Eigen::Matrix3d& world_from_cam_ro
   }
 }
 
+// Relative sampling density of a primary edge, ∝ the size of the jump expected across it:
+// 1 where the image may jump to something unrelated (silhouettes, boundary, non-manifold and
+// degenerate-neighbour edges); for a crease between faces with unit normals n0, n1 the
+// flat-shaded radiance jumps by about |∂L/∂n|·|n0 − n1|, so |n0 − n1| (at least 1/16, because a
+// glossy highlight makes ∂L/∂n large). Any positive density leaves the estimator unbiased (the
+// pdf includes it); this one spends the samples where the derivative is.
+double PrimaryEdgeImportance(const RenderScene& scene, const MeshEdge& edge,
+                             const Eigen::Vector3d& eye) {
+  if (edge.num_faces != 2) return 1.0;
+  const Eigen::Vector3d n0 = scene.FaceNormal(edge.f0), n1 = scene.FaceNormal(edge.f1);
+  if (n0.isZero() || n1.isZero()) return 1.0;
+  const Eigen::Vector3d to_eye = eye - scene.positions()[edge.v0];
+  if ((n0.dot(to_eye) > 0.0) != (n1.dot(to_eye) > 0.0)) return 1.0;
+  return std::clamp((n0 - n1).norm(), 1.0 / 16.0, 1.0);
+}
+
 // L(q − εm) − L(q + εm) across a primary edge, for camera paths with the same random numbers on
 // both sides. Zero without tracing paths when both sides see the same face (or nothing): the
 // edge is hidden there, and the remaining difference is interior variation, not a jump.
@@ -792,7 +881,8 @@ void AddEdgeTerms(const Context& ctx, std::vector<DerivativeList>* pixel_lists,
       const Eigen::Vector2d q1 = camera.ImageFromCam(a_cam + s1 * (b_cam - a_cam));
       const double length = (q1 - q0).norm();
       if (!std::isfinite(length)) continue;
-      candidates.push_back({static_cast<int>(e), s0, s1, length + 1e-3});
+      candidates.push_back(
+          {static_cast<int>(e), s0, s1, (length + 1e-3) * PrimaryEdgeImportance(scene, edge, center)});
     }
     const auto sample_primary = [&](const EdgeCandidate& candidate, double s, double inv_pdf,
                                     const Sampler& sampler, std::vector<EdgeEntry>* out) {
@@ -903,22 +993,6 @@ void AddEdgeTerms(const Context& ctx, std::vector<DerivativeList>* pixel_lists,
   }
 }
 
-// Sorts a pixel's derivative list by parameter and merges duplicates, scaling by `scale`.
-void MergeDerivatives(DerivativeList* list, double scale, std::vector<JacobianEntry>* merged) {
-  merged->clear();
-  std::sort(list->begin(), list->end(),
-            [](const auto& a, const auto& b) { return a.first < b.first; });
-  for (size_t i = 0; i < list->size();) {
-    const int param = (*list)[i].first;
-    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-    for (; i < list->size() && (*list)[i].first == param; ++i) sum += (*list)[i].second;
-    if (!sum.allFinite()) continue;
-    merged->push_back({param,
-                       {static_cast<float>(sum[0] * scale), static_cast<float>(sum[1] * scale),
-                        static_cast<float>(sum[2] * scale)}});
-  }
-}
-
 void RenderImpl(const RenderScene& scene, const Material& material, const ViewSetup& view,
                 const RenderOptions& options, const DerivativeRequest* request,
                 const ParameterLayout* layout, Image* image, DerivativeOutput* output,
@@ -957,6 +1031,7 @@ void RenderImpl(const RenderScene& scene, const Material& material, const ViewSe
   std::vector<std::vector<std::pair<int, double>>> tile_gradients(weights != nullptr ? num_tiles
                                                                                      : 0);
   tbb::enumerable_thread_specific<RenderStats> thread_stats;
+  tbb::enumerable_thread_specific<std::array<RowAccumulator, kTile>> thread_rows;
   // Boundary (edge) terms of vertex derivatives land at random pixels: gathered first, per pixel.
   std::vector<DerivativeList> edge_lists;
   RenderStats edge_stats;
@@ -972,15 +1047,14 @@ void RenderImpl(const RenderScene& scene, const Material& material, const ViewSe
     const int x0 = (tile % tiles_x) * kTile;
     const int y0 = (tile / tiles_x) * kTile;
     const int count = std::min(kTile, width - x0);
-    DerivativeList lists[kTile];
+    std::array<RowAccumulator, kTile>& rows = thread_rows.local();
+    std::optional<PathDerivatives> path;
+    if (want_derivatives) path.emplace(ctx);
     std::vector<JacobianEntry> merged;
     for (int y = y0; y < std::min(y0 + kTile, height); ++y) {
       Eigen::Vector3d sums[kTile];
       int hits[kTile] = {0};
-      for (int i = 0; i < count; ++i) {
-        sums[i].setZero();
-        lists[i].clear();
-      }
+      for (int i = 0; i < count; ++i) sums[i].setZero();
       for (int s = 0; s < options.spp; ++s) {
         Sampler samplers[kTile];
         Eigen::Vector3d dirs[kTile];
@@ -992,10 +1066,11 @@ void RenderImpl(const RenderScene& scene, const Material& material, const ViewSe
         scene.Intersect8(center, dirs, count, first_hits);
         local.camera_rays += count;
         for (int i = 0; i < count; ++i) {
+          if (path) path->Reset(&rows[i]);
           const Eigen::Vector3d value =
               options.pass == RenderPass::kColor
                   ? TraceRadiance(ctx, &samplers[i], dirs[i], first_hits[i], &local,
-                                  want_derivatives ? &lists[i] : nullptr)
+                                  path ? &*path : nullptr)
                   : TraceAuxiliary(ctx, dirs[i], first_hits[i]);
           if (value.allFinite()) sums[i] += value;
           hits[i] += first_hits[i].hit ? 1 : 0;
@@ -1007,10 +1082,11 @@ void RenderImpl(const RenderScene& scene, const Material& material, const ViewSe
         image->at(x, y, 3) = static_cast<float>(hits[i] * inv_spp);
         if (!want_derivatives) continue;
         if (!edge_lists.empty()) {
-          const DerivativeList& edge = edge_lists[static_cast<size_t>(y) * width + x];
-          lists[i].insert(lists[i].end(), edge.begin(), edge.end());
+          for (const auto& [param, d] : edge_lists[static_cast<size_t>(y) * width + x]) {
+            rows[i].Add(param, d);
+          }
         }
-        MergeDerivatives(&lists[i], inv_spp, &merged);
+        rows[i].Flush(inv_spp, &merged);
         if (weights != nullptr) {
           const Eigen::Vector3d w(weights->at(x, y, 0), weights->at(x, y, 1), weights->at(x, y, 2));
           for (const JacobianEntry& e : merged) {
