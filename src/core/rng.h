@@ -86,6 +86,16 @@ class Sampler {
     return static_cast<double>(bits >> 11) * 0x1.0p-53;  // 53 random mantissa bits: < 1 always.
   }
 
+  // An independent stream for the same sample (same sample index, so its Next2D pairs are
+  // stratified over the pixel's samples too), told apart by `key`; leaves this one untouched.
+  Sampler Fork(uint64_t key) const {
+    Sampler fork;
+    fork.pixel_key_ = Mix64(pixel_key_ ^ Mix64(key + (static_cast<uint64_t>(pair_) << 32) +
+                                               dimension_));
+    fork.sample_ = sample_;
+    return fork;
+  }
+
   void Next2D(double* u1, double* u2) {
     const uint64_t hash = Mix64(pixel_key_ + 0xD1B54A32D192ED03ull * (++pair_));
     // Shuffle the index per pair by a nested uniform scramble of its bits (Burley 2020, §4): a

@@ -110,6 +110,13 @@ struct DerivativeRequest {
   // the edge terms' noise dominates (e.g. few views, large silhouette derivatives).
   double primary_edge_ratio = 0.25;
   double shadow_edge_ratio = 0.125;
+  // Secondary edges (Li et al. 2018 §5: visibility seen from path vertices): edge samples per
+  // path vertex whose hemisphere integral has jumps — occlusion of the environment light (with
+  // shadows), silhouettes and creases of what an indirect bounce sees, and point-light shadow
+  // boundaries seen through a bounce. Each sample picks one mesh edge (∝ length) and, with point
+  // lights, one shadow-casting edge point; most are rejected by cheap tests. Range [0, 16]; 0
+  // turns them off.
+  int secondary_edge_samples = 4;
 
   // True when valid; else *why names the field.
   bool Check(std::string* why) const;

@@ -29,6 +29,8 @@ double PowerHeuristic(double pdf_a, double pdf_b) {
   return a2 / (a2 + b2);
 }
 
+struct SecondaryEdges;
+
 struct Context {
   const RenderScene& scene;
   const Material& material;
@@ -41,6 +43,8 @@ struct Context {
   // Derivatives (null request: none).
   const DerivativeRequest* request;
   const ParameterLayout* layout;
+  // Candidates of secondary edge samples; null when they are off.
+  const SecondaryEdges* secondary;
 };
 
 // Texel indices of a hit, and the BSDF parameters there.
@@ -263,6 +267,26 @@ class PathDerivatives {
     }
   }
 
+  // A boundary (edge) term at the current vertex: Σ_j weight·(rows_j·∂y/∂p_{vertices_j}) for
+  // the vertices that move the curve point, plus weight·(x_row·∂x/∂θ) for the motion of the
+  // vertex itself (chained to the faces hit before; dropped when that chain is undefined).
+  void AddBoundary(const Eigen::Vector3d& weight, const int* vertices, const Eigen::Vector3d* rows,
+                   int count, const Eigen::Vector3d& x_row) {
+    if (!vertices_ || !weight.allFinite()) return;
+    for (int j = 0; j < count; ++j) {
+      for (int k = 0; k < 3; ++k) {
+        if (std::isfinite(rows[j][k])) Emit(3 * vertices[j] + k, weight * rows[j][k]);
+      }
+    }
+    if (!point_.valid) return;
+    for (int e = 0; e < point_.count; ++e) {
+      const Eigen::RowVector3d g = x_row.transpose() * point_.m[e];
+      for (int k = 0; k < 3; ++k) {
+        if (std::isfinite(g[k])) Emit(3 * point_.vertex[e] + k, weight * g[k]);
+      }
+    }
+  }
+
   // The path continues from the current vertex with scatter factor s = f·(n·wi)/pdf.
   void AddScatter(const Eigen::Vector3d& prefix, const SurfaceMaterial& surface,
                   const Eigen::Vector3d& n, const Eigen::Vector3d& wo, const Eigen::Vector3d& wi,
@@ -343,11 +367,19 @@ class PathDerivatives {
   PointJacobian point_;
 };
 
+// Secondary edge samples at a path vertex (defined with the edge sampling below).
+void AddSecondaryEdgeSamples(const Context& ctx, const Sampler& path_sampler, int depth, int face,
+                             const Eigen::Vector3d& throughput, const Eigen::Vector3d& x,
+                             const Eigen::Vector3d& n, const Eigen::Vector3d& wo,
+                             const BsdfParams& params, PathDerivatives* path, RenderStats* stats);
+
 // Radiance along the camera ray with direction `dir` whose first intersection is `hit` (traced
 // by the caller, in packets). When `path` is non-null (its Reset called by the caller), the
-// path's parameter derivatives are added to its accumulator.
+// path's parameter derivatives are added to its accumulator. `first_depth` > 0 continues a
+// path whose first first_depth segments were traced elsewhere (the ray along `dir` is then
+// segment first_depth + 1): the radiance leaving `hit` towards −dir with the remaining depth.
 Eigen::Vector3d TraceRadiance(const Context& ctx, Sampler* sampler, Eigen::Vector3d dir, RayHit hit,
-                              RenderStats* stats, PathDerivatives* path) {
+                              RenderStats* stats, PathDerivatives* path, int first_depth = 0) {
   const Effects& effects = ctx.options.effects;
   Eigen::Vector3d radiance = Eigen::Vector3d::Zero();
   if (!hit.hit) {
@@ -362,7 +394,7 @@ Eigen::Vector3d TraceRadiance(const Context& ctx, Sampler* sampler, Eigen::Vecto
   }
   const bool detached = &ctx.sampling_material != &ctx.material;
   Eigen::Vector3d throughput = Eigen::Vector3d::Ones();
-  for (int depth = 0;; ++depth) {
+  for (int depth = first_depth;; ++depth) {
     const Eigen::Vector3d p = ctx.scene.Point(hit.face, hit.u, hit.v);
     Eigen::Vector3d n = ctx.scene.FaceNormal(hit.face);
     if (n.isZero()) break;  // degenerate triangle: no defined surface, nothing reflected.
@@ -371,7 +403,7 @@ Eigen::Vector3d TraceRadiance(const Context& ctx, Sampler* sampler, Eigen::Vecto
     n *= sign;  // two-sided shading.
     if (path) {
       path->SetVertex(hit.face, Eigen::Vector3d(1.0 - hit.u - hit.v, hit.u, hit.v), dir, sign,
-                      !ctx.view.point_lights.empty());
+                      !ctx.view.point_lights.empty() || ctx.secondary != nullptr);
     }
     const SurfaceMaterial surface = LookUpMaterial(ctx, ctx.material, hit.face, hit.u, hit.v);
     const BsdfParams& params = surface.params;
@@ -435,6 +467,11 @@ Eigen::Vector3d TraceRadiance(const Context& ctx, Sampler* sampler, Eigen::Vecto
           }
         }
       }
+    }
+
+    if (path != nullptr && ctx.secondary != nullptr) {
+      AddSecondaryEdgeSamples(ctx, *sampler, depth, hit.face, throughput, p, n, wo, params, path,
+                              stats);
     }
 
     const bool continue_path = depth + 1 < ctx.max_segments;
@@ -746,6 +783,28 @@ Eigen::Vector3d PrimaryJump(const Context& ctx, const Eigen::Matrix3d& world_fro
   return jump;
 }
 
+// The direct term of point light `light`, shadow ray included, at the first hit of the ray from
+// `origin` along the unit direction `dir` (from t_near `t_near` on), as TraceRadiance computes
+// it there. False when that hit is not on face `receiver`.
+bool DirectAtReceiver(const Context& ctx, const PointLight& light, const Eigen::Vector3d& origin,
+                      const Eigen::Vector3d& dir, double t_near, int receiver, RenderStats* stats,
+                      Eigen::Vector3d* radiance) {
+  const RayHit hit = ctx.scene.Intersect(origin, dir, t_near, kInfinity);
+  ++stats->bounce_rays;
+  if (!hit.hit || hit.face != receiver) return false;
+  radiance->setZero();
+  const Eigen::Vector3d p = ctx.scene.Point(hit.face, hit.u, hit.v);
+  Eigen::Vector3d n = ctx.scene.FaceNormal(hit.face);
+  const Eigen::Vector3d wo = -dir;
+  if (n.dot(wo) < 0.0) n = -n;
+  const BsdfParams params = LookUpMaterial(ctx, ctx.material, hit.face, hit.u, hit.v).params;
+  PointLightSample ls;
+  if (!SamplePointLight(ctx, light, p, n, wo, params, &ls)) return true;
+  if (!PointLightVisible(ctx, p, RayOffset(ctx, p), ls, stats)) return true;
+  *radiance = ls.f.cwiseProduct(light.intensity) * (ls.cos_i / (ls.dist * ls.dist));
+  return true;
+}
+
 // The jump across the shadow that point light `light` casts on face `receiver` seen directly
 // at image point q: only that light's direct term at the first vertex is discontinuous there
 // (the rest of the paths varies smoothly with the same random numbers), so the jump is
@@ -758,23 +817,287 @@ Eigen::Vector3d ShadowJump(const Context& ctx, const Eigen::Matrix3d& world_from
                            RenderStats* stats) {
   Eigen::Vector3d dirs[2];
   SideDirections(ctx, world_from_cam_rotation, q, m, dirs);
-  Eigen::Vector3d jump = Eigen::Vector3d::Zero();
+  Eigen::Vector3d direct[2];
   for (int i = 0; i < 2; ++i) {
-    const RayHit hit = ctx.scene.Intersect(center, dirs[i], 0.0, kInfinity);
-    ++stats->camera_rays;
-    if (!hit.hit || hit.face != receiver) return Eigen::Vector3d::Zero();
-    const Eigen::Vector3d p = ctx.scene.Point(hit.face, hit.u, hit.v);
-    Eigen::Vector3d n = ctx.scene.FaceNormal(hit.face);
-    const Eigen::Vector3d wo = -dirs[i];
-    if (n.dot(wo) < 0.0) n = -n;
-    const BsdfParams params = LookUpMaterial(ctx, ctx.material, hit.face, hit.u, hit.v).params;
-    PointLightSample ls;
-    if (!SamplePointLight(ctx, light, p, n, wo, params, &ls)) continue;
-    if (!PointLightVisible(ctx, p, RayOffset(ctx, p), ls, stats)) continue;
-    const Eigen::Vector3d c = ls.f.cwiseProduct(light.intensity) * (ls.cos_i / (ls.dist * ls.dist));
-    jump += i == 0 ? c : -c;
+    if (!DirectAtReceiver(ctx, light, center, dirs[i], 0.0, receiver, stats, &direct[i])) {
+      return Eigen::Vector3d::Zero();
+    }
   }
+  const Eigen::Vector3d jump = direct[0] - direct[1];
   return jump.allFinite() ? jump : Eigen::Vector3d::Zero();
+}
+
+// A point of a mesh edge lit by a point light, and the shadow point it casts: the first surface
+// behind the edge point along the light's ray.
+struct ShadowPoint {
+  int receiver = -1;              // face of the shadow point.
+  Eigen::Vector3d y;              // the shadow point.
+  Eigen::Vector3d barycentrics;   // of y on the receiver.
+  Eigen::Matrix3d d_y_d_point;    // ∂y/∂(edge point).
+  Eigen::Matrix3d along;          // ∂y/∂p_j = barycentrics_j·along (receiver corners p_j).
+};
+
+// Casts the shadow of point a + s(b − a) of `edge` from the light at `light`; false when the
+// light does not reach the edge point, nothing lies behind it, or the receiver is grazed.
+// y = light + τ·d on the receiver's plane, d = point − light, τ = (|d| + t)/|d|:
+//   ∂y/∂point = τ(I − d̂ n_rᵀ/(n_r·d̂)),  ∂y/∂p_j = b_j·d̂ n_rᵀ/(n_r·d̂).
+bool CastShadowPoint(const Context& ctx, const Eigen::Vector3d& light, const MeshEdge& edge,
+                     double s, RenderStats* stats, ShadowPoint* out) {
+  const RenderScene& scene = ctx.scene;
+  const Eigen::Vector3d& a = scene.positions()[edge.v0];
+  const Eigen::Vector3d& b = scene.positions()[edge.v1];
+  const Eigen::Vector3d point = a + s * (b - a);
+  const Eigen::Vector3d d = point - light;
+  const double dist = d.norm();
+  if (!(dist > kMinRelativeLightDistance * scene.extent())) return false;
+  const Eigen::Vector3d dir = d / dist;
+  const double offset = SurfaceRayOffset(scene, point);
+  // The light must reach the edge, and the ray grazing it must land on a receiver.
+  ++stats->shadow_rays;
+  if (scene.Occluded(light, dir, 0.0, dist - offset)) return false;
+  ++stats->shadow_rays;
+  const RayHit hit = scene.Intersect(point, dir, offset, kInfinity);
+  if (!hit.hit || hit.face == edge.f0 || hit.face == edge.f1) return false;
+  const Eigen::Vector3d n_r = scene.FaceNormal(hit.face);
+  const double cosine = n_r.dot(dir);
+  if (!(std::abs(cosine) > kMinHitCosine)) return false;
+  out->receiver = hit.face;
+  out->y = scene.Point(hit.face, hit.u, hit.v);
+  out->barycentrics = Eigen::Vector3d(1.0 - hit.u - hit.v, hit.u, hit.v);
+  const double tau = (dist + hit.t) / dist;
+  out->along = dir * n_r.transpose() / cosine;
+  out->d_y_d_point = tau * (Eigen::Matrix3d::Identity() - out->along);
+  return true;
+}
+
+// Shadow-casting edges of a point light: every edge that can be a silhouette from it, weighted
+// by the angle it subtends there (shadow samples are spread ∝ angle at the light).
+std::vector<EdgeCandidate> ShadowEdgeCandidates(const RenderScene& scene,
+                                                const Eigen::Vector3d& light) {
+  std::vector<EdgeCandidate> candidates;
+  const auto& positions = scene.positions();
+  const auto& edges = scene.edges();
+  for (size_t e = 0; e < edges.size(); ++e) {
+    const MeshEdge& edge = edges[e];
+    const Eigen::Vector3d a = positions[edge.v0] - light, b = positions[edge.v1] - light;
+    if (a == b || !IsDiscontinuityEdge(scene, edge, light, /*creases=*/false)) continue;
+    const double angle = std::atan2(a.cross(b).norm(), a.dot(b));
+    if (!(angle > 0.0) || !std::isfinite(angle)) continue;
+    candidates.push_back({static_cast<int>(e), 0.0, 1.0, angle});
+  }
+  return candidates;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Secondary edges (Li et al. 2018 §5). A path vertex x estimates the hemisphere integral
+//   H(x) = ∫ f(wo, ω)·(n·ω)·L_in(x, ω) dω,
+// and L_in jumps along curves on x's sphere of directions that move with the vertices:
+//   (A) the directions of mesh edges that are silhouettes seen from x (behind them: the
+//       environment, when it is lit with shadows, or a farther surface, when a further bounce
+//       is traced) and, when a further bounce is traced, creases (flat shading);
+//   (B) when a further bounce is traced with shadows, the directions of the shadow points that
+//       point lights' silhouette edges cast (the next vertex's direct term jumps there).
+// Boundary term: ∂H/∂θ += ∫_curve (g(ω⁻) − g(ω⁺))·(m·∂ω/∂θ) dl, g = f·(n·ω)·L_in, m the unit
+// normal of the curve on the sphere and ω± = normalize(ω ± εm). For a curve point y seen from x,
+// ω = (y − x)/r and m·∂ω/∂θ = mᵀ(∂y/∂θ − ∂x/∂θ)/r; dl = |dω/ds| ds along the curve parameter s.
+// Estimator per sample: (A) an edge ∝ its length, s uniform; (B) a light uniformly, a
+// shadow-casting edge ∝ its angle at the light, s uniform; weight (g⁻ − g⁺)·|dω/ds|/pdf, times the
+// path throughput, credited to the path's pixel. Both sides trace with the same random numbers.
+// Other radiance leaving the next vertex is continuous along ω (its own hemisphere integrals
+// smooth out their jumps), so (A) and (B) are all the curves for flat-shaded, untextured
+// surfaces; texel boundaries seen from x are not sampled. Sampling edges ∝ length (not by the
+// solid angle they subtend at x) is simple and unbiased but noisy for edges close to x.
+
+// Directions closer than this (relative to extent/r) to a curve on the sphere are its sides.
+constexpr double kSecondarySideOffset = 1e-5;
+constexpr uint64_t kSecondaryEdgeKey = 0x5EC0DE0000000000ull;
+
+struct SecondaryEdges {
+  std::vector<int> edges;        // mesh edges where radiance can jump for some viewpoint.
+  std::vector<double> cumulative;  // their cumulative lengths.
+  bool environment = false;        // the environment is lit with visibility (shadows on).
+  // Per point light of the view (when shadows and a further bounce exist): shadow-casting edges
+  // and their cumulative weights (angles at the light).
+  std::vector<std::vector<EdgeCandidate>> shadow_candidates;
+  std::vector<std::vector<double>> shadow_cumulative;
+};
+
+SecondaryEdges BuildSecondaryEdges(const RenderScene& scene, const ViewSetup& view,
+                                   const RenderOptions& options, bool environment,
+                                   int max_segments) {
+  SecondaryEdges out;
+  out.environment = environment && options.effects.shadows;
+  double total = 0.0;
+  for (size_t e = 0; e < scene.edges().size(); ++e) {
+    const MeshEdge& edge = scene.edges()[e];
+    const double length =
+        (scene.positions()[edge.v1] - scene.positions()[edge.v0]).norm();
+    if (!(length > 0.0) || !std::isfinite(length)) continue;
+    if (edge.num_faces == 2) {
+      const Eigen::Vector3d n0 = scene.FaceNormal(edge.f0), n1 = scene.FaceNormal(edge.f1);
+      // Coplanar neighbours with the same orientation: never a silhouette nor a crease.
+      if (!n0.isZero() && !n1.isZero() && n0.dot(n1) > 1.0 - 1e-12) continue;
+    }
+    out.edges.push_back(static_cast<int>(e));
+    out.cumulative.push_back(total += length);
+  }
+  if (options.effects.shadows && max_segments > 1) {
+    for (const PointLight& light : view.point_lights) {
+      std::vector<EdgeCandidate> candidates = ShadowEdgeCandidates(scene, light.position);
+      std::vector<double> cumulative;
+      double sum = 0.0;
+      for (const EdgeCandidate& c : candidates) cumulative.push_back(sum += c.weight);
+      out.shadow_candidates.push_back(std::move(candidates));
+      out.shadow_cumulative.push_back(std::move(cumulative));
+    }
+  }
+  return out;
+}
+
+// The two side directions ω ∓ εm (index 0: −) of a curve point in direction ω (unit) at
+// distance r from x, and the curve's unit normal m given its tangent dω/ds (false when
+// degenerate).
+bool SphereSides(const Eigen::Vector3d& omega, const Eigen::Vector3d& d_omega_ds, double r,
+                 double extent, Eigen::Vector3d* m, Eigen::Vector3d sides[2], double* speed) {
+  *speed = d_omega_ds.norm();
+  if (!(*speed > 0.0) || !std::isfinite(*speed)) return false;
+  *m = omega.cross(d_omega_ds / *speed);
+  const double eps = kSecondarySideOffset * extent / r;
+  if (!std::isfinite(eps)) return false;
+  sides[0] = (omega - eps * *m).normalized();
+  sides[1] = (omega + eps * *m).normalized();
+  return true;
+}
+
+void AddSecondaryEdgeSamples(const Context& ctx, const Sampler& path_sampler, int depth, int face,
+                             const Eigen::Vector3d& throughput, const Eigen::Vector3d& x,
+                             const Eigen::Vector3d& n, const Eigen::Vector3d& wo,
+                             const BsdfParams& params, PathDerivatives* path, RenderStats* stats) {
+  const SecondaryEdges& secondary = *ctx.secondary;
+  const RenderScene& scene = ctx.scene;
+  const bool lit_here = depth > 0 || ctx.options.effects.direct;
+  const bool environment = secondary.environment && lit_here && ctx.environment != nullptr;
+  const bool indirect = depth + 1 < ctx.max_segments;
+  if (!environment && !indirect) return;
+  const int num_samples = ctx.request->secondary_edge_samples;
+  const double offset = RayOffset(ctx, x);
+  const double extent = scene.extent();
+  const auto& positions = scene.positions();
+  // g(ω) = f·(n·ω)·L_in for the incoming radiance `l_in` along ω (0 below the horizon).
+  auto integrand = [&](const Eigen::Vector3d& omega, const Eigen::Vector3d& l_in) {
+    const double cosine = n.dot(omega);
+    if (!(cosine > 0.0)) return Eigen::Vector3d::Zero().eval();
+    return (EvalBsdf(params, n, wo, omega).cwiseProduct(l_in) * cosine).eval();
+  };
+  for (int i = 0; i < num_samples; ++i) {
+    Sampler sampler = path_sampler.Fork(kSecondaryEdgeKey + 64 * static_cast<uint64_t>(depth) + i);
+    double u1, u2, u3, u4;
+    sampler.Next2D(&u1, &u2);
+    sampler.Next2D(&u3, &u4);
+
+    // (A) Silhouettes (and creases) of mesh edges seen from x.
+    if (!secondary.edges.empty()) {
+      const int c = PickCandidate(secondary.cumulative, u1);
+      const double weight = secondary.cumulative[c] - (c > 0 ? secondary.cumulative[c - 1] : 0.0);
+      const MeshEdge& edge = scene.edges()[secondary.edges[c]];
+      const Eigen::Vector3d& a = positions[edge.v0];
+      const Eigen::Vector3d& b = positions[edge.v1];
+      const Eigen::Vector3d y = a + u2 * (b - a);
+      const Eigen::Vector3d to_y = y - x;
+      const double r = to_y.norm();
+      const Eigen::Vector3d omega = to_y / r;
+      if (edge.f0 != face && edge.f1 != face && r > offset && n.dot(omega) > 0.0 &&
+          IsDiscontinuityEdge(scene, edge, x, /*creases=*/indirect)) {
+        const Eigen::Matrix3d tangent_projection =
+            (Eigen::Matrix3d::Identity() - omega * omega.transpose()) / r;
+        Eigen::Vector3d m, sides[2];
+        double speed;
+        if (SphereSides(omega, tangent_projection * (b - a), r, extent, &m, sides, &speed)) {
+          RayHit hits[2];
+          for (int k = 0; k < 2; ++k) hits[k] = scene.Intersect(x, sides[k], offset, kInfinity);
+          stats->bounce_rays += 2;
+          const bool same = hits[0].hit == hits[1].hit &&
+                            (!hits[0].hit || hits[0].face == hits[1].face);
+          if (!same && (indirect || !hits[0].hit || !hits[1].hit)) {
+            Eigen::Vector3d g[2];
+            for (int k = 0; k < 2; ++k) {
+              Eigen::Vector3d l_in = Eigen::Vector3d::Zero();
+              if (!hits[k].hit) {
+                if (environment) {
+                  l_in = ctx.view.environment_scale * ctx.environment->Radiance(sides[k]);
+                }
+              } else if (indirect) {
+                Sampler copy = sampler;
+                l_in = TraceRadiance(ctx, &copy, sides[k], hits[k], stats, nullptr, depth + 1);
+              }
+              g[k] = integrand(sides[k], l_in);
+            }
+            const Eigen::Vector3d jump = g[0] - g[1];
+            if (!jump.isZero() && jump.allFinite()) {
+              const double inv_pdf = secondary.cumulative.back() / weight / num_samples;
+              const Eigen::Vector3d m_row = m / r;  // m·∂ω/∂y.
+              const int vertices[2] = {edge.v0, edge.v1};
+              const Eigen::Vector3d rows[2] = {(1.0 - u2) * m_row, u2 * m_row};
+              path->AddBoundary(throughput.cwiseProduct(jump) * (speed * inv_pdf), vertices, rows,
+                                2, -m_row);
+            }
+          }
+        }
+      }
+    }
+
+    // (B) Point-light shadow boundaries on the surfaces a further bounce sees.
+    const int num_lights = static_cast<int>(secondary.shadow_candidates.size());
+    if (indirect && num_lights > 0) {
+      const int l = std::min(static_cast<int>(u3 * num_lights), num_lights - 1);
+      const std::vector<double>& cumulative = secondary.shadow_cumulative[l];
+      if (cumulative.empty()) continue;
+      // Reuse u3's fraction within the light's slot for the edge choice.
+      const double u_edge = u3 * num_lights - l;
+      const int c = PickCandidate(cumulative, u_edge);
+      const EdgeCandidate& candidate = secondary.shadow_candidates[l][c];
+      const MeshEdge& edge = scene.edges()[candidate.edge];
+      const PointLight& light = ctx.view.point_lights[l];
+      ShadowPoint shadow;
+      if (!CastShadowPoint(ctx, light.position, edge, u4, stats, &shadow)) continue;
+      if (shadow.receiver == face) continue;
+      const Eigen::Vector3d to_y = shadow.y - x;
+      const double r = to_y.norm();
+      const Eigen::Vector3d omega = to_y / r;
+      if (!(r > offset) || !(n.dot(omega) > 0.0)) continue;
+      const Eigen::Matrix3d tangent_projection =
+          (Eigen::Matrix3d::Identity() - omega * omega.transpose()) / r;
+      Eigen::Vector3d m, sides[2];
+      double speed;
+      if (!SphereSides(omega,
+                       tangent_projection * shadow.d_y_d_point *
+                           (positions[edge.v1] - positions[edge.v0]),
+                       r, extent, &m, sides, &speed)) {
+        continue;
+      }
+      Eigen::Vector3d direct[2];
+      bool seen = true;
+      for (int k = 0; k < 2 && seen; ++k) {
+        seen = DirectAtReceiver(ctx, light, x, sides[k], offset, shadow.receiver, stats,
+                                &direct[k]);
+      }
+      if (!seen) continue;
+      const Eigen::Vector3d jump = integrand(sides[0], direct[0]) - integrand(sides[1], direct[1]);
+      if (jump.isZero() || !jump.allFinite()) continue;
+      const double inv_pdf = num_lights * cumulative.back() / candidate.weight / num_samples;
+      const Eigen::Vector3d m_row = m / r;
+      const Eigen::Vector3d point_row = shadow.d_y_d_point.transpose() * m_row;
+      const Eigen::Vector3d receiver_row = shadow.along.transpose() * m_row;
+      const Eigen::Vector3i& corners = scene.faces()[shadow.receiver];
+      const int vertices[5] = {edge.v0, edge.v1, corners[0], corners[1], corners[2]};
+      const Eigen::Vector3d rows[5] = {(1.0 - u4) * point_row, u4 * point_row,
+                                       shadow.barycentrics[0] * receiver_row,
+                                       shadow.barycentrics[1] * receiver_row,
+                                       shadow.barycentrics[2] * receiver_row};
+      path->AddBoundary(throughput.cwiseProduct(jump) * (speed * inv_pdf), vertices, rows, 5,
+                        -m_row);
+    }
+  }
 }
 
 // Appends the entries jump·(row_j·∂q/∂vertex_j) for the moving vertices of one sample.
@@ -917,63 +1240,34 @@ void AddEdgeTerms(const Context& ctx, std::vector<DerivativeList>* pixel_lists,
   if (shadow_ratio > 0.0 && options.effects.shadows && options.effects.direct) {
     for (size_t l = 0; l < view.point_lights.size(); ++l) {
       const Eigen::Vector3d light = view.point_lights[l].position;
-      std::vector<EdgeCandidate> candidates;
-      for (size_t e = 0; e < edges.size(); ++e) {
-        const MeshEdge& edge = edges[e];
-        const Eigen::Vector3d a = positions[edge.v0] - light, b = positions[edge.v1] - light;
-        if (a == b || !IsDiscontinuityEdge(scene, edge, light, /*creases=*/false)) continue;
-        const double angle = std::atan2(a.cross(b).norm(), a.dot(b));
-        if (!(angle > 0.0) || !std::isfinite(angle)) continue;
-        candidates.push_back({static_cast<int>(e), 0.0, 1.0, angle});
-      }
+      const std::vector<EdgeCandidate> candidates = ShadowEdgeCandidates(scene, light);
       const auto sample_shadow = [&](const EdgeCandidate& candidate, double s, double inv_pdf,
-                                     const Sampler& sampler, std::vector<EdgeEntry>* out) {
+                                     const Sampler& /*sampler*/, std::vector<EdgeEntry>* out) {
         RenderStats& local = thread_stats.local();
         const MeshEdge& edge = edges[candidate.edge];
-        const Eigen::Vector3d& a = positions[edge.v0];
-        const Eigen::Vector3d& b = positions[edge.v1];
-        const Eigen::Vector3d point = a + s * (b - a);
-        const Eigen::Vector3d d = point - light;
-        const double dist = d.norm();
-        if (!(dist > kMinRelativeLightDistance * scene.extent())) return;
-        const Eigen::Vector3d dir = d / dist;
-        const double offset = SurfaceRayOffset(scene, point);
-        // The light must reach the edge, and the ray grazing it must land on a receiver.
-        ++local.shadow_rays;
-        if (scene.Occluded(light, dir, 0.0, dist - offset)) return;
-        ++local.shadow_rays;
-        const RayHit hit = scene.Intersect(point, dir, offset, kInfinity);
-        if (!hit.hit || hit.face == edge.f0 || hit.face == edge.f1) return;
-        const Eigen::Vector3d n_r = scene.FaceNormal(hit.face);
-        const double cosine = n_r.dot(dir);
-        if (!(std::abs(cosine) > kMinHitCosine)) return;
-        const Eigen::Vector3d y = scene.Point(hit.face, hit.u, hit.v);
+        ShadowPoint shadow;
+        if (!CastShadowPoint(ctx, light, edge, s, &local, &shadow)) return;
         Eigen::Vector2d q;
         Eigen::Matrix<double, 2, 3> d_q;
         int pixel;
-        if (!project(y, &q, &d_q, &pixel)) return;
-
-        // y = light + τ·d on the receiver's plane, τ = (dist + t)/dist:
-        //   ∂y/∂point = τ(I − d n_rᵀ/(n_r·d)),  ∂y/∂p_j = b_j·d n_rᵀ/(n_r·d) (receiver corners).
-        const double tau = (dist + hit.t) / dist;
-        const Eigen::Matrix3d along = dir * n_r.transpose() / cosine;
-        const Eigen::Matrix3d d_y_d_point = tau * (Eigen::Matrix3d::Identity() - along);
-        const Eigen::Vector2d tangent = d_q * d_y_d_point * (b - a);
+        if (!project(shadow.y, &q, &d_q, &pixel)) return;
+        const Eigen::Vector2d tangent =
+            d_q * shadow.d_y_d_point * (positions[edge.v1] - positions[edge.v0]);
         const double speed = tangent.norm();
         if (!(speed > 0.0) || !std::isfinite(speed)) return;
         const Eigen::Vector2d m(-tangent.y() / speed, tangent.x() / speed);
         const Eigen::Vector3d jump = ShadowJump(ctx, world_from_cam_rotation, center,
-                                                view.point_lights[l], hit.face, q, m, &local);
+                                                view.point_lights[l], shadow.receiver, q, m, &local);
         if (jump.isZero()) return;
         const Eigen::Vector3d m_row = d_q.transpose() * m;  // m·∂q/∂y
-        const Eigen::Vector3d point_row = d_y_d_point.transpose() * m_row;
-        const Eigen::Vector3d receiver_row = along.transpose() * m_row;
-        const Eigen::Vector3i& corners = scene.faces()[hit.face];
-        const double barycentrics[3] = {1.0 - hit.u - hit.v, hit.u, hit.v};
+        const Eigen::Vector3d point_row = shadow.d_y_d_point.transpose() * m_row;
+        const Eigen::Vector3d receiver_row = shadow.along.transpose() * m_row;
+        const Eigen::Vector3i& corners = scene.faces()[shadow.receiver];
         const int vertices[5] = {edge.v0, edge.v1, corners[0], corners[1], corners[2]};
-        const Eigen::Vector3d rows[5] = {
-            (1.0 - s) * point_row, s * point_row, barycentrics[0] * receiver_row,
-            barycentrics[1] * receiver_row, barycentrics[2] * receiver_row};
+        const Eigen::Vector3d rows[5] = {(1.0 - s) * point_row, s * point_row,
+                                         shadow.barycentrics[0] * receiver_row,
+                                         shadow.barycentrics[1] * receiver_row,
+                                         shadow.barycentrics[2] * receiver_row};
         EmitBoundary(pixel, jump, speed * inv_pdf * options.spp, vertices, rows, 5, out);
       };
       const int64_t num_samples =
@@ -998,16 +1292,26 @@ void RenderImpl(const RenderScene& scene, const Material& material, const ViewSe
                 const ParameterLayout* layout, Image* image, DerivativeOutput* output,
                 RenderStats* stats) {
   const auto start = std::chrono::steady_clock::now();
+  const EnvironmentMap* environment = options.effects.environment ? view.environment : nullptr;
+  const int max_segments = options.effects.bounces ? options.bounces : 1;
+  std::optional<SecondaryEdges> secondary;
+  if (request != nullptr && (request->jacobian_rows || request->adjoint_weights != nullptr) &&
+      request->params.vertices && options.pass == RenderPass::kColor &&
+      request->secondary_edge_samples > 0 &&
+      ((environment != nullptr && options.effects.shadows) || max_segments > 1)) {
+    secondary = BuildSecondaryEdges(scene, view, options, environment != nullptr, max_segments);
+  }
   const Context ctx{scene,
                     material,
                     options.sampling_material != nullptr ? *options.sampling_material : material,
                     view,
                     options,
-                    options.effects.environment ? view.environment : nullptr,
-                    options.effects.bounces ? options.bounces : 1,
+                    environment,
+                    max_segments,
                     options.effects.specular ? 1.0 : 0.0,
                     request,
-                    layout};
+                    layout,
+                    secondary ? &*secondary : nullptr};
   const int width = view.camera.width;
   const int height = view.camera.height;
   *image = Image(width, height, 4);

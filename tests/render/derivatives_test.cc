@@ -256,6 +256,12 @@ TEST(DerivativeRequestTest, VertexDerivativesAndEdgeRatios) {
     EXPECT_FALSE(shadow.Check(&why)) << bad;
     EXPECT_NE(why.find("shadow_edge_ratio"), std::string::npos) << why;
   }
+  for (int bad : {-1, 17}) {
+    DerivativeRequest secondary = request;
+    secondary.secondary_edge_samples = bad;
+    EXPECT_FALSE(secondary.Check(&why)) << bad;
+    EXPECT_NE(why.find("secondary_edge_samples"), std::string::npos) << why;
+  }
 }
 
 }  // namespace
