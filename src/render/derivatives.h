@@ -116,7 +116,7 @@ struct DerivativeRequest {
   // boundaries seen through a bounce. Each sample picks one mesh edge (∝ length) and, with point
   // lights, one shadow-casting edge point; most are rejected by cheap tests. Range [0, 16]; 0
   // turns them off.
-  int secondary_edge_samples = 4;
+  int secondary_edge_samples = 1;
 
   // True when valid; else *why names the field.
   bool Check(std::string* why) const;
