@@ -94,7 +94,8 @@ bool ParameterSelection::Selected(ParameterKind kind) const {
 bool DerivativeRequest::Check(std::string* why) const {
   for (const auto& [name, ratio] :
        {std::pair<const char*, double>{"primary_edge_ratio", primary_edge_ratio},
-        std::pair<const char*, double>{"shadow_edge_ratio", shadow_edge_ratio}}) {
+        std::pair<const char*, double>{"shadow_edge_ratio", shadow_edge_ratio},
+        std::pair<const char*, double>{"texel_edge_ratio", texel_edge_ratio}}) {
     if (!(ratio >= 0.0 && ratio <= 16.0)) {
       *why = std::string(name) + ": must be in [0, 16], got " + std::to_string(ratio);
       return false;

@@ -626,14 +626,19 @@ namespace {
 //     silhouettes (adjacent faces facing opposite ways from the camera), boundary and
 //     non-manifold edges, and creases (flat shading: any edge whose faces are not coplanar);
 //   shadow edges: the shadow that a silhouette edge as seen from a point light casts on the
-//     first surface behind it, as seen by the camera (the receiver's motion included).
+//     first surface behind it, as seen by the camera (the receiver's motion included);
+//   texel boundaries: where the mesh-colors albedo or roughness differs on the two sides of a
+//     texel grid line inside a face (α or β = k/r) or of an edge between coplanar faces (not a
+//     primary edge). The points y = Σ_k b_k·p_k of such a line have fixed barycentrics b, so
+//     ∂y/∂p_k = b_k·I, and the jump is that of the full paths across the line.
 // Sampling: a curve is chosen with probability ∝ its length (projected length for primary
-// edges, angle subtended at the light for shadow edges), a point uniformly in its parameter s;
-// the estimator is ΔL·(m·∂q/∂θ)·|dq/ds|/pdf, credited to the pixel holding q. Both sides are
-// traced with the same random numbers, so away from a real jump ΔL is (nearly) zero.
-// Not handled (documented in derivatives.h): jumps seen through a bounce (shadows or silhouettes
-// in reflections), occlusion of the environment light and of indirect light (Li et al.'s
-// secondary edges for hemispherical integrals), texel boundaries of the albedo/roughness.
+// edges, angle subtended at the light for shadow edges, projected length × the size of the
+// material jump for texel boundaries), a point uniformly in its parameter s; the estimator is
+// ΔL·(m·∂q/∂θ)·|dq/ds|/pdf, credited to the pixel holding q. Both sides are traced with the same
+// random numbers, so away from a real jump ΔL is (nearly) zero.
+// Not handled (documented in derivatives.h): jumps seen through a bounce (shadows, silhouettes or
+// texel boundaries in reflections), occlusion of the environment light and of indirect light (Li
+// et al.'s secondary edges for hemispherical integrals).
 
 // Sides of an edge point are traced this far from it (pixels).
 constexpr double kEdgeSideOffset = 1e-3;
@@ -642,6 +647,10 @@ constexpr int kEdgeChunk = 1024;
 // Sample streams of edge samples are told apart from pixel samples by this key.
 constexpr uint64_t kPrimaryEdgeKey = 0xE1D6E00000000000ull;
 constexpr uint64_t kShadowEdgeKey = 0xE1D6500000000000ull;
+constexpr uint64_t kTexelEdgeKey = 0xE1D6700000000000ull;
+// Texel look-ups either side of a texel boundary are made this far from it (barycentric units;
+// far above MeshColors' lattice snap of 1e-9 texels, far below a texel).
+constexpr double kTexelSideOffset = 1e-6;
 
 // One boundary-term contribution: pixel, parameter, ∂RGB (already divided by the sample count).
 struct EdgeEntry {
@@ -653,6 +662,16 @@ struct EdgeEntry {
 // A curve to sample: mesh edge `edge` over the parameter range [s0, s1], with sampling weight.
 struct EdgeCandidate {
   int edge;
+  double s0, s1;
+  double weight;
+};
+
+// A texel boundary segment to sample: the points Σ_k b_k(s)·p_k of face `face` (corners p_k),
+// b(s) = b0 + s·(b1 − b0), over s ∈ [s0, s1] (the part in view); `other` is the face across it
+// (`face` itself for a grid line inside the face, the neighbour for a coplanar mesh edge).
+struct TexelCandidate {
+  int face, other;
+  Eigen::Vector3d b0, b1;
   double s0, s1;
   double weight;
 };
@@ -759,6 +778,30 @@ double PrimaryEdgeImportance(const RenderScene& scene, const MeshEdge& edge,
   return std::clamp((n0 - n1).norm(), 1.0 / 16.0, 1.0);
 }
 
+// The camera rays through the two sides q ∓ εm of a curve point and their first hits.
+void TraceSides(const Context& ctx, const Eigen::Matrix3d& world_from_cam_rotation,
+                const Eigen::Vector3d& center, const Eigen::Vector2d& q, const Eigen::Vector2d& m,
+                Eigen::Vector3d dirs[2], RayHit hits[2], RenderStats* stats) {
+  SideDirections(ctx, world_from_cam_rotation, q, m, dirs);
+  for (int i = 0; i < 2; ++i) hits[i] = ctx.scene.Intersect(center, dirs[i], 0.0, kInfinity);
+  stats->camera_rays += 2;
+}
+
+// L(q − εm) − L(q + εm) from the full camera paths through the two side rays, traced with the
+// same random numbers on both sides so that only the jump remains. Zero when a side's radiance
+// is not finite.
+Eigen::Vector3d SideRadianceJump(const Context& ctx, const Eigen::Vector3d dirs[2],
+                                 const RayHit hits[2], const Sampler& sampler, RenderStats* stats) {
+  Eigen::Vector3d jump = Eigen::Vector3d::Zero();
+  for (int i = 0; i < 2; ++i) {
+    Sampler copy = sampler;
+    const Eigen::Vector3d radiance = TraceRadiance(ctx, &copy, dirs[i], hits[i], stats, nullptr);
+    if (!radiance.allFinite()) return Eigen::Vector3d::Zero();
+    jump += i == 0 ? radiance : -radiance;
+  }
+  return jump;
+}
+
 // Relative depth margin by which a surface must lie in front of an edge's own face, along a side
 // ray, to count as hiding the edge (not just float noise of Embree's single-precision t).
 constexpr double kEdgeOcclusionMargin = 1e-5;
@@ -828,10 +871,8 @@ Eigen::Vector3d PrimaryJump(const Context& ctx, const Eigen::Matrix3d& world_fro
                             const Eigen::Vector2d& q, const Eigen::Vector2d& m,
                             const Sampler& sampler, RenderStats* stats) {
   Eigen::Vector3d dirs[2];
-  SideDirections(ctx, world_from_cam_rotation, q, m, dirs);
   RayHit hits[2];
-  for (int i = 0; i < 2; ++i) hits[i] = ctx.scene.Intersect(center, dirs[i], 0.0, kInfinity);
-  stats->camera_rays += 2;
+  TraceSides(ctx, world_from_cam_rotation, center, q, m, dirs, hits, stats);
   for (int i = 0; i < 2; ++i) {
     RayHit own;
     if (!EdgeFaceHit(ctx.scene, edge, center, dirs[i], &own)) continue;
@@ -845,14 +886,70 @@ Eigen::Vector3d PrimaryJump(const Context& ctx, const Eigen::Matrix3d& world_fro
   if (hits[0].hit == hits[1].hit && (!hits[0].hit || hits[0].face == hits[1].face)) {
     return Eigen::Vector3d::Zero();
   }
-  Eigen::Vector3d jump = Eigen::Vector3d::Zero();
-  for (int i = 0; i < 2; ++i) {
-    Sampler copy = sampler;
-    const Eigen::Vector3d radiance = TraceRadiance(ctx, &copy, dirs[i], hits[i], stats, nullptr);
-    if (!radiance.allFinite()) return Eigen::Vector3d::Zero();
-    jump += i == 0 ? radiance : -radiance;
+  return SideRadianceJump(ctx, dirs, hits, sampler, stats);
+}
+
+// L(q − εm) − L(q + εm) across a texel boundary between faces `face_a` and `face_b` (equal for a
+// grid line inside a face). Zero without tracing paths unless the two sides see these faces, one
+// each: otherwise the boundary is hidden at q, or q is where it meets a face border (where the
+// primary edge term, if any, takes over).
+Eigen::Vector3d TexelJump(const Context& ctx, const Eigen::Matrix3d& world_from_cam_rotation,
+                          const Eigen::Vector3d& center, const Eigen::Vector2d& q,
+                          const Eigen::Vector2d& m, int face_a, int face_b, const Sampler& sampler,
+                          RenderStats* stats) {
+  Eigen::Vector3d dirs[2];
+  RayHit hits[2];
+  TraceSides(ctx, world_from_cam_rotation, center, q, m, dirs, hits, stats);
+  if (!hits[0].hit || !hits[1].hit) return Eigen::Vector3d::Zero();
+  const bool seen = (hits[0].face == face_a && hits[1].face == face_b) ||
+                    (hits[0].face == face_b && hits[1].face == face_a);
+  if (!seen) return Eigen::Vector3d::Zero();
+  return SideRadianceJump(ctx, dirs, hits, sampler, stats);
+}
+
+// Interior lines k/r (0 < k < r) of the albedo and the roughness texel grids, sorted; a line of
+// both grids (equal fractions) appears once.
+std::vector<double> TexelGridLines(const Material& material) {
+  std::vector<double> lines;
+  for (const int r : {material.albedo.resolution(), material.roughness.resolution()}) {
+    for (int k = 1; k < r; ++k) lines.push_back(static_cast<double>(k) / r);
   }
-  return jump;
+  std::sort(lines.begin(), lines.end());
+  // Distinct fractions k/r ≠ k'/r' differ by at least 1/(r·r'), far above 1e-9.
+  lines.erase(
+      std::unique(lines.begin(), lines.end(), [](double a, double b) { return b - a < 1e-9; }),
+      lines.end());
+  return lines;
+}
+
+// Whether the texels of `face` are not all equal.
+bool FaceTexelsVary(const MeshColors& colors, int face) {
+  const int n = MeshColors::TexelsPerFace(colors.resolution());
+  const double* first = colors.texel(face * n);
+  for (int k = 1; k < n; ++k) {
+    const double* texel = colors.texel(face * n + k);
+    for (int c = 0; c < colors.channels(); ++c) {
+      if (texel[c] != first[c]) return true;
+    }
+  }
+  return false;
+}
+
+// Size of the material jump between the barycentric points ab_a of face_a and ab_b of face_b:
+// the mean absolute albedo difference over RGB plus, when the glossy lobe is on, the absolute
+// roughness difference (without it roughness changes nothing). Zero when the two points look
+// the same. It only weights the sampling (the pdf accounts for it), so any scale will do.
+double MaterialJump(const Material& material, bool glossy, int face_a, const Eigen::Vector2d& ab_a,
+                    int face_b, const Eigen::Vector2d& ab_b) {
+  const double* a = material.albedo.texel(material.albedo.TexelIndex(face_a, ab_a.x(), ab_a.y()));
+  const double* b = material.albedo.texel(material.albedo.TexelIndex(face_b, ab_b.x(), ab_b.y()));
+  double size = (std::abs(a[0] - b[0]) + std::abs(a[1] - b[1]) + std::abs(a[2] - b[2])) / 3.0;
+  if (glossy) {
+    size += std::abs(
+        *material.roughness.texel(material.roughness.TexelIndex(face_a, ab_a.x(), ab_a.y())) -
+        *material.roughness.texel(material.roughness.TexelIndex(face_b, ab_b.x(), ab_b.y())));
+  }
+  return std::isfinite(size) ? size : 0.0;
 }
 
 // The direct term of point light `light`, shadow ray included, at the first hit of the ray from
@@ -1186,8 +1283,8 @@ void EmitBoundary(int pixel, const Eigen::Vector3d& jump, double scale, const in
 
 // Draws `num_samples` samples over the candidates in parallel chunks and returns the entries in
 // chunk order. `sample_one(candidate, s, sampler, out)` evaluates one sample at parameter s.
-template <typename SampleOne>
-void SampleCandidates(const RenderOptions& options, const std::vector<EdgeCandidate>& candidates,
+template <typename Candidate, typename SampleOne>
+void SampleCandidates(const RenderOptions& options, const std::vector<Candidate>& candidates,
                       int64_t num_samples, uint64_t key, uint64_t view_index,
                       const SampleOne& sample_one, std::vector<EdgeEntry>* entries) {
   if (candidates.empty() || num_samples <= 0) return;
@@ -1211,7 +1308,7 @@ void SampleCandidates(const RenderOptions& options, const std::vector<EdgeCandid
         // quadrature rather than like independent Monte Carlo).
         const double u = (static_cast<double>(i) + sampler.Next1D()) / num_samples;
         const int c = PickCandidate(cumulative, u);
-        const EdgeCandidate& candidate = candidates[c];
+        const Candidate& candidate = candidates[c];
         const double before = c > 0 ? cumulative[c - 1] : 0.0;
         const double local = std::clamp((u * total - before) / candidate.weight, 0.0, 1.0);
         const double s = candidate.s0 + local * (candidate.s1 - candidate.s0);
@@ -1225,8 +1322,8 @@ void SampleCandidates(const RenderOptions& options, const std::vector<EdgeCandid
   for (const auto& chunk : chunks) entries->insert(entries->end(), chunk.begin(), chunk.end());
 }
 
-// Boundary terms of one view (primary and point-light shadow edges), pixel-major lists of
-// entries scaled for MergeDerivatives' 1/spp.
+// Boundary terms of one view (primary edges, point-light shadow edges, texel boundaries),
+// pixel-major lists of entries scaled for MergeDerivatives' 1/spp.
 void AddEdgeTerms(const Context& ctx, std::vector<DerivativeList>* pixel_lists,
                   RenderStats* stats) {
   const RenderScene& scene = ctx.scene;
@@ -1240,6 +1337,7 @@ void AddEdgeTerms(const Context& ctx, std::vector<DerivativeList>* pixel_lists,
   const Eigen::Matrix3d cam_from_world_rotation = world_from_cam_rotation.transpose();
   const auto& positions = scene.positions();
   const auto& edges = scene.edges();
+  const auto& faces = scene.faces();
   const double pixels = static_cast<double>(camera.width) * camera.height;
   std::vector<EdgeEntry> entries;
   tbb::enumerable_thread_specific<RenderStats> thread_stats;
@@ -1258,11 +1356,12 @@ void AddEdgeTerms(const Context& ctx, std::vector<DerivativeList>* pixel_lists,
     return true;
   };
 
-  // Primary edges.
   const double primary_ratio = request.primary_edge_ratio;
   const double shadow_ratio = request.shadow_edge_ratio;
+  const double texel_ratio = request.texel_edge_ratio;
+  const FrustumBounds frustum = ViewFrustum(ctx);
+  // Primary edges.
   if (primary_ratio > 0.0) {
-    const FrustumBounds frustum = ViewFrustum(ctx);
     std::vector<EdgeCandidate> candidates;
     for (size_t e = 0; e < edges.size(); ++e) {
       const MeshEdge& edge = edges[e];
@@ -1347,6 +1446,137 @@ void AddEdgeTerms(const Context& ctx, std::vector<DerivativeList>* pixel_lists,
       SampleCandidates(options, candidates, num_samples, kShadowEdgeKey + (l << 40),
                        view.view_index, sample_shadow, &entries);
     }
+  }
+
+  // Texel boundaries seen directly.
+  if (texel_ratio > 0.0) {
+    const Material& material = ctx.material;
+    const bool glossy = material.specular * ctx.specular_scale > 0.0;
+    const std::vector<double> lines = TexelGridLines(material);
+    std::vector<TexelCandidate> candidates;
+    // Adds the segment of `face` from barycentrics b0 to b1 (over its corners), clipped to the
+    // view, weighted by projected length × material jump `size`.
+    auto add_segment = [&](int face, int other, const Eigen::Vector3d& b0,
+                           const Eigen::Vector3d& b1, double size) {
+      const Eigen::Vector3i& corners = faces[face];
+      Eigen::Vector3d y0 = Eigen::Vector3d::Zero(), y1 = Eigen::Vector3d::Zero();
+      for (int k = 0; k < 3; ++k) {
+        y0 += b0[k] * positions[corners[k]];
+        y1 += b1[k] * positions[corners[k]];
+      }
+      const Eigen::Vector3d a_cam = view.cam_from_world * y0, b_cam = view.cam_from_world * y1;
+      double s0, s1;
+      if (!ClipSegment(a_cam, b_cam, frustum, &s0, &s1)) return;
+      const Eigen::Vector2d q0 = camera.ImageFromCam(a_cam + s0 * (b_cam - a_cam));
+      const Eigen::Vector2d q1 = camera.ImageFromCam(a_cam + s1 * (b_cam - a_cam));
+      const double weight = (q1 - q0).norm() * size;
+      if (!(weight > 0.0) || !std::isfinite(weight)) return;
+      candidates.push_back({face, other, b0, b1, s0, s1, weight});
+    };
+    auto barycentrics = [](double alpha, double beta) {
+      return Eigen::Vector3d(1.0 - alpha - beta, alpha, beta);
+    };
+    // Grid lines inside the faces: α = a (axis 0) or β = a (axis 1), the other coordinate t over
+    // [0, 1 − a], cut where the other grid lines cross so that each piece separates two texels.
+    std::vector<double> cuts;
+    for (size_t f = 0; f < faces.size() && !lines.empty(); ++f) {
+      const int face = static_cast<int>(f);
+      if (scene.FaceNormal(face).isZero()) continue;
+      if (!FaceTexelsVary(material.albedo, face) &&
+          !(glossy && FaceTexelsVary(material.roughness, face))) {
+        continue;
+      }
+      for (const double a : lines) {
+        const double extent = 1.0 - a;
+        cuts.assign(1, 0.0);
+        for (const double c : lines) {
+          if (c < extent - 1e-9) cuts.push_back(c);  // lines ending on this one: not a cut.
+        }
+        cuts.push_back(extent);
+        for (int axis = 0; axis < 2; ++axis) {
+          // (α, β) of the point at distance `across` from the line's axis and `along` it.
+          auto ab = [axis](double across, double along) {
+            return axis == 0 ? Eigen::Vector2d(across, along) : Eigen::Vector2d(along, across);
+          };
+          for (size_t k = 0; k + 1 < cuts.size(); ++k) {
+            const double mid = 0.5 * (cuts[k] + cuts[k + 1]);
+            const double size = MaterialJump(material, glossy, face, ab(a - kTexelSideOffset, mid),
+                                             face, ab(a + kTexelSideOffset, mid));
+            if (!(size > 0.0)) continue;
+            const Eigen::Vector2d from = ab(a, cuts[k]), to = ab(a, cuts[k + 1]);
+            add_segment(face, face, barycentrics(from.x(), from.y()), barycentrics(to.x(), to.y()),
+                        size);
+          }
+        }
+      }
+    }
+    // Edges between coplanar faces (the others are primary edges, whose jump includes the
+    // material's), cut at the grid lines' crossings t = k/r (the same on every edge).
+    cuts.assign(1, 0.0);
+    cuts.insert(cuts.end(), lines.begin(), lines.end());
+    cuts.push_back(1.0);
+    for (const MeshEdge& edge : edges) {
+      if (edge.num_faces != 2 || positions[edge.v0] == positions[edge.v1] ||
+          IsDiscontinuityEdge(scene, edge, center, /*creases=*/true)) {
+        continue;
+      }
+      // Per face (0: f0, 1: f1): the barycentric unit vectors of the edge's ends and of the
+      // opposite corner.
+      const int side_faces[2] = {edge.f0, edge.f1};
+      Eigen::Vector3d end0[2], end1[2], opposite[2];
+      for (int i = 0; i < 2; ++i) {
+        const Eigen::Vector3i& corners = faces[side_faces[i]];
+        for (int k = 0; k < 3; ++k) {
+          end0[i][k] = corners[k] == edge.v0 ? 1.0 : 0.0;
+          end1[i][k] = corners[k] == edge.v1 ? 1.0 : 0.0;
+          opposite[i][k] = corners[k] != edge.v0 && corners[k] != edge.v1 ? 1.0 : 0.0;
+        }
+      }
+      for (size_t k = 0; k + 1 < cuts.size(); ++k) {
+        const double mid = 0.5 * (cuts[k] + cuts[k + 1]);
+        Eigen::Vector2d ab[2];
+        for (int i = 0; i < 2; ++i) {
+          // The edge point, moved slightly into face i so that it looks up that face's texel.
+          const Eigen::Vector3d b =
+              (1.0 - kTexelSideOffset) * ((1.0 - mid) * end0[i] + mid * end1[i]) +
+              kTexelSideOffset * opposite[i];
+          ab[i] = Eigen::Vector2d(b[1], b[2]);
+        }
+        const double size = MaterialJump(material, glossy, edge.f0, ab[0], edge.f1, ab[1]);
+        if (!(size > 0.0)) continue;
+        add_segment(edge.f0, edge.f1, (1.0 - cuts[k]) * end0[0] + cuts[k] * end1[0],
+                    (1.0 - cuts[k + 1]) * end0[0] + cuts[k + 1] * end1[0], size);
+      }
+    }
+    const auto sample_texel = [&](const TexelCandidate& candidate, double s, double inv_pdf,
+                                  const Sampler& sampler, std::vector<EdgeEntry>* out) {
+      RenderStats& local = thread_stats.local();
+      const Eigen::Vector3i& corners = faces[candidate.face];
+      const Eigen::Vector3d b = candidate.b0 + s * (candidate.b1 - candidate.b0);
+      const Eigen::Vector3d db_ds = candidate.b1 - candidate.b0;
+      Eigen::Vector3d y = Eigen::Vector3d::Zero(), dy_ds = Eigen::Vector3d::Zero();
+      for (int k = 0; k < 3; ++k) {
+        y += b[k] * positions[corners[k]];
+        dy_ds += db_ds[k] * positions[corners[k]];
+      }
+      Eigen::Vector2d q;
+      Eigen::Matrix<double, 2, 3> d_q;
+      int pixel;
+      if (!project(y, &q, &d_q, &pixel)) return;
+      const Eigen::Vector2d tangent = d_q * dy_ds;  // dq/ds
+      const double speed = tangent.norm();
+      if (!(speed > 0.0) || !std::isfinite(speed)) return;
+      const Eigen::Vector2d m(-tangent.y() / speed, tangent.x() / speed);
+      const Eigen::Vector3d jump = TexelJump(ctx, world_from_cam_rotation, center, q, m,
+                                             candidate.face, candidate.other, sampler, &local);
+      if (jump.isZero()) return;
+      const Eigen::Vector3d m_row = d_q.transpose() * m;  // m·∂q/∂y; ∂y/∂p_k = b_k·I.
+      const Eigen::Vector3d rows[3] = {b[0] * m_row, b[1] * m_row, b[2] * m_row};
+      EmitBoundary(pixel, jump, speed * inv_pdf * options.spp, corners.data(), rows, 3, out);
+    };
+    const int64_t num_samples = static_cast<int64_t>(std::ceil(texel_ratio * options.spp * pixels));
+    SampleCandidates(options, candidates, num_samples, kTexelEdgeKey, view.view_index, sample_texel,
+                     &entries);
   }
 
   for (const EdgeEntry& entry : entries) {

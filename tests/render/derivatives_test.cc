@@ -245,6 +245,7 @@ TEST(DerivativeRequestTest, VertexDerivativesAndEdgeRatios) {
   EXPECT_TRUE(request.Check(&why)) << why;
   request.primary_edge_ratio = 0.0;  // edge terms off: allowed.
   request.shadow_edge_ratio = 16.0;  // the upper end: allowed.
+  request.texel_edge_ratio = 0.0;
   EXPECT_TRUE(request.Check(&why)) << why;
   for (double bad : {-0.5, 16.5, std::nan("")}) {
     DerivativeRequest primary = request;
@@ -255,6 +256,10 @@ TEST(DerivativeRequestTest, VertexDerivativesAndEdgeRatios) {
     shadow.shadow_edge_ratio = bad;
     EXPECT_FALSE(shadow.Check(&why)) << bad;
     EXPECT_NE(why.find("shadow_edge_ratio"), std::string::npos) << why;
+    DerivativeRequest texel = request;
+    texel.texel_edge_ratio = bad;
+    EXPECT_FALSE(texel.Check(&why)) << bad;
+    EXPECT_NE(why.find("texel_edge_ratio"), std::string::npos) << why;
   }
   for (int bad : {-1, 17}) {
     DerivativeRequest secondary = request;
