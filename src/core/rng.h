@@ -90,8 +90,8 @@ class Sampler {
   // stratified over the pixel's samples too), told apart by `key`; leaves this one untouched.
   Sampler Fork(uint64_t key) const {
     Sampler fork;
-    fork.pixel_key_ = Mix64(pixel_key_ ^ Mix64(key + (static_cast<uint64_t>(pair_) << 32) +
-                                               dimension_));
+    fork.pixel_key_ =
+        Mix64(pixel_key_ ^ Mix64(key + (static_cast<uint64_t>(pair_) << 32) + dimension_));
     fork.sample_ = sample_;
     return fork;
   }

@@ -102,8 +102,8 @@ bool DerivativeRequest::Check(std::string* why) const {
     }
   }
   if (secondary_edge_samples < 0 || secondary_edge_samples > 16) {
-    *why = "secondary_edge_samples: must be in [0, 16], got " +
-           std::to_string(secondary_edge_samples);
+    *why =
+        "secondary_edge_samples: must be in [0, 16], got " + std::to_string(secondary_edge_samples);
     return false;
   }
   if (adjoint_weights != nullptr && adjoint_weights->channels < 3) {

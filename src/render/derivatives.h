@@ -19,12 +19,20 @@
 //   vertices, boundary terms (edge sampling, render.cc): see the table.
 //
 // Vertex derivative terms present per Effects setting (✓ present, — not needed, ✗ missing):
-//   effect on      interior  primary edges     texel boundaries  point-light shadow  env/indirect
+//   effect on      interior  primary edges     texel boundaries  point-light shadow  secondary (A)
 //   direct         ✓         ✓                 ✓ seen directly   —                   —
-//   + shadows      ✓         ✓                 ✓ seen directly   ✓ seen directly     ✗ env occluded
-//   + bounces      ✓         ✓                 ✗ seen via bounce ✗ seen via bounce   ✗ (secondary)
-//   + environment  ✓         ✓ (vs background) ✓ seen directly   —                   ✗ with shadows
+//   + shadows      ✓         ✓                 ✓ seen directly   ✓ seen directly     —
+//   + bounces      ✓         ✓                 ✗ seen via bounce ✓ via bounce (B)    ✓ silhouettes,
+//                                                                                      creases
+//   + environment  ✓         ✓ (vs background) ✓ seen directly   —                   ✓ occlusion
+//                                                                                      (with
+//                                                                                      shadows)
 //   + specular     ✓         ✓                 as above          as above            as above
+// Secondary edges (render.cc, AddSecondaryEdgeSamples; secondary_edge_samples per path vertex):
+// (A) mesh edges seen from a path vertex — silhouettes against the environment (when it is lit
+// with shadows) or against farther surfaces, and creases, when a further bounce is traced;
+// (B) point-light shadow boundaries on the surface a bounce reaches. Their sampling (edges ∝
+// length, uniform in subtended angle) is unbiased but noisy on finely tessellated meshes.
 // Primary edges cover silhouettes, boundary and non-manifold edges and, because shading is flat,
 // creases between non-coplanar faces. Texel boundaries are where piecewise-constant albedo or
 // roughness (mesh colors) jumps: grid lines inside faces and edges between coplanar faces, moving

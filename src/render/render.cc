@@ -83,8 +83,8 @@ struct PointLightSample {
 // False when the light is below the surface or closer than kMinRelativeLightDistance (the
 // contribution is then zero).
 bool SamplePointLight(const Context& ctx, const PointLight& light, const Eigen::Vector3d& p,
-                      const Eigen::Vector3d& n, const Eigen::Vector3d& wo,
-                      const BsdfParams& params, PointLightSample* sample) {
+                      const Eigen::Vector3d& n, const Eigen::Vector3d& wo, const BsdfParams& params,
+                      PointLightSample* sample) {
   const Eigen::Vector3d to_light = light.position - p;
   const double dist2 = to_light.squaredNorm();
   const double min_dist = kMinRelativeLightDistance * ctx.scene.extent();
@@ -385,8 +385,7 @@ Eigen::Vector3d TraceRadiance(const Context& ctx, Sampler* sampler, Eigen::Vecto
   if (!hit.hit) {
     if (ctx.environment != nullptr && ctx.view.environment_background) {
       radiance = ctx.view.environment_scale * ctx.environment->Radiance(dir);
-      if (path != nullptr && ctx.request->params.lights &&
-          ctx.view.environment_light_index >= 0) {
+      if (path != nullptr && ctx.request->params.lights && ctx.view.environment_light_index >= 0) {
         path->out()->Add(ctx.layout->LightOffset() + ctx.view.environment_light_index, radiance);
       }
     }
@@ -757,8 +756,9 @@ void SideDirections(const Context& ctx, const Eigen::Matrix3d& world_from_cam_ro
                     const Eigen::Vector2d& q, const Eigen::Vector2d& m, Eigen::Vector3d dirs[2]) {
   for (int i = 0; i < 2; ++i) {
     const double side = i == 0 ? -1.0 : 1.0;
-    dirs[i] = (world_from_cam_rotation * ctx.view.camera.CamFromImage(q + side * kEdgeSideOffset * m))
-                  .normalized();
+    dirs[i] =
+        (world_from_cam_rotation * ctx.view.camera.CamFromImage(q + side * kEdgeSideOffset * m))
+            .normalized();
   }
 }
 
@@ -982,8 +982,7 @@ bool DirectAtReceiver(const Context& ctx, const PointLight& light, const Eigen::
 // shadow boundary meets a primary edge there: a set of measure zero).
 Eigen::Vector3d ShadowJump(const Context& ctx, const Eigen::Matrix3d& world_from_cam_rotation,
                            const Eigen::Vector3d& center, const PointLight& light, int receiver,
-                           const Eigen::Vector2d& q, const Eigen::Vector2d& m,
-                           RenderStats* stats) {
+                           const Eigen::Vector2d& q, const Eigen::Vector2d& m, RenderStats* stats) {
   Eigen::Vector3d dirs[2];
   SideDirections(ctx, world_from_cam_rotation, q, m, dirs);
   Eigen::Vector3d direct[2];
@@ -999,11 +998,11 @@ Eigen::Vector3d ShadowJump(const Context& ctx, const Eigen::Matrix3d& world_from
 // A point of a mesh edge lit by a point light, and the shadow point it casts: the first surface
 // behind the edge point along the light's ray.
 struct ShadowPoint {
-  int receiver = -1;              // face of the shadow point.
-  Eigen::Vector3d y;              // the shadow point.
-  Eigen::Vector3d barycentrics;   // of y on the receiver.
-  Eigen::Matrix3d d_y_d_point;    // ∂y/∂(edge point).
-  Eigen::Matrix3d along;          // ∂y/∂p_j = barycentrics_j·along (receiver corners p_j).
+  int receiver = -1;             // face of the shadow point.
+  Eigen::Vector3d y;             // the shadow point.
+  Eigen::Vector3d barycentrics;  // of y on the receiver.
+  Eigen::Matrix3d d_y_d_point;   // ∂y/∂(edge point).
+  Eigen::Matrix3d along;         // ∂y/∂p_j = barycentrics_j·along (receiver corners p_j).
 };
 
 // Casts the shadow of point a + s(b − a) of `edge` from the light at `light`; false when the
@@ -1082,7 +1081,7 @@ constexpr double kSecondarySideOffset = 1e-5;
 constexpr uint64_t kSecondaryEdgeKey = 0x5EC0DE0000000000ull;
 
 struct SecondaryEdges {
-  std::vector<int> edges;        // mesh edges where radiance can jump for some viewpoint.
+  std::vector<int> edges;          // mesh edges where radiance can jump for some viewpoint.
   std::vector<double> cumulative;  // their cumulative lengths.
   bool environment = false;        // the environment is lit with visibility (shadows on).
   // Per point light of the view (when shadows and a further bounce exist): shadow-casting edges
@@ -1099,8 +1098,7 @@ SecondaryEdges BuildSecondaryEdges(const RenderScene& scene, const ViewSetup& vi
   double total = 0.0;
   for (size_t e = 0; e < scene.edges().size(); ++e) {
     const MeshEdge& edge = scene.edges()[e];
-    const double length =
-        (scene.positions()[edge.v1] - scene.positions()[edge.v0]).norm();
+    const double length = (scene.positions()[edge.v1] - scene.positions()[edge.v0]).norm();
     if (!(length > 0.0) || !std::isfinite(length)) continue;
     if (edge.num_faces == 2) {
       const Eigen::Vector3d n0 = scene.FaceNormal(edge.f0), n1 = scene.FaceNormal(edge.f1);
@@ -1138,6 +1136,28 @@ bool SphereSides(const Eigen::Vector3d& omega, const Eigen::Vector3d& d_omega_ds
   return true;
 }
 
+// The point a + s(b − a) whose direction from x is at angle ξ·Θ from (a − x) in the plane of x
+// and the segment, Θ the angle the segment subtends at x. False when degenerate (x on the
+// segment's line, zero angle).
+bool AngleUniformEdgePoint(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                           const Eigen::Vector3d& x, double xi, double* s, double* subtended) {
+  const Eigen::Vector3d da = a - x, db = b - x;
+  const Eigen::Vector3d k = da.cross(db);
+  const double k_norm = k.norm();
+  if (!(k_norm > 0.0) || !std::isfinite(k_norm)) return false;
+  *subtended = std::atan2(k_norm, da.dot(db));
+  if (!(*subtended > 0.0)) return false;
+  const Eigen::Vector3d ua = da.normalized();
+  const Eigen::Vector3d w = (k / k_norm).cross(ua);  // in the plane, ⊥ ua, towards b.
+  const double theta = xi * *subtended;
+  const Eigen::Vector3d omega = std::cos(theta) * ua + std::sin(theta) * w;
+  // (a − x + s(b − a)) × ω = 0 along k.
+  const double denominator = (b - a).cross(omega).dot(k);
+  if (!(std::abs(denominator) > 0.0)) return false;
+  *s = std::clamp(-da.cross(omega).dot(k) / denominator, 0.0, 1.0);
+  return std::isfinite(*s);
+}
+
 void AddSecondaryEdgeSamples(const Context& ctx, const Sampler& path_sampler, int depth, int face,
                              const Eigen::Vector3d& throughput, const Eigen::Vector3d& x,
                              const Eigen::Vector3d& n, const Eigen::Vector3d& wo,
@@ -1171,11 +1191,16 @@ void AddSecondaryEdgeSamples(const Context& ctx, const Sampler& path_sampler, in
       const MeshEdge& edge = scene.edges()[secondary.edges[c]];
       const Eigen::Vector3d& a = positions[edge.v0];
       const Eigen::Vector3d& b = positions[edge.v1];
-      const Eigen::Vector3d y = a + u2 * (b - a);
+      // The point on the edge is drawn uniformly in the angle it subtends at x (not in s): the
+      // sphere arc length |dω/ds| ds is then Θ·dξ, bounded, where uniform s would weight points
+      // near x by 1/r (infinite variance for edges that touch x's face).
+      double s_edge = 0.0, subtended = 0.0;
+      const bool drawn = AngleUniformEdgePoint(a, b, x, u2, &s_edge, &subtended);
+      const Eigen::Vector3d y = a + s_edge * (b - a);
       const Eigen::Vector3d to_y = y - x;
       const double r = to_y.norm();
       const Eigen::Vector3d omega = to_y / r;
-      if (edge.f0 != face && edge.f1 != face && r > offset && n.dot(omega) > 0.0 &&
+      if (drawn && edge.f0 != face && edge.f1 != face && r > offset && n.dot(omega) > 0.0 &&
           IsDiscontinuityEdge(scene, edge, x, /*creases=*/indirect)) {
         const Eigen::Matrix3d tangent_projection =
             (Eigen::Matrix3d::Identity() - omega * omega.transpose()) / r;
@@ -1185,8 +1210,8 @@ void AddSecondaryEdgeSamples(const Context& ctx, const Sampler& path_sampler, in
           RayHit hits[2];
           for (int k = 0; k < 2; ++k) hits[k] = scene.Intersect(x, sides[k], offset, kInfinity);
           stats->bounce_rays += 2;
-          const bool same = hits[0].hit == hits[1].hit &&
-                            (!hits[0].hit || hits[0].face == hits[1].face);
+          const bool same =
+              hits[0].hit == hits[1].hit && (!hits[0].hit || hits[0].face == hits[1].face);
           if (!same && (indirect || !hits[0].hit || !hits[1].hit)) {
             Eigen::Vector3d g[2];
             for (int k = 0; k < 2; ++k) {
@@ -1203,12 +1228,12 @@ void AddSecondaryEdgeSamples(const Context& ctx, const Sampler& path_sampler, in
             }
             const Eigen::Vector3d jump = g[0] - g[1];
             if (!jump.isZero() && jump.allFinite()) {
-              const double inv_pdf = secondary.cumulative.back() / weight / num_samples;
+              // 1/pdf of the edge (∝ length) and of the angle (uniform over Θ).
+              const double inv_pdf = secondary.cumulative.back() / weight * subtended / num_samples;
               const Eigen::Vector3d m_row = m / r;  // m·∂ω/∂y.
               const int vertices[2] = {edge.v0, edge.v1};
-              const Eigen::Vector3d rows[2] = {(1.0 - u2) * m_row, u2 * m_row};
-              path->AddBoundary(throughput.cwiseProduct(jump) * (speed * inv_pdf), vertices, rows,
-                                2, -m_row);
+              const Eigen::Vector3d rows[2] = {(1.0 - s_edge) * m_row, s_edge * m_row};
+              path->AddBoundary(throughput.cwiseProduct(jump) * inv_pdf, vertices, rows, 2, -m_row);
             }
           }
         }
@@ -1238,17 +1263,17 @@ void AddSecondaryEdgeSamples(const Context& ctx, const Sampler& path_sampler, in
           (Eigen::Matrix3d::Identity() - omega * omega.transpose()) / r;
       Eigen::Vector3d m, sides[2];
       double speed;
-      if (!SphereSides(omega,
-                       tangent_projection * shadow.d_y_d_point *
-                           (positions[edge.v1] - positions[edge.v0]),
-                       r, extent, &m, sides, &speed)) {
+      if (!SphereSides(
+              omega,
+              tangent_projection * shadow.d_y_d_point * (positions[edge.v1] - positions[edge.v0]),
+              r, extent, &m, sides, &speed)) {
         continue;
       }
       Eigen::Vector3d direct[2];
       bool seen = true;
       for (int k = 0; k < 2 && seen; ++k) {
-        seen = DirectAtReceiver(ctx, light, x, sides[k], offset, shadow.receiver, stats,
-                                &direct[k]);
+        seen =
+            DirectAtReceiver(ctx, light, x, sides[k], offset, shadow.receiver, stats, &direct[k]);
       }
       if (!seen) continue;
       const Eigen::Vector3d jump = integrand(sides[0], direct[0]) - integrand(sides[1], direct[1]);
@@ -1259,10 +1284,9 @@ void AddSecondaryEdgeSamples(const Context& ctx, const Sampler& path_sampler, in
       const Eigen::Vector3d receiver_row = shadow.along.transpose() * m_row;
       const Eigen::Vector3i& corners = scene.faces()[shadow.receiver];
       const int vertices[5] = {edge.v0, edge.v1, corners[0], corners[1], corners[2]};
-      const Eigen::Vector3d rows[5] = {(1.0 - u4) * point_row, u4 * point_row,
-                                       shadow.barycentrics[0] * receiver_row,
-                                       shadow.barycentrics[1] * receiver_row,
-                                       shadow.barycentrics[2] * receiver_row};
+      const Eigen::Vector3d rows[5] = {
+          (1.0 - u4) * point_row, u4 * point_row, shadow.barycentrics[0] * receiver_row,
+          shadow.barycentrics[1] * receiver_row, shadow.barycentrics[2] * receiver_row};
       path->AddBoundary(throughput.cwiseProduct(jump) * (speed * inv_pdf), vertices, rows, 5,
                         -m_row);
     }
@@ -1375,8 +1399,8 @@ void AddEdgeTerms(const Context& ctx, std::vector<DerivativeList>* pixel_lists,
       const Eigen::Vector2d q1 = camera.ImageFromCam(a_cam + s1 * (b_cam - a_cam));
       const double length = (q1 - q0).norm();
       if (!std::isfinite(length)) continue;
-      candidates.push_back(
-          {static_cast<int>(e), s0, s1, (length + 1e-3) * PrimaryEdgeImportance(scene, edge, center)});
+      candidates.push_back({static_cast<int>(e), s0, s1,
+                            (length + 1e-3) * PrimaryEdgeImportance(scene, edge, center)});
     }
     const auto sample_primary = [&](const EdgeCandidate& candidate, double s, double inv_pdf,
                                     const Sampler& sampler, std::vector<EdgeEntry>* out) {
@@ -1427,18 +1451,18 @@ void AddEdgeTerms(const Context& ctx, std::vector<DerivativeList>* pixel_lists,
         const double speed = tangent.norm();
         if (!(speed > 0.0) || !std::isfinite(speed)) return;
         const Eigen::Vector2d m(-tangent.y() / speed, tangent.x() / speed);
-        const Eigen::Vector3d jump = ShadowJump(ctx, world_from_cam_rotation, center,
-                                                view.point_lights[l], shadow.receiver, q, m, &local);
+        const Eigen::Vector3d jump =
+            ShadowJump(ctx, world_from_cam_rotation, center, view.point_lights[l], shadow.receiver,
+                       q, m, &local);
         if (jump.isZero()) return;
         const Eigen::Vector3d m_row = d_q.transpose() * m;  // m·∂q/∂y
         const Eigen::Vector3d point_row = shadow.d_y_d_point.transpose() * m_row;
         const Eigen::Vector3d receiver_row = shadow.along.transpose() * m_row;
         const Eigen::Vector3i& corners = scene.faces()[shadow.receiver];
         const int vertices[5] = {edge.v0, edge.v1, corners[0], corners[1], corners[2]};
-        const Eigen::Vector3d rows[5] = {(1.0 - s) * point_row, s * point_row,
-                                         shadow.barycentrics[0] * receiver_row,
-                                         shadow.barycentrics[1] * receiver_row,
-                                         shadow.barycentrics[2] * receiver_row};
+        const Eigen::Vector3d rows[5] = {
+            (1.0 - s) * point_row, s * point_row, shadow.barycentrics[0] * receiver_row,
+            shadow.barycentrics[1] * receiver_row, shadow.barycentrics[2] * receiver_row};
         EmitBoundary(pixel, jump, speed * inv_pdf * options.spp, vertices, rows, 5, out);
       };
       const int64_t num_samples =
