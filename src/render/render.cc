@@ -1079,6 +1079,8 @@ std::vector<EdgeCandidate> ShadowEdgeCandidates(const RenderScene& scene,
 // Directions closer than this (relative to extent/r) to a curve on the sphere are its sides.
 constexpr double kSecondarySideOffset = 1e-5;
 constexpr uint64_t kSecondaryEdgeKey = 0x5EC0DE0000000000ull;
+// Edges drawn per secondary sample before one is kept (resampled importance sampling).
+constexpr int kSecondaryCandidates = 8;
 
 struct SecondaryEdges {
   std::vector<int> edges;          // mesh edges where radiance can jump for some viewpoint.
@@ -1185,23 +1187,44 @@ void AddSecondaryEdgeSamples(const Context& ctx, const Sampler& path_sampler, in
     sampler.Next2D(&u3, &u4);
 
     // (A) Silhouettes (and creases) of mesh edges seen from x.
+    // The edge is chosen by resampled importance sampling (Talbot et al. 2005): kSecondary-
+    // Candidates edges drawn ∝ length (pdf p_k), each weighted w_k = Θ_k/p_k where it can be a
+    // jump seen from x (silhouette or crease test, partly above the horizon; Θ_k the angle it
+    // subtends at x) and 0 elsewhere, one kept ∝ w_k. The point on the kept edge is drawn
+    // uniformly in that angle (not in s: the sphere arc length |dω/ds| ds is then Θ·dξ, where
+    // uniform s would weight points near x by 1/r — infinite variance for edges touching x's
+    // face). The estimate g·Θ·(1/Θ)·(1/K)Σ_k w_k = g·(1/K)Σ_k w_k is unbiased because w_k > 0
+    // wherever the edge's integrand can be non-zero.
+    int chosen = -1;
+    double w_sum = 0.0;
     if (!secondary.edges.empty()) {
-      const int c = PickCandidate(secondary.cumulative, u1);
-      const double weight = secondary.cumulative[c] - (c > 0 ? secondary.cumulative[c - 1] : 0.0);
-      const MeshEdge& edge = scene.edges()[secondary.edges[c]];
+      for (int k = 0; k < kSecondaryCandidates; ++k) {
+        const int c = PickCandidate(secondary.cumulative, k == 0 ? u1 : sampler.Next1D());
+        const double pick = sampler.Next1D();
+        const double length = secondary.cumulative[c] - (c > 0 ? secondary.cumulative[c - 1] : 0.0);
+        const MeshEdge& edge = scene.edges()[secondary.edges[c]];
+        if (edge.f0 == face || edge.f1 == face) continue;
+        const Eigen::Vector3d da = positions[edge.v0] - x, db = positions[edge.v1] - x;
+        if (!(std::max(n.dot(da), n.dot(db)) > 0.0)) continue;
+        if (!IsDiscontinuityEdge(scene, edge, x, /*creases=*/indirect)) continue;
+        const double angle = std::atan2(da.cross(db).norm(), da.dot(db));
+        const double w = angle * secondary.cumulative.back() / length;
+        if (!(w > 0.0) || !std::isfinite(w)) continue;
+        w_sum += w;
+        if (pick * w_sum < w) chosen = c;
+      }
+    }
+    if (chosen >= 0) {
+      const MeshEdge& edge = scene.edges()[secondary.edges[chosen]];
       const Eigen::Vector3d& a = positions[edge.v0];
       const Eigen::Vector3d& b = positions[edge.v1];
-      // The point on the edge is drawn uniformly in the angle it subtends at x (not in s): the
-      // sphere arc length |dω/ds| ds is then Θ·dξ, bounded, where uniform s would weight points
-      // near x by 1/r (infinite variance for edges that touch x's face).
       double s_edge = 0.0, subtended = 0.0;
       const bool drawn = AngleUniformEdgePoint(a, b, x, u2, &s_edge, &subtended);
       const Eigen::Vector3d y = a + s_edge * (b - a);
       const Eigen::Vector3d to_y = y - x;
       const double r = to_y.norm();
       const Eigen::Vector3d omega = to_y / r;
-      if (drawn && edge.f0 != face && edge.f1 != face && r > offset && n.dot(omega) > 0.0 &&
-          IsDiscontinuityEdge(scene, edge, x, /*creases=*/indirect)) {
+      if (drawn && r > offset && n.dot(omega) > 0.0) {
         const Eigen::Matrix3d tangent_projection =
             (Eigen::Matrix3d::Identity() - omega * omega.transpose()) / r;
         Eigen::Vector3d m, sides[2];
@@ -1228,8 +1251,7 @@ void AddSecondaryEdgeSamples(const Context& ctx, const Sampler& path_sampler, in
             }
             const Eigen::Vector3d jump = g[0] - g[1];
             if (!jump.isZero() && jump.allFinite()) {
-              // 1/pdf of the edge (∝ length) and of the angle (uniform over Θ).
-              const double inv_pdf = secondary.cumulative.back() / weight * subtended / num_samples;
+              const double inv_pdf = w_sum / kSecondaryCandidates / num_samples;
               const Eigen::Vector3d m_row = m / r;  // m·∂ω/∂y.
               const int vertices[2] = {edge.v0, edge.v1};
               const Eigen::Vector3d rows[2] = {(1.0 - s_edge) * m_row, s_edge * m_row};
