@@ -1038,6 +1038,25 @@ bool CastShadowPoint(const Context& ctx, const Eigen::Vector3d& light, const Mes
   return true;
 }
 
+// The vertices that move a shadow point of `edge` at parameter s, and rows_j = (∂y/∂p_j)ᵀ·row for
+// a row vector `row` (= some linear functional of y's motion): the edge's two ends through the
+// edge point, the receiver's three corners through its plane.
+void ShadowPointRows(const ShadowPoint& shadow, const RenderScene& scene, const MeshEdge& edge,
+                     double s, const Eigen::Vector3d& row, int vertices[5],
+                     Eigen::Vector3d rows[5]) {
+  const Eigen::Vector3d point_row = shadow.d_y_d_point.transpose() * row;
+  const Eigen::Vector3d receiver_row = shadow.along.transpose() * row;
+  const Eigen::Vector3i& corners = scene.faces()[shadow.receiver];
+  vertices[0] = edge.v0;
+  vertices[1] = edge.v1;
+  rows[0] = (1.0 - s) * point_row;
+  rows[1] = s * point_row;
+  for (int j = 0; j < 3; ++j) {
+    vertices[2 + j] = corners[j];
+    rows[2 + j] = shadow.barycentrics[j] * receiver_row;
+  }
+}
+
 // Shadow-casting edges of a point light: every edge that can be a silhouette from it, weighted
 // by the angle it subtends there (shadow samples are spread ∝ angle at the light).
 std::vector<EdgeCandidate> ShadowEdgeCandidates(const RenderScene& scene,
@@ -1068,13 +1087,14 @@ std::vector<EdgeCandidate> ShadowEdgeCandidates(const RenderScene& scene,
 // Boundary term: ∂H/∂θ += ∫_curve (g(ω⁻) − g(ω⁺))·(m·∂ω/∂θ) dl, g = f·(n·ω)·L_in, m the unit
 // normal of the curve on the sphere and ω± = normalize(ω ± εm). For a curve point y seen from x,
 // ω = (y − x)/r and m·∂ω/∂θ = mᵀ(∂y/∂θ − ∂x/∂θ)/r; dl = |dω/ds| ds along the curve parameter s.
-// Estimator per sample: (A) an edge ∝ its length, s uniform; (B) a light uniformly, a
-// shadow-casting edge ∝ its angle at the light, s uniform; weight (g⁻ − g⁺)·|dω/ds|/pdf, times the
-// path throughput, credited to the path's pixel. Both sides trace with the same random numbers.
-// Other radiance leaving the next vertex is continuous along ω (its own hemisphere integrals
-// smooth out their jumps), so (A) and (B) are all the curves for flat-shaded, untextured
-// surfaces; texel boundaries seen from x are not sampled. Sampling edges ∝ length (not by the
-// solid angle they subtend at x) is simple and unbiased but noisy for edges close to x.
+// Estimator per sample: (A) an edge chosen by resampling among length-proportional candidates,
+// a point uniform in the angle it subtends at x (see the loop below); (B) a light uniformly, a
+// shadow-casting edge ∝ its angle at the light, s uniform; weight (g⁻ − g⁺)·(arc length)/pdf,
+// times the path throughput, credited to the path's pixel. Both sides trace with the same random
+// numbers. Other radiance leaving the next vertex is continuous along ω (its own hemisphere
+// integrals smooth out their jumps), so (A) and (B) are all the curves for flat-shaded, untextured
+// surfaces; texel boundaries seen from x are not sampled. (B)'s uniform s still weights receiver
+// points close to x by 1/r.
 
 // Directions closer than this (relative to extent/r) to a curve on the sphere are its sides.
 constexpr double kSecondarySideOffset = 1e-5;
@@ -1302,13 +1322,9 @@ void AddSecondaryEdgeSamples(const Context& ctx, const Sampler& path_sampler, in
       if (jump.isZero() || !jump.allFinite()) continue;
       const double inv_pdf = num_lights * cumulative.back() / candidate.weight / num_samples;
       const Eigen::Vector3d m_row = m / r;
-      const Eigen::Vector3d point_row = shadow.d_y_d_point.transpose() * m_row;
-      const Eigen::Vector3d receiver_row = shadow.along.transpose() * m_row;
-      const Eigen::Vector3i& corners = scene.faces()[shadow.receiver];
-      const int vertices[5] = {edge.v0, edge.v1, corners[0], corners[1], corners[2]};
-      const Eigen::Vector3d rows[5] = {
-          (1.0 - u4) * point_row, u4 * point_row, shadow.barycentrics[0] * receiver_row,
-          shadow.barycentrics[1] * receiver_row, shadow.barycentrics[2] * receiver_row};
+      int vertices[5];
+      Eigen::Vector3d rows[5];
+      ShadowPointRows(shadow, scene, edge, u4, m_row, vertices, rows);
       path->AddBoundary(throughput.cwiseProduct(jump) * (speed * inv_pdf), vertices, rows, 5,
                         -m_row);
     }
@@ -1478,13 +1494,9 @@ void AddEdgeTerms(const Context& ctx, std::vector<DerivativeList>* pixel_lists,
                        q, m, &local);
         if (jump.isZero()) return;
         const Eigen::Vector3d m_row = d_q.transpose() * m;  // m·∂q/∂y
-        const Eigen::Vector3d point_row = shadow.d_y_d_point.transpose() * m_row;
-        const Eigen::Vector3d receiver_row = shadow.along.transpose() * m_row;
-        const Eigen::Vector3i& corners = scene.faces()[shadow.receiver];
-        const int vertices[5] = {edge.v0, edge.v1, corners[0], corners[1], corners[2]};
-        const Eigen::Vector3d rows[5] = {
-            (1.0 - s) * point_row, s * point_row, shadow.barycentrics[0] * receiver_row,
-            shadow.barycentrics[1] * receiver_row, shadow.barycentrics[2] * receiver_row};
+        int vertices[5];
+        Eigen::Vector3d rows[5];
+        ShadowPointRows(shadow, scene, edge, s, m_row, vertices, rows);
         EmitBoundary(pixel, jump, speed * inv_pdf * options.spp, vertices, rows, 5, out);
       };
       const int64_t num_samples =
