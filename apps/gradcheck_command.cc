@@ -127,8 +127,8 @@ CommandRunner SetupGradcheckCommand(CLI::App* app) {
                   "Parameter kind: vertices | albedo | roughness | specular | light")
       ->required();
   app->add_option("--spp", opts->check.render.spp,
-                  "Samples per pixel (vertices: use e.g. 64; finite differences of moving "
-                  "edges need many samples)")
+                  "Samples per pixel (vertices: finite differences of moving edges need many: "
+                  "64+ for Lambertian direct light, 1024+ with a glossy lobe or bounces)")
       ->capture_default_str();
   app->add_option("--bounces", opts->check.render.bounces,
                   "Path segments: 1 = direct light only, 2 = one indirect bounce")
@@ -140,9 +140,11 @@ CommandRunner SetupGradcheckCommand(CLI::App* app) {
   app->add_option("--tolerance", opts->check.tolerance,
                   "Maximum relative L2 error (of the block sums, see --block)")
       ->capture_default_str();
-  app->add_option("--step", opts->check.step,
-                  "Finite-difference step (0 = automatic: 1e-3, roughness 1e-4·r, vertices "
-                  "5e-3 × bounding-box diagonal along a displacement field of max length 1)")
+  app->add_option(
+         "--step", opts->check.step,
+         "Finite-difference step (0 = automatic: 1e-3, roughness 1e-4·r, vertices "
+         "5e-3 × bounding-box diagonal along a displacement field of max length 1, shorter for "
+         "glossy lobes)")
       ->capture_default_str();
   app->add_option("--block", opts->check.block,
                   "Compare sums over BxB pixel blocks (0 = automatic: 8 for vertices, whose edge "
@@ -154,6 +156,21 @@ CommandRunner SetupGradcheckCommand(CLI::App* app) {
       ->capture_default_str();
   app->add_option("--threads", opts->check.render.threads, "Worker threads (0 = all cores)")
       ->capture_default_str();
+  app->add_option("--primary-edge-ratio", opts->check.derivatives.primary_edge_ratio,
+                  "Primary (silhouette/crease) edge samples per pixel sample, [0, 16]; 0 = off")
+      ->capture_default_str();
+  app->add_option("--shadow-edge-ratio", opts->check.derivatives.shadow_edge_ratio,
+                  "Point-light shadow edge samples per pixel sample, [0, 16]; 0 = off")
+      ->capture_default_str();
+  app->add_option("--secondary-edge-samples", opts->check.derivatives.secondary_edge_samples,
+                  "Secondary edge samples per path vertex, [0, 16]; 0 = off")
+      ->capture_default_str();
+  app->add_option("--texel-edge-ratio", opts->check.derivatives.texel_edge_ratio,
+                  "Texel-boundary samples per pixel sample, [0, 16]; 0 = off")
+      ->capture_default_str();
+  app->add_option("--images", opts->check.image_dir,
+                  "Write per-view analytic/finite-difference derivative images (EXR) and a "
+                  "comparison PNG into this directory");
   app->add_option("--json", opts->json, "Write the results as JSON to this file");
   return [opts]() { return RunGradcheckCommand(*opts); };
 }

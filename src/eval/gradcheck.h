@@ -15,26 +15,32 @@
 // Vertices: δ is a smooth random displacement field over the mesh, a sum of three low-frequency
 // modes δ(p) = Σ_m a_m·sin(2π k_m·(p − c)/e + φ_m) (c the bounding-box centre, e its diagonal,
 // random amplitude vectors a_m, wave vectors |k_m| ≤ 1.5, phases φ_m), scaled so that
-// max_v |δ(v)| = 1; the step h is a length (automatic: 5e-3·e). The finite differences render
-// the displaced meshes p ± h·δ with the same seeds. Moving geometry moves silhouettes, shadow
-// boundaries and (faces are flat-shaded) every edge between non-coplanar faces; the renderer
-// estimates such derivatives by edge sampling, a Monte Carlo estimate that lands at random pixels
-// along the edges, while the finite difference counts the camera and shadow samples that switch
-// sides (its noise grows like 1/√(h·spp), its truncation error like h because block sums kink as
-// edges cross pixel and block boundaries). Both are noisy per pixel, so the images are compared
-// after summing over B×B pixel blocks (`block`, automatic 8 for vertices), and the report adds
-// `projection_error`, the relative error of three smooth global projections Σ_p Σ_c w(p)·I_pc
-// with w = 1, cos(π(x + ½)/W) and cos(π(y + ½)/H) (ill-conditioned when these sums nearly cancel,
-// e.g. an object moving sideways; informative, not part of the pass criterion). The pass
+// max_v |δ(v)| = 1; the step h is a length (automatic: 5e-3·e, shortened for glossy lobes so
+// that the normals turn by much less than the lobe's width α: ×clamp(2α, 1/16, 1), ¼ at
+// roughness 0.35; at 5e-3·e a roughness-0.35 highlight's truncation error alone was 10%).
+// The finite differences render the displaced meshes p ± h·δ with the same seeds. Moving geometry
+// moves silhouettes, shadow boundaries and (faces are flat-shaded) every edge between non-coplanar
+// faces; the renderer estimates such derivatives by edge sampling, a Monte Carlo estimate that
+// lands at random pixels along the edges, while the finite difference counts the camera and shadow
+// samples that switch sides (its noise grows like 1/√(h·spp), its truncation error like h because
+// block sums kink as edges cross pixel and block boundaries). Both are noisy per pixel, so the
+// images are compared after summing over B×B pixel blocks (`block`, automatic 8 for vertices), and
+// the report adds `projection_error`, the relative error of three smooth global projections Σ_p Σ_c
+// w(p)·I_pc with w = 1, cos(π(x + ½)/W) and cos(π(y + ½)/H) (ill-conditioned when these sums nearly
+// cancel, e.g. an object moving sideways; informative, not part of the pass criterion). The pass
 // criterion is the block relative error.
 //
-// Finite differences of geometry need many samples; recommended: `--spp 64` or more. The
+// Finite differences of geometry need many samples; recommended: `--spp 64` or more for
+// Lambertian direct light, 1024 with a glossy lobe (the shorter step is noisier) or a bounce. The
 // finite difference's own block error (seed-to-seed, 8×8 blocks, h = 5e-3·e, 128² Cycles bunny
 // views) is 1–2.5% for Lambert and direct light at 64 spp (0.6–1.4% at h = 1e-2·e, 2.5–4% at
 // 3e-3·e), 4% with a glossy lobe (specular 0.5, roughness 0.35) at 64 spp and 2% at 256 spp, and
-// 17% (64 spp) or 9% (256 spp) with an indirect bounce: bounce directions are sampled around the
-// moving normals, so bounce rays switch what they hit. Check bounces > 1 with a larger --block
-// and many more samples, or check direct light and bounces separately.
+// 17% (64 spp) or 9% (256 spp) with an indirect bounce. With the glossy step (h = 1.25e-3·e) and
+// a bounce it is 9% at 1024 spp (2.6% without the bounce): bounce rays passing near silhouettes
+// switch what they hit as those move (sampling the bounce directions around the undisplaced
+// normals left it at 9.1%). The analytic side is noisy too with a bounce (edge samples; at 1024
+// spp on that view: primary edges 4.8%, secondary edges 8%). Check bounces > 1 with many more
+// samples (errors fall like 1/√spp), or check direct light and bounces separately.
 #ifndef SFT_EVAL_GRADCHECK_H_
 #define SFT_EVAL_GRADCHECK_H_
 
@@ -55,7 +61,8 @@ struct GradcheckOptions {
   RenderOptions render;                         // spp, bounces, effects, seed, threads.
   std::vector<int> views;                       // view indices; empty = all.
   double step = 0.0;  // finite-difference step h; 0 = automatic per kind (1e-3, 1e-4·r for
-                      // roughness r, 5e-3 × the bounding-box diagonal for vertices).
+                      // roughness r, 5e-3 × the bounding-box diagonal for vertices, times
+                      // clamp(2α, 1/16, 1) with a glossy lobe of width α = r²_min).
   // Side B of the pixel blocks summed before comparing; 0 = automatic: 8 for vertices (edge
   // sampling puts silhouette and shadow-boundary derivatives at random pixels along the edge, and
   // the finite difference of a moving edge is quantised by the camera samples that cross it:
@@ -63,6 +70,14 @@ struct GradcheckOptions {
   int block = 0;
   double tolerance = 0.05;      // pass when the overall (block) relative error is at most this.
   uint64_t direction_seed = 1;  // seed of the random direction δ.
+  // Edge-sampling budgets of the analytic side (primary/shadow/texel edge ratios, secondary edge
+  // samples; see DerivativeRequest). Setting one to 0 isolates the other terms; `params` and the
+  // outputs are set by the check itself.
+  DerivativeRequest derivatives;
+  // When not empty: per view, writes DIR/view_<v>_analytic.exr, view_<v>_fd.exr (RGB directional
+  // derivative images, linear float) and view_<v>_compare.png (analytic | finite difference |
+  // difference, red positive, blue negative, all on one scale), to see where they disagree.
+  std::string image_dir;
 
   bool Check(std::string* why) const;
 };

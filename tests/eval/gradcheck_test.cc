@@ -134,7 +134,8 @@ TEST_F(GradcheckTest, VerticesReportBlocksAndProjections) {
   EXPECT_EQ(result.block, 8);
   Eigen::Vector3d lo, hi;
   MeshBounds(mesh_, &lo, &hi);
-  EXPECT_NEAR(result.step, 5e-3 * (hi - lo).norm(), 1e-9);
+  // Glossy lobe of roughness 0.35: the automatic step is shortened by 2α = 2·0.35².
+  EXPECT_NEAR(result.step, 2.0 * 0.35 * 0.35 * 5e-3 * (hi - lo).norm(), 1e-9);
   ASSERT_EQ(result.views.size(), 1u);
   const GradcheckViewResult& view = result.views[0];
   ASSERT_EQ(view.projections.size(), 3u);
@@ -144,6 +145,12 @@ TEST_F(GradcheckTest, VerticesReportBlocksAndProjections) {
     EXPECT_TRUE(std::isfinite(e));
     EXPECT_GE(e, 0.0);
   }
+  // Without the glossy lobe the step is the base 5e-3 × the diagonal.
+  GradcheckOptions lambert = options;
+  lambert.render.effects.specular = false;
+  GradcheckResult lambert_result;
+  ASSERT_TRUE(RunGradcheck(dataset_, mesh_, material_, lambert, &lambert_result).ok());
+  EXPECT_NEAR(lambert_result.step, 5e-3 * (hi - lo).norm(), 1e-9);
   // Other kinds default to per-pixel comparison: block and pixel errors coincide.
   options.kind = ParameterKind::kAlbedo;
   ASSERT_TRUE(RunGradcheck(dataset_, mesh_, material_, options, &result).ok());
@@ -153,6 +160,45 @@ TEST_F(GradcheckTest, VerticesReportBlocksAndProjections) {
   options.block = 4;
   ASSERT_TRUE(RunGradcheck(dataset_, mesh_, material_, options, &result).ok());
   EXPECT_EQ(result.block, 4);
+}
+
+// The edge budgets reach the analytic side: with every edge term off, the silhouettes' and
+// creases' derivatives are missing and the check fails by far; the images of both sides are
+// written when asked, and bad budgets are rejected with the field's name.
+TEST(GradcheckVertexTest, EdgeBudgetsAndImages) {
+  const std::string root = testing::DataDir() + "/cycles/bunny_point_diffuse";
+  Dataset dataset;
+  TriMesh mesh;
+  Material material;
+  ASSERT_TRUE(ReadDataset(root, &dataset).ok());
+  ASSERT_TRUE(ReadMesh(root + "/gt/mesh.ply", &mesh).ok());
+  ASSERT_TRUE(LoadMaterial(R"({"albedo": [0.7, 0.5, 0.3], "specular": 0})", mesh, &material).ok());
+  GradcheckOptions options;
+  options.kind = ParameterKind::kVertex;
+  options.views = {0};
+  options.render.spp = 16;
+  options.render.bounces = 1;
+  testing::TempDir tmp;
+  options.image_dir = tmp.Join("images");
+  GradcheckResult with_edges;
+  ASSERT_TRUE(RunGradcheck(dataset, mesh, material, options, &with_edges).ok());
+  for (const char* name : {"view_0_analytic.exr", "view_0_fd.exr", "view_0_compare.png"}) {
+    EXPECT_TRUE(std::filesystem::exists(tmp.Join(std::string("images/") + name))) << name;
+  }
+  GradcheckOptions interior = options;
+  interior.image_dir.clear();
+  interior.derivatives.primary_edge_ratio = 0.0;
+  interior.derivatives.shadow_edge_ratio = 0.0;
+  interior.derivatives.secondary_edge_samples = 0;
+  interior.derivatives.texel_edge_ratio = 0.0;
+  GradcheckResult without_edges;
+  ASSERT_TRUE(RunGradcheck(dataset, mesh, material, interior, &without_edges).ok());
+  EXPECT_GT(without_edges.relative_error, 0.5);
+  EXPECT_LT(with_edges.relative_error, 0.5 * without_edges.relative_error);
+  interior.derivatives.primary_edge_ratio = -1.0;
+  const Status status = RunGradcheck(dataset, mesh, material, interior, &without_edges);
+  EXPECT_FALSE(status.ok());
+  EXPECT_THAT(status.message(), HasSubstr("primary_edge_ratio"));
 }
 
 // Vertex derivatives (interior terms and primary edge sampling) agree with finite differences
@@ -211,6 +257,8 @@ TEST(GradcheckCliTest, ExitCodes) {
     EXPECT_TRUE(json.contains("projection_error"));
     EXPECT_EQ(json["views"][0]["projections"].size(), 3u);
   }
+  EXPECT_EQ(testing::RunCommand(base + "--param vertices --secondary-edge-samples 17", &out), 1);
+  EXPECT_THAT(out, HasSubstr("secondary_edge_samples"));
   EXPECT_NE(testing::RunCommand(base + "--param colour", &out), 0);
   EXPECT_THAT(out, HasSubstr("--param"));
   testing::TempDir tmp;
