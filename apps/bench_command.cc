@@ -137,6 +137,7 @@ CommandRunner SetupBenchCommand(CLI::App* app) {
   gradient->add_flag("--keep-rows", gradient_opts->cost.keep_rows,
                      "Hold every view's Jacobian rows until the end of the pass (default: one "
                      "view's at a time) and report the total resident memory");
+  AddEdgeBudgetOptions(gradient, &gradient_opts->cost.derivatives);
   gradient->add_option("--json", gradient_opts->json, "Also write the results to this JSON file");
   gradient->add_flag("--quiet", gradient_opts->quiet, "No progress lines");
   return [render, render_opts, gradient, gradient_opts]() {

@@ -19,6 +19,21 @@ const CommandEntry kCommands[] = {
 
 }  // namespace
 
+void AddEdgeBudgetOptions(CLI::App* app, DerivativeRequest* request) {
+  app->add_option("--primary-edge-ratio", request->primary_edge_ratio,
+                  "Primary (silhouette/crease) edge samples per pixel sample, [0, 16]; 0 = off")
+      ->capture_default_str();
+  app->add_option("--shadow-edge-ratio", request->shadow_edge_ratio,
+                  "Point-light shadow edge samples per pixel sample, [0, 16]; 0 = off")
+      ->capture_default_str();
+  app->add_option("--secondary-edge-samples", request->secondary_edge_samples,
+                  "Secondary edge samples per path vertex, [0, 16]; 0 = off")
+      ->capture_default_str();
+  app->add_option("--texel-edge-ratio", request->texel_edge_ratio,
+                  "Texel-boundary samples per pixel sample, [0, 16]; 0 = off")
+      ->capture_default_str();
+}
+
 int PrintError(const std::string& command, const Status& status) {
   std::fprintf(stderr, "sft %s: error: %s\n", command.c_str(), status.message().c_str());
   return 1;

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "src/core/status.h"
+#include "src/render/derivatives.h"
 
 namespace sft {
 
@@ -26,6 +27,11 @@ struct CommandEntry {
 int PrintError(const std::string& command, const Status& status);
 
 int RunCommandTable(int argc, char** argv);
+
+// Declares --primary-edge-ratio, --shadow-edge-ratio, --secondary-edge-samples and
+// --texel-edge-ratio (the edge-sampling budgets of vertex derivatives) on `app`, bound to
+// `request`'s fields (defaults shown; DerivativeRequest::Check validates them).
+void AddEdgeBudgetOptions(CLI::App* app, DerivativeRequest* request);
 
 // One per command file.
 CommandRunner SetupSynthCommand(CLI::App* app);

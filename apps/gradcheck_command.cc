@@ -156,18 +156,7 @@ CommandRunner SetupGradcheckCommand(CLI::App* app) {
       ->capture_default_str();
   app->add_option("--threads", opts->check.render.threads, "Worker threads (0 = all cores)")
       ->capture_default_str();
-  app->add_option("--primary-edge-ratio", opts->check.derivatives.primary_edge_ratio,
-                  "Primary (silhouette/crease) edge samples per pixel sample, [0, 16]; 0 = off")
-      ->capture_default_str();
-  app->add_option("--shadow-edge-ratio", opts->check.derivatives.shadow_edge_ratio,
-                  "Point-light shadow edge samples per pixel sample, [0, 16]; 0 = off")
-      ->capture_default_str();
-  app->add_option("--secondary-edge-samples", opts->check.derivatives.secondary_edge_samples,
-                  "Secondary edge samples per path vertex, [0, 16]; 0 = off")
-      ->capture_default_str();
-  app->add_option("--texel-edge-ratio", opts->check.derivatives.texel_edge_ratio,
-                  "Texel-boundary samples per pixel sample, [0, 16]; 0 = off")
-      ->capture_default_str();
+  AddEdgeBudgetOptions(app, &opts->check.derivatives);
   app->add_option("--images", opts->check.image_dir,
                   "Write per-view analytic/finite-difference derivative images (EXR) and a "
                   "comparison PNG into this directory");

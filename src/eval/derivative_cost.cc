@@ -155,6 +155,7 @@ bool DerivativeCostOptions::Check(std::string* why) const {
     *why = "res: must be in [1, 4096], got " + std::to_string(resolution);
     return false;
   }
+  if (!derivatives.Check(why)) return false;
   RenderOptions render;
   render.spp = spp;
   render.bounces = bounces;
@@ -184,6 +185,8 @@ Status MeasureDerivativeCost(const DerivativeCostOptions& options, const TriMesh
   result.spp = options.spp;
   result.bounces = options.bounces;
   result.keep_rows = options.keep_rows;
+  result.derivatives = options.derivatives;
+  result.derivatives.adjoint_weights = nullptr;
 
   const RenderScene scene(mesh);
   const Material material = MakeMaterial(mesh, options.seed);
@@ -195,11 +198,14 @@ Status MeasureDerivativeCost(const DerivativeCostOptions& options, const TriMesh
   render.seed = options.seed;
   render.threads = options.threads;
 
-  DerivativeRequest rows_request;  // every parameter kind, vertices (and edge sampling) included.
+  // Every parameter kind, vertices (and edge sampling) included.
+  DerivativeRequest rows_request = options.derivatives;
+  rows_request.params = ParameterSelection();
   rows_request.params.vertices = true;
   rows_request.jacobian_rows = true;
-  DerivativeRequest adjoint_request;
-  adjoint_request.params.vertices = true;
+  rows_request.adjoint_weights = nullptr;
+  DerivativeRequest adjoint_request = rows_request;
+  adjoint_request.jacobian_rows = false;
   adjoint_request.adjoint_weights = &weights;
   if (!rows_request.Check(&why) || !adjoint_request.Check(&why)) {
     return Status::Error("derivative request: " + why);
@@ -314,6 +320,10 @@ nlohmann::json DerivativeCostReportToJson(const DerivativeCostReport& report) {
   json["height"] = report.height;
   json["spp"] = report.spp;
   json["bounces"] = report.bounces;
+  json["edge_budgets"] = {{"primary_edge_ratio", report.derivatives.primary_edge_ratio},
+                          {"shadow_edge_ratio", report.derivatives.shadow_edge_ratio},
+                          {"secondary_edge_samples", report.derivatives.secondary_edge_samples},
+                          {"texel_edge_ratio", report.derivatives.texel_edge_ratio}};
   json["covered_pixels"] = report.covered_pixels;
   json["parameters"] = {{"total", report.num_parameters},
                         {"differentiated", report.num_differentiated},
@@ -347,6 +357,10 @@ std::string DerivativeCostReportTable(const DerivativeCostReport& report) {
       static_cast<long long>(report.covered_pixels));
   add("parameters     %d differentiated (vertices, albedo, roughness, specular, light) of %d\n",
       report.num_differentiated, report.num_parameters);
+  add("edge budgets   primary %g, shadow %g, texel %g (x spp x pixels); secondary %d per path "
+      "vertex\n",
+      report.derivatives.primary_edge_ratio, report.derivatives.shadow_edge_ratio,
+      report.derivatives.texel_edge_ratio, report.derivatives.secondary_edge_samples);
   add("%-28s %10s %10s %12s %14s\n", "pass", "seconds", "x forward", "Mrays/s", "peak RSS MiB");
   auto row = [&](const char* name, const DerivativePassCost& pass) {
     add("%-28s %10.3f %10.2f %12.2f %14.1f\n", name, pass.seconds, pass.ratio,

@@ -29,6 +29,7 @@
 
 #include "src/core/status.h"
 #include "src/geometry/mesh.h"
+#include "src/render/derivatives.h"
 #include "src/render/render.h"
 
 namespace sft {
@@ -42,6 +43,9 @@ struct DerivativeCostOptions {
   uint64_t seed = 0;       // sample seed of every pass; also seeds the albedo and the weights.
   bool keep_rows = false;  // hold every view's Jacobian rows until the end of the rows pass.
   bool progress = false;   // print a progress line per pass on stderr.
+  // Edge-sampling budgets of both derivative passes (DerivativeRequest defaults unless changed);
+  // its parameter selection and outputs are set by the benchmark.
+  DerivativeRequest derivatives;
 
   bool Check(std::string* why) const;
 };
@@ -61,10 +65,11 @@ struct DerivativeCostReport {
   int threads = 0;  // actual thread count (0 in the options resolved to the core count).
   int views = 0, width = 0, height = 0, spp = 0, bounces = 0;
   bool keep_rows = false;
-  bool peak_rss_reset = false;  // the kernel let us reset the peak before each pass.
-  int num_parameters = 0;       // the full index space (ParameterLayout::size()).
-  int num_differentiated = 0;   // of those, the differentiated ones (all kinds: = num_parameters).
-  int64_t covered_pixels = 0;   // pixels with coverage > 0, summed over the views.
+  DerivativeRequest derivatives;  // the edge budgets used (outputs unset).
+  bool peak_rss_reset = false;    // the kernel let us reset the peak before each pass.
+  int num_parameters = 0;         // the full index space (ParameterLayout::size()).
+  int num_differentiated = 0;  // of those, the differentiated ones (all kinds: = num_parameters).
+  int64_t covered_pixels = 0;  // pixels with coverage > 0, summed over the views.
 
   DerivativePassCost forward;        // RenderView.
   DerivativePassCost jacobian_rows;  // + Jacobian rows (vertices, albedo, roughness, specular,

@@ -183,6 +183,7 @@ std::vector<double> SmoothDisplacementField(const std::vector<Eigen::Vector3d>& 
 
 bool GradcheckOptions::Check(std::string* why) const {
   if (!render.Check(why)) return false;
+  if (!derivatives.Check(why)) return false;
   if (!(step >= 0.0) || !std::isfinite(step)) {
     *why = "step: must be >= 0 (0 = automatic)";
     return false;

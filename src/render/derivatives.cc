@@ -91,11 +91,12 @@ bool ParameterSelection::Selected(ParameterKind kind) const {
   return false;
 }
 
+// Messages name the fields as the CLI flags do (primary-edge-ratio, ...).
 bool DerivativeRequest::Check(std::string* why) const {
   for (const auto& [name, ratio] :
-       {std::pair<const char*, double>{"primary_edge_ratio", primary_edge_ratio},
-        std::pair<const char*, double>{"shadow_edge_ratio", shadow_edge_ratio},
-        std::pair<const char*, double>{"texel_edge_ratio", texel_edge_ratio}}) {
+       {std::pair<const char*, double>{"primary-edge-ratio", primary_edge_ratio},
+        std::pair<const char*, double>{"shadow-edge-ratio", shadow_edge_ratio},
+        std::pair<const char*, double>{"texel-edge-ratio", texel_edge_ratio}}) {
     if (!(ratio >= 0.0 && ratio <= 16.0)) {
       *why = std::string(name) + ": must be in [0, 16], got " + std::to_string(ratio);
       return false;
@@ -103,7 +104,7 @@ bool DerivativeRequest::Check(std::string* why) const {
   }
   if (secondary_edge_samples < 0 || secondary_edge_samples > 16) {
     *why =
-        "secondary_edge_samples: must be in [0, 16], got " + std::to_string(secondary_edge_samples);
+        "secondary-edge-samples: must be in [0, 16], got " + std::to_string(secondary_edge_samples);
     return false;
   }
   if (adjoint_weights != nullptr && adjoint_weights->channels < 3) {

@@ -31,9 +31,9 @@
 // Secondary edges (render.cc, AddSecondaryEdgeSamples; secondary_edge_samples per path vertex):
 // (A) mesh edges seen from a path vertex — silhouettes against the environment (when it is lit
 // with shadows) or against farther surfaces, and creases, when a further bounce is traced;
-// (B) point-light shadow boundaries on the surface a bounce reaches. Their sampling (edges by
-// resampling length-proportional candidates, points uniform in subtended angle) is unbiased but
-// noisy on finely tessellated meshes.
+// (B) point-light shadow boundaries on the surface a bounce reaches. Their sampling ((edge,
+// point) pairs drawn ∝ length and uniform in subtended angle, one kept by resampling with the
+// BSDF·cosine towards it) is unbiased but noisy on finely tessellated meshes.
 // Primary edges cover silhouettes, boundary and non-manifold edges and, because shading is flat,
 // creases between non-coplanar faces. Texel boundaries are where piecewise-constant albedo or
 // roughness (mesh colors) jumps: grid lines inside faces and edges between coplanar faces, moving
@@ -126,9 +126,9 @@ struct DerivativeRequest {
   // Secondary edges (Li et al. 2018 §5: visibility seen from path vertices): edge samples per
   // path vertex whose hemisphere integral has jumps — occlusion of the environment light (with
   // shadows), silhouettes and creases of what an indirect bounce sees, and point-light shadow
-  // boundaries seen through a bounce. Each sample picks one mesh edge (resampled among 8
-  // length-proportional candidates by the angle they subtend) and, with point lights, one
-  // shadow-casting edge point; most are rejected by cheap tests. Range [0, 16]; 0 turns them off.
+  // boundaries seen through a bounce. Each sample picks one mesh edge point (resampled among 16
+  // candidates by BSDF·cosine × subtended angle) and, with point lights, one shadow-casting edge
+  // point; most are rejected by cheap tests. Range [0, 16]; 0 turns them off.
   int secondary_edge_samples = 1;
   // Texel-boundary samples = ratio × spp × pixels, each tracing two camera rays and, when both
   // see the boundary's face, two paths. Only boundaries whose two texels differ visibly are

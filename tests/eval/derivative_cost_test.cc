@@ -153,7 +153,8 @@ TEST(BenchGradientCommandTest, SmallRunWritesJson) {
   const int code =
       testing::RunCommand(testing::SftBinary() + " bench gradient --mesh " + testing::DataDir() +
                               "/meshes/icosphere_r1_320f.obj --views 2 --res 16 "
-                              "--spp 1 --quiet --json " +
+                              "--spp 1 --secondary-edge-samples 0 --texel-edge-ratio 0.5 "
+                              "--quiet --json " +
                               json_path,
                           &output);
   EXPECT_EQ(code, 0) << output;
@@ -165,6 +166,20 @@ TEST(BenchGradientCommandTest, SmallRunWritesJson) {
   EXPECT_EQ(json["views"].get<int>(), 2);
   EXPECT_GT(json["jacobian_rows"]["entries"].get<int64_t>(), 0);
   EXPECT_TRUE(json["passes"].contains("forward"));
+  // The edge budgets given on the command line are the ones used and reported.
+  EXPECT_EQ(json["edge_budgets"]["secondary_edge_samples"].get<int>(), 0);
+  EXPECT_EQ(json["edge_budgets"]["texel_edge_ratio"].get<double>(), 0.5);
+  EXPECT_EQ(json["edge_budgets"]["primary_edge_ratio"].get<double>(),
+            DerivativeRequest().primary_edge_ratio);
+}
+
+TEST(BenchGradientCommandTest, BadEdgeBudgetIsOneErrorLine) {
+  std::string output;
+  const int code = testing::RunCommand(
+      testing::SftBinary() + " bench gradient --views 1 --primary-edge-ratio 17", &output);
+  EXPECT_EQ(code, 1);
+  EXPECT_NE(output.find("--primary-edge-ratio"), std::string::npos) << output;
+  EXPECT_EQ(output.find('\n'), output.size() - 1) << output;
 }
 
 }  // namespace

@@ -251,21 +251,21 @@ TEST(DerivativeRequestTest, VertexDerivativesAndEdgeRatios) {
     DerivativeRequest primary = request;
     primary.primary_edge_ratio = bad;
     EXPECT_FALSE(primary.Check(&why)) << bad;
-    EXPECT_NE(why.find("primary_edge_ratio"), std::string::npos) << why;
+    EXPECT_NE(why.find("primary-edge-ratio"), std::string::npos) << why;
     DerivativeRequest shadow = request;
     shadow.shadow_edge_ratio = bad;
     EXPECT_FALSE(shadow.Check(&why)) << bad;
-    EXPECT_NE(why.find("shadow_edge_ratio"), std::string::npos) << why;
+    EXPECT_NE(why.find("shadow-edge-ratio"), std::string::npos) << why;
     DerivativeRequest texel = request;
     texel.texel_edge_ratio = bad;
     EXPECT_FALSE(texel.Check(&why)) << bad;
-    EXPECT_NE(why.find("texel_edge_ratio"), std::string::npos) << why;
+    EXPECT_NE(why.find("texel-edge-ratio"), std::string::npos) << why;
   }
   for (int bad : {-1, 17}) {
     DerivativeRequest secondary = request;
     secondary.secondary_edge_samples = bad;
     EXPECT_FALSE(secondary.Check(&why)) << bad;
-    EXPECT_NE(why.find("secondary_edge_samples"), std::string::npos) << why;
+    EXPECT_NE(why.find("secondary-edge-samples"), std::string::npos) << why;
   }
 }
 
