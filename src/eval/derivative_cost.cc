@@ -357,7 +357,7 @@ std::string DerivativeCostReportTable(const DerivativeCostReport& report) {
       static_cast<long long>(report.covered_pixels));
   add("parameters     %d differentiated (vertices, albedo, roughness, specular, light) of %d\n",
       report.num_differentiated, report.num_parameters);
-  add("edge budgets   primary %g, shadow %g, texel %g (x spp x pixels); secondary %d per path "
+  add("edge budgets   primary %g, shadow %g, texel %g (x spp x pixels); secondary %g per path "
       "vertex\n",
       report.derivatives.primary_edge_ratio, report.derivatives.shadow_edge_ratio,
       report.derivatives.texel_edge_ratio, report.derivatives.secondary_edge_samples);

@@ -102,7 +102,7 @@ bool DerivativeRequest::Check(std::string* why) const {
       return false;
     }
   }
-  if (secondary_edge_samples < 0 || secondary_edge_samples > 16) {
+  if (!(secondary_edge_samples >= 0.0 && secondary_edge_samples <= 16.0)) {
     *why =
         "secondary-edge-samples: must be in [0, 16], got " + std::to_string(secondary_edge_samples);
     return false;

@@ -1240,7 +1240,14 @@ void AddSecondaryEdgeSamples(const Context& ctx, const Sampler& path_sampler, in
   const bool environment = secondary.environment && lit_here && ctx.environment != nullptr;
   const bool indirect = depth + 1 < ctx.max_segments;
   if (!environment && !indirect) return;
-  const int num_samples = ctx.request->secondary_edge_samples;
+  // secondary_edge_samples = r samples per vertex on average: ⌊r⌋, plus one more with
+  // probability r − ⌊r⌋, each weighted 1/r (unbiased: the expected count is r).
+  const double num_samples = ctx.request->secondary_edge_samples;
+  int count = static_cast<int>(num_samples);
+  if (count < num_samples &&
+      path_sampler.Fork(kSecondaryEdgeKey - 1).Next1D() < num_samples - count) {
+    ++count;
+  }
   const double offset = RayOffset(ctx, x);
   const double extent = scene.extent();
   const auto& positions = scene.positions();
@@ -1250,7 +1257,7 @@ void AddSecondaryEdgeSamples(const Context& ctx, const Sampler& path_sampler, in
     if (!(cosine > 0.0)) return Eigen::Vector3d::Zero().eval();
     return (EvalBsdf(params, n, wo, omega).cwiseProduct(l_in) * cosine).eval();
   };
-  for (int i = 0; i < num_samples; ++i) {
+  for (int i = 0; i < count; ++i) {
     Sampler sampler = path_sampler.Fork(kSecondaryEdgeKey + 64 * static_cast<uint64_t>(depth) + i);
     double u1, u2, u3, u4;
     sampler.Next2D(&u1, &u2);

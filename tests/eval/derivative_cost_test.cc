@@ -167,7 +167,7 @@ TEST(BenchGradientCommandTest, SmallRunWritesJson) {
   EXPECT_GT(json["jacobian_rows"]["entries"].get<int64_t>(), 0);
   EXPECT_TRUE(json["passes"].contains("forward"));
   // The edge budgets given on the command line are the ones used and reported.
-  EXPECT_EQ(json["edge_budgets"]["secondary_edge_samples"].get<int>(), 0);
+  EXPECT_EQ(json["edge_budgets"]["secondary_edge_samples"].get<double>(), 0.0);
   EXPECT_EQ(json["edge_budgets"]["texel_edge_ratio"].get<double>(), 0.5);
   EXPECT_EQ(json["edge_budgets"]["primary_edge_ratio"].get<double>(),
             DerivativeRequest().primary_edge_ratio);

@@ -261,7 +261,7 @@ TEST(DerivativeRequestTest, VertexDerivativesAndEdgeRatios) {
     EXPECT_FALSE(texel.Check(&why)) << bad;
     EXPECT_NE(why.find("texel-edge-ratio"), std::string::npos) << why;
   }
-  for (int bad : {-1, 17}) {
+  for (double bad : {-1.0, 16.5, std::nan("")}) {
     DerivativeRequest secondary = request;
     secondary.secondary_edge_samples = bad;
     EXPECT_FALSE(secondary.Check(&why)) << bad;
