@@ -19,9 +19,13 @@
 #include "src/render/camera_rig.h"
 #include "src/render/environment.h"
 #include "src/render/render.h"
+#include "tests/testing/views.h"
 
 namespace sft {
 namespace {
+
+using testing::AddPointLight;
+using testing::LookAtView;
 
 struct EdgeScene {
   std::vector<Eigen::Vector3d> positions;
@@ -30,14 +34,19 @@ struct EdgeScene {
   ViewSetup view;
 };
 
-ViewSetup MakeView(const Eigen::Vector3d& center, const Eigen::Vector3d& target, int size,
-                   double focal) {
-  ViewSetup view;
-  view.camera.model = CameraModel::kPinhole;
-  view.camera.width = view.camera.height = size;
-  view.camera.params = {focal, focal, size / 2.0, size / 2.0};
-  view.cam_from_world = LookAt(center, target, Eigen::Vector3d(0, 0, 1));
-  return view;
+// A 6×6 plane (two triangles) filling the view and tilting/shifting along δ: no edge of it is
+// seen, so only interior terms move the image.
+EdgeScene TiltingPlaneScene() {
+  EdgeScene s;
+  s.positions = {{-3, -3, 0}, {3, -3, 0}, {3, 3, 0}, {-3, 3, 0}};
+  s.faces = {{0, 1, 2}, {0, 2, 3}};
+  for (const auto& p : s.positions) {
+    s.delta.push_back(0.1);
+    s.delta.push_back(0.0);
+    s.delta.push_back(0.3 * p.x() + 0.2 * p.y() + 0.5);
+  }
+  s.view = LookAtView({1, 0.5, 3}, {0, 0, 0}, 64, 150);
+  return s;
 }
 
 // A dim uniform environment with one bright patch above the horizon.
@@ -133,7 +142,7 @@ EdgeScene ShadowScene() {
   // The occluder moves sideways and its first corner up.
   for (int v = 4; v < 7; ++v) s.delta[3 * v + 0] = 1.0;
   s.delta[3 * 4 + 2] = 0.5;
-  s.view = MakeView({3, 0.2, 3}, {0, 0, 0}, 64, 200);
+  s.view = LookAtView({3, 0.2, 3}, {0, 0, 0}, 64, 200);
   PointLight light;
   light.position = Eigen::Vector3d(-1, 0, 2);
   light.intensity = Eigen::Vector3d::Constant(10.0);
@@ -156,11 +165,8 @@ TEST(EdgeSamplingTest, PrimaryEdgesAlone) {
   s.positions = {{-0.5, -0.4, 0}, {0.6, -0.3, 0.1}, {0.0, 0.5, -0.1}};
   s.faces = {{0, 1, 2}};
   s.delta = {1, 0, 0, 0, 0.5, 0, 0.3, -0.2, 0.4};
-  s.view = MakeView({0.2, 0.1, 3}, {0, 0, 0}, 64, 80);
-  PointLight light;
-  light.position = Eigen::Vector3d(0.5, 0.5, 3);
-  light.intensity = Eigen::Vector3d::Constant(10.0);
-  s.view.point_lights.push_back(light);
+  s.view = LookAtView({0.2, 0.1, 3}, {0, 0, 0}, 64, 80);
+  AddPointLight(Eigen::Vector3d(0.5, 0.5, 3), 10.0, &s.view);
   RenderOptions options;
   options.spp = 64;
   options.bounces = 1;
@@ -172,11 +178,8 @@ TEST(EdgeSamplingTest, PrimaryEdgesInPlane) {
   s.positions = {{-0.5, -0.4, 0}, {0.6, -0.3, 0}, {0.0, 0.5, 0}};
   s.faces = {{0, 1, 2}};
   s.delta = {1, 0, 0, 0, 0.5, 0, 0.3, -0.2, 0};
-  s.view = MakeView({0.2, 0.1, 3}, {0, 0, 0}, 64, 80);
-  PointLight light;
-  light.position = Eigen::Vector3d(0.5, 0.5, 3);
-  light.intensity = Eigen::Vector3d::Constant(10.0);
-  s.view.point_lights.push_back(light);
+  s.view = LookAtView({0.2, 0.1, 3}, {0, 0, 0}, 64, 80);
+  AddPointLight(Eigen::Vector3d(0.5, 0.5, 3), 10.0, &s.view);
   RenderOptions options;
   options.spp = 64;
   options.bounces = 1;
@@ -184,19 +187,8 @@ TEST(EdgeSamplingTest, PrimaryEdgesInPlane) {
 }
 
 TEST(EdgeSamplingTest, InteriorOnlyTilt) {
-  EdgeScene s;
-  s.positions = {{-3, -3, 0}, {3, -3, 0}, {3, 3, 0}, {-3, 3, 0}};
-  s.faces = {{0, 1, 2}, {0, 2, 3}};
-  for (const auto& p : s.positions) {
-    s.delta.push_back(0.1);
-    s.delta.push_back(0.0);
-    s.delta.push_back(0.3 * p.x() + 0.2 * p.y() + 0.5);
-  }
-  s.view = MakeView({1, 0.5, 3}, {0, 0, 0}, 64, 150);
-  PointLight light;
-  light.position = Eigen::Vector3d(0.5, 0.5, 1);
-  light.intensity = Eigen::Vector3d::Constant(10.0);
-  s.view.point_lights.push_back(light);
+  EdgeScene s = TiltingPlaneScene();
+  AddPointLight(Eigen::Vector3d(0.5, 0.5, 1), 10.0, &s.view);
   RenderOptions options;
   options.spp = 4;
   options.bounces = 1;
@@ -204,15 +196,7 @@ TEST(EdgeSamplingTest, InteriorOnlyTilt) {
 }
 
 TEST(EdgeSamplingTest, InteriorOnlyEnvironment) {
-  EdgeScene s;
-  s.positions = {{-3, -3, 0}, {3, -3, 0}, {3, 3, 0}, {-3, 3, 0}};
-  s.faces = {{0, 1, 2}, {0, 2, 3}};
-  for (const auto& p : s.positions) {
-    s.delta.push_back(0.1);
-    s.delta.push_back(0.0);
-    s.delta.push_back(0.3 * p.x() + 0.2 * p.y() + 0.5);
-  }
-  s.view = MakeView({1, 0.5, 3}, {0, 0, 0}, 64, 150);
+  EdgeScene s = TiltingPlaneScene();
   s.view.environment = &PatchEnvironment();
   RenderOptions options;
   options.spp = 16;
@@ -235,16 +219,13 @@ EdgeScene TentScene() {
   s.delta[3 * 1 + 0] = 1.0;
   s.delta[3 * 2 + 0] = 0.5;
   s.delta[3 * 1 + 2] = 0.5;
-  s.view = MakeView({0.5, 0.3, 3}, {0, 0, 0.3}, 64, 100);
+  s.view = LookAtView({0.5, 0.3, 3}, {0, 0, 0.3}, 64, 100);
   return s;
 }
 
 TEST(EdgeSamplingTest, CreaseUnderPointLight) {
   EdgeScene s = TentScene();
-  PointLight light;
-  light.position = Eigen::Vector3d(2, -1, 3);
-  light.intensity = Eigen::Vector3d::Constant(10.0);
-  s.view.point_lights.push_back(light);
+  AddPointLight(Eigen::Vector3d(2, -1, 3), 10.0, &s.view);
   RenderOptions options;
   options.spp = 64;
   options.bounces = 1;

@@ -25,6 +25,7 @@
 #include "src/geometry/material.h"
 #include "src/render/camera_rig.h"
 #include "src/render/render.h"
+#include "tests/testing/views.h"
 
 namespace sft {
 namespace {
@@ -68,11 +69,8 @@ PlaneScene MakePlane() {
     s.delta.push_back(0.5 * std::cos(0.7 * p.x() - 0.2) - 0.2 * p.x());
     s.delta.push_back(0.2 * std::sin(0.8 * p.x() + 0.6 * p.y()));
   }
-  s.view.camera.model = CameraModel::kPinhole;
-  s.view.camera.width = s.view.camera.height = 64;
-  s.view.camera.params = {120.0, 120.0, 32.0, 32.0};
-  s.view.cam_from_world = LookAt(Eigen::Vector3d(0.3, -0.6, 3.0), Eigen::Vector3d(0.13, 0.07, 0),
-                                 Eigen::Vector3d(0, 1, 0));
+  s.view = testing::LookAtView(Eigen::Vector3d(0.3, -0.6, 3.0), Eigen::Vector3d(0.13, 0.07, 0), 64,
+                               120.0, Eigen::Vector3d(0, 1, 0));
   PointLight light;
   light.position = Eigen::Vector3d(0.5, 0.3, 2.0);
   light.intensity = Eigen::Vector3d::Constant(8.0);
