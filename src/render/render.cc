@@ -999,6 +999,105 @@ double MaterialJump(const Material& material, bool glossy, int face_a, const Eig
   return std::isfinite(size) ? size : 0.0;
 }
 
+// A texel boundary segment in 3D: the points Σ_k b_k(s)·p_k, b(s) = b0 + s·(b1 − b0), s ∈ [0, 1],
+// of face `face` (corners p_k), separating texels whose material differs by `size`
+// (MaterialJump); `other` is the face across it (`face` itself for a grid line inside the face,
+// the neighbour for mesh edge `edge` between coplanar faces; edge −1 for grid lines).
+struct TexelSegment {
+  int face, other, edge;
+  Eigen::Vector3d b0, b1;
+  double size;
+};
+
+// Every texel boundary of the material on the mesh: grid lines inside faces whose texels vary
+// and edges between coplanar, equally oriented faces, each cut where other grid lines cross so
+// that a piece separates two texels, kept where the two sides' materials differ (roughness only
+// counts with the glossy lobe on).
+std::vector<TexelSegment> TexelSegments(const RenderScene& scene, const Material& material,
+                                        bool glossy) {
+  std::vector<TexelSegment> segments;
+  const std::vector<double> lines = TexelGridLines(material);
+  if (lines.empty()) return segments;
+  const auto& faces = scene.faces();
+  const auto& positions = scene.positions();
+  auto barycentrics = [](const Eigen::Vector2d& ab) {
+    return Eigen::Vector3d(1.0 - ab.x() - ab.y(), ab.x(), ab.y());
+  };
+  // Grid lines inside the faces: α = a (axis 0) or β = a (axis 1), the other coordinate t over
+  // [0, 1 − a], cut where the other grid lines cross.
+  std::vector<double> cuts;
+  for (size_t f = 0; f < faces.size(); ++f) {
+    const int face = static_cast<int>(f);
+    if (scene.FaceNormal(face).isZero()) continue;
+    if (!FaceTexelsVary(material.albedo, face) &&
+        !(glossy && FaceTexelsVary(material.roughness, face))) {
+      continue;
+    }
+    for (const double a : lines) {
+      const double extent = 1.0 - a;
+      cuts.assign(1, 0.0);
+      for (const double c : lines) {
+        if (c < extent - 1e-9) cuts.push_back(c);  // lines ending on this one: not a cut.
+      }
+      cuts.push_back(extent);
+      for (int axis = 0; axis < 2; ++axis) {
+        // (α, β) of the point at distance `across` from the line's axis and `along` it.
+        auto ab = [axis](double across, double along) {
+          return axis == 0 ? Eigen::Vector2d(across, along) : Eigen::Vector2d(along, across);
+        };
+        for (size_t k = 0; k + 1 < cuts.size(); ++k) {
+          const double mid = 0.5 * (cuts[k] + cuts[k + 1]);
+          const double size = MaterialJump(material, glossy, face, ab(a - kTexelSideOffset, mid),
+                                           face, ab(a + kTexelSideOffset, mid));
+          if (!(size > 0.0)) continue;
+          segments.push_back({face, face, -1, barycentrics(ab(a, cuts[k])),
+                              barycentrics(ab(a, cuts[k + 1])), size});
+        }
+      }
+    }
+  }
+  // Edges between coplanar faces (the others are mesh edges, sampled as such, whose jump
+  // includes the material's), cut at the grid lines' crossings t = k/r (the same on every edge).
+  cuts.assign(1, 0.0);
+  cuts.insert(cuts.end(), lines.begin(), lines.end());
+  cuts.push_back(1.0);
+  for (size_t e = 0; e < scene.edges().size(); ++e) {
+    const MeshEdge& edge = scene.edges()[e];
+    if (edge.num_faces != 2 || positions[edge.v0] == positions[edge.v1]) continue;
+    const Eigen::Vector3d n0 = scene.FaceNormal(edge.f0), n1 = scene.FaceNormal(edge.f1);
+    if (n0.isZero() || n1.isZero() || !(n0.dot(n1) >= 1.0 - 1e-12)) continue;
+    // Per face (0: f0, 1: f1): the barycentric unit vectors of the edge's ends and of the
+    // opposite corner.
+    const int side_faces[2] = {edge.f0, edge.f1};
+    Eigen::Vector3d end0[2], end1[2], opposite[2];
+    for (int i = 0; i < 2; ++i) {
+      const Eigen::Vector3i& corners = faces[side_faces[i]];
+      for (int k = 0; k < 3; ++k) {
+        end0[i][k] = corners[k] == edge.v0 ? 1.0 : 0.0;
+        end1[i][k] = corners[k] == edge.v1 ? 1.0 : 0.0;
+        opposite[i][k] = corners[k] != edge.v0 && corners[k] != edge.v1 ? 1.0 : 0.0;
+      }
+    }
+    for (size_t k = 0; k + 1 < cuts.size(); ++k) {
+      const double mid = 0.5 * (cuts[k] + cuts[k + 1]);
+      Eigen::Vector2d ab[2];
+      for (int i = 0; i < 2; ++i) {
+        // The edge point, moved slightly into face i so that it looks up that face's texel.
+        const Eigen::Vector3d b =
+            (1.0 - kTexelSideOffset) * ((1.0 - mid) * end0[i] + mid * end1[i]) +
+            kTexelSideOffset * opposite[i];
+        ab[i] = Eigen::Vector2d(b[1], b[2]);
+      }
+      const double size = MaterialJump(material, glossy, edge.f0, ab[0], edge.f1, ab[1]);
+      if (!(size > 0.0)) continue;
+      segments.push_back({edge.f0, edge.f1, static_cast<int>(e),
+                          (1.0 - cuts[k]) * end0[0] + cuts[k] * end1[0],
+                          (1.0 - cuts[k + 1]) * end0[0] + cuts[k + 1] * end1[0], size});
+    }
+  }
+  return segments;
+}
+
 // The direct term of point light `light`, shadow ray included, at the first hit of the ray from
 // `origin` along the unit direction `dir` (from t_near `t_near` on), as TraceRadiance computes
 // it there. False when that hit is not on face `receiver`.
@@ -1577,7 +1676,6 @@ void AddEdgeTerms(const Context& ctx, std::vector<DerivativeList>* pixel_lists,
   if (texel_ratio > 0.0) {
     const Material& material = ctx.material;
     const bool glossy = material.specular * ctx.specular_scale > 0.0;
-    const std::vector<double> lines = TexelGridLines(material);
     std::vector<TexelCandidate> candidates;
     // Adds the segment of `face` from barycentrics b0 to b1 (over its corners), clipped to the
     // view, weighted by projected length × material jump `size`.
@@ -1598,80 +1696,13 @@ void AddEdgeTerms(const Context& ctx, std::vector<DerivativeList>* pixel_lists,
       if (!(weight > 0.0) || !std::isfinite(weight)) return;
       candidates.push_back({face, other, b0, b1, s0, s1, weight});
     };
-    auto barycentrics = [](double alpha, double beta) {
-      return Eigen::Vector3d(1.0 - alpha - beta, alpha, beta);
-    };
-    // Grid lines inside the faces: α = a (axis 0) or β = a (axis 1), the other coordinate t over
-    // [0, 1 − a], cut where the other grid lines cross so that each piece separates two texels.
-    std::vector<double> cuts;
-    for (size_t f = 0; f < faces.size() && !lines.empty(); ++f) {
-      const int face = static_cast<int>(f);
-      if (scene.FaceNormal(face).isZero()) continue;
-      if (!FaceTexelsVary(material.albedo, face) &&
-          !(glossy && FaceTexelsVary(material.roughness, face))) {
+    for (const TexelSegment& segment : TexelSegments(scene, material, glossy)) {
+      // A coplanar edge seen edge-on from the camera is a primary edge there.
+      if (segment.edge >= 0 &&
+          IsDiscontinuityEdge(scene, edges[segment.edge], center, /*creases=*/true)) {
         continue;
       }
-      for (const double a : lines) {
-        const double extent = 1.0 - a;
-        cuts.assign(1, 0.0);
-        for (const double c : lines) {
-          if (c < extent - 1e-9) cuts.push_back(c);  // lines ending on this one: not a cut.
-        }
-        cuts.push_back(extent);
-        for (int axis = 0; axis < 2; ++axis) {
-          // (α, β) of the point at distance `across` from the line's axis and `along` it.
-          auto ab = [axis](double across, double along) {
-            return axis == 0 ? Eigen::Vector2d(across, along) : Eigen::Vector2d(along, across);
-          };
-          for (size_t k = 0; k + 1 < cuts.size(); ++k) {
-            const double mid = 0.5 * (cuts[k] + cuts[k + 1]);
-            const double size = MaterialJump(material, glossy, face, ab(a - kTexelSideOffset, mid),
-                                             face, ab(a + kTexelSideOffset, mid));
-            if (!(size > 0.0)) continue;
-            const Eigen::Vector2d from = ab(a, cuts[k]), to = ab(a, cuts[k + 1]);
-            add_segment(face, face, barycentrics(from.x(), from.y()), barycentrics(to.x(), to.y()),
-                        size);
-          }
-        }
-      }
-    }
-    // Edges between coplanar faces (the others are primary edges, whose jump includes the
-    // material's), cut at the grid lines' crossings t = k/r (the same on every edge).
-    cuts.assign(1, 0.0);
-    cuts.insert(cuts.end(), lines.begin(), lines.end());
-    cuts.push_back(1.0);
-    for (const MeshEdge& edge : edges) {
-      if (edge.num_faces != 2 || positions[edge.v0] == positions[edge.v1] ||
-          IsDiscontinuityEdge(scene, edge, center, /*creases=*/true)) {
-        continue;
-      }
-      // Per face (0: f0, 1: f1): the barycentric unit vectors of the edge's ends and of the
-      // opposite corner.
-      const int side_faces[2] = {edge.f0, edge.f1};
-      Eigen::Vector3d end0[2], end1[2], opposite[2];
-      for (int i = 0; i < 2; ++i) {
-        const Eigen::Vector3i& corners = faces[side_faces[i]];
-        for (int k = 0; k < 3; ++k) {
-          end0[i][k] = corners[k] == edge.v0 ? 1.0 : 0.0;
-          end1[i][k] = corners[k] == edge.v1 ? 1.0 : 0.0;
-          opposite[i][k] = corners[k] != edge.v0 && corners[k] != edge.v1 ? 1.0 : 0.0;
-        }
-      }
-      for (size_t k = 0; k + 1 < cuts.size(); ++k) {
-        const double mid = 0.5 * (cuts[k] + cuts[k + 1]);
-        Eigen::Vector2d ab[2];
-        for (int i = 0; i < 2; ++i) {
-          // The edge point, moved slightly into face i so that it looks up that face's texel.
-          const Eigen::Vector3d b =
-              (1.0 - kTexelSideOffset) * ((1.0 - mid) * end0[i] + mid * end1[i]) +
-              kTexelSideOffset * opposite[i];
-          ab[i] = Eigen::Vector2d(b[1], b[2]);
-        }
-        const double size = MaterialJump(material, glossy, edge.f0, ab[0], edge.f1, ab[1]);
-        if (!(size > 0.0)) continue;
-        add_segment(edge.f0, edge.f1, (1.0 - cuts[k]) * end0[0] + cuts[k] * end1[0],
-                    (1.0 - cuts[k + 1]) * end0[0] + cuts[k + 1] * end1[0], size);
-      }
+      add_segment(segment.face, segment.other, segment.b0, segment.b1, segment.size);
     }
     const auto sample_texel = [&](const TexelCandidate& candidate, double s, double inv_pdf,
                                   const Sampler& sampler, std::vector<EdgeEntry>* out) {
