@@ -18,11 +18,11 @@
 //     through the hit points of earlier bounces; all effects;
 //   vertices, boundary terms (edge sampling, render.cc): see the table.
 //
-// Vertex derivative terms present per Effects setting (✓ present, — not needed, ✗ missing):
+// Vertex derivative terms present per Effects setting (✓ present, — not needed):
 //   effect on      interior  primary edges     texel boundaries  point-light shadow  secondary (A)
 //   direct         ✓         ✓                 ✓ seen directly   —                   —
 //   + shadows      ✓         ✓                 ✓ seen directly   ✓ seen directly     —
-//   + bounces      ✓         ✓                 ✗ seen via bounce ✓ via bounce (B)    ✓ silhouettes,
+//   + bounces      ✓         ✓                 ✓ via bounce (C)  ✓ via bounce (B)    ✓ silhouettes,
 //                                                                                      creases
 //   + environment  ✓         ✓ (vs background) ✓ seen directly   —                   ✓ occlusion
 //                                                                                      (with
@@ -31,16 +31,17 @@
 // Secondary edges (render.cc, AddSecondaryEdgeSamples; secondary_edge_samples per path vertex):
 // (A) mesh edges seen from a path vertex — silhouettes against the environment (when it is lit
 // with shadows) or against farther surfaces, and creases, when a further bounce is traced;
-// (B) point-light shadow boundaries on the surface a bounce reaches. Their sampling ((edge,
-// point) pairs drawn ∝ length and uniform in subtended angle, one kept by resampling with the
-// BSDF·cosine towards it) is unbiased but noisy on finely tessellated meshes.
+// (B) point-light shadow boundaries on the surface a bounce reaches; (C) texel boundaries on the
+// surface a bounce reaches. Their sampling ((edge, point) pairs drawn ∝ length — × material
+// jump for (C) — and uniform in subtended angle, one kept by resampling with the BSDF·cosine
+// towards it) is unbiased but noisy on finely tessellated meshes.
 // Primary edges cover silhouettes, boundary and non-manifold edges and, because shading is flat,
 // creases between non-coplanar faces. Texel boundaries are where piecewise-constant albedo or
 // roughness (mesh colors) jumps: grid lines inside faces and edges between coplanar faces, moving
 // with the vertices. Their jump in the full path radiance (direct and indirect light, shadowed or
-// not) is included where the camera sees them directly; not included is their effect through a
-// bounce (a texel boundary seen in a reflection, or the indirect light it sends to other
-// surfaces). Shadow rays do not depend on the material, so texel boundaries cast no shadows.
+// not) is included where the camera sees them directly, and through a bounce by secondary edges
+// (C) (a texel boundary seen in a reflection, or the indirect light it sends to other surfaces).
+// Shadow rays do not depend on the material, so texel boundaries cast no shadows.
 #ifndef SFT_RENDER_DERIVATIVES_H_
 #define SFT_RENDER_DERIVATIVES_H_
 

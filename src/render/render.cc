@@ -1229,7 +1229,9 @@ std::vector<EdgeCandidate> ShadowEdgeCandidates(const RenderScene& scene,
 //       environment, when it is lit with shadows, or a farther surface, when a further bounce
 //       is traced) and, when a further bounce is traced, creases (flat shading);
 //   (B) when a further bounce is traced with shadows, the directions of the shadow points that
-//       point lights' silhouette edges cast (the next vertex's direct term jumps there).
+//       point lights' silhouette edges cast (the next vertex's direct term jumps there);
+//   (C) when a further bounce is traced, the directions of texel boundaries (TexelSegments) on
+//       the surfaces seen (the material, hence the radiance leaving them, jumps there).
 // Boundary term: ∂H/∂θ += ∫_curve (g(ω⁻) − g(ω⁺))·(m·∂ω/∂θ) dl, g = f·(n·ω)·L_in, m the unit
 // normal of the curve on the sphere and ω± = normalize(ω ± εm). For a curve point y seen from x,
 // ω = (y − x)/r and m·∂ω/∂θ = mᵀ(∂y/∂θ − ∂x/∂θ)/r; dl = |dω/ds| ds along the curve parameter s.
@@ -1239,8 +1241,8 @@ std::vector<EdgeCandidate> ShadowEdgeCandidates(const RenderScene& scene,
 // times the path throughput, credited to the path's pixel. Both sides trace with the same random
 // numbers. Other radiance leaving the next vertex is continuous along ω (its own hemisphere
 // integrals smooth out their jumps), so (A) and (B) are all the curves for flat-shaded, untextured
-// surfaces; texel boundaries seen from x are not sampled. (B)'s uniform s still weights receiver
-// points close to x by 1/r.
+// surfaces; (C) adds the texel boundaries of mesh-colors materials on the surfaces a further
+// bounce sees. (B)'s uniform s still weights receiver points close to x by 1/r.
 
 // Directions closer than this (relative to extent/r) to a curve on the sphere are its sides.
 constexpr double kSecondarySideOffset = 1e-5;
@@ -1255,16 +1257,36 @@ struct SecondaryEdges {
   std::vector<double> lengths;  // their lengths.
   AliasTable by_length;         // draws an index into `edges` ∝ length.
   bool environment = false;     // the environment is lit with visibility (shadows on).
+  // Texel boundaries (when a further bounce is traced and the material has any), with weights
+  // 3D length × material jump and an alias table over them.
+  std::vector<TexelSegment> texels;
+  std::vector<double> texel_weights;
+  AliasTable texels_by_weight;
   // Per point light of the view (when shadows and a further bounce exist): shadow-casting edges
   // and their cumulative weights (angles at the light).
   std::vector<std::vector<EdgeCandidate>> shadow_candidates;
   std::vector<std::vector<double>> shadow_cumulative;
 };
 
-SecondaryEdges BuildSecondaryEdges(const RenderScene& scene, const ViewSetup& view,
-                                   const RenderOptions& options, bool environment,
-                                   int max_segments) {
+SecondaryEdges BuildSecondaryEdges(const RenderScene& scene, const Material& material,
+                                   const ViewSetup& view, const RenderOptions& options,
+                                   bool environment, int max_segments) {
   SecondaryEdges out;
+  if (max_segments > 1) {
+    const bool glossy = options.effects.specular && material.specular > 0.0;
+    for (const TexelSegment& segment : TexelSegments(scene, material, glossy)) {
+      const Eigen::Vector3i& corners = scene.faces()[segment.face];
+      Eigen::Vector3d along = Eigen::Vector3d::Zero();
+      for (int k = 0; k < 3; ++k) {
+        along += (segment.b1[k] - segment.b0[k]) * scene.positions()[corners[k]];
+      }
+      const double weight = along.norm() * segment.size;
+      if (!(weight > 0.0) || !std::isfinite(weight)) continue;
+      out.texels.push_back(segment);
+      out.texel_weights.push_back(weight);
+    }
+    if (!out.texels.empty()) out.texels_by_weight = AliasTable(out.texel_weights);
+  }
   out.environment = environment && options.effects.shadows;
   for (size_t e = 0; e < scene.edges().size(); ++e) {
     const MeshEdge& edge = scene.edges()[e];
@@ -1442,6 +1464,88 @@ void AddSecondaryEdgeSamples(const Context& ctx, const Sampler& path_sampler, in
               const int vertices[2] = {edge.v0, edge.v1};
               const Eigen::Vector3d rows[2] = {(1.0 - s_edge) * m_row, s_edge * m_row};
               path->AddBoundary(throughput.cwiseProduct(jump) * inv_pdf, vertices, rows, 2, -m_row);
+            }
+          }
+        }
+      }
+    }
+
+    // (C) Texel boundaries on the surfaces a further bounce sees: L_in jumps where the material
+    // of the surface hit along ω does. Sampled like (A): kSecondaryCandidates (segment, point)
+    // pairs, the segment ∝ 3D length × material jump, the point uniform in its subtended angle,
+    // one kept by resampling with target f·(n·ω); the jump counts only where the two side rays
+    // see the segment's faces (one each; both the same face for a grid line inside a face).
+    if (indirect && !secondary.texels.empty()) {
+      Sampler texel_sampler = sampler.Fork(1);
+      int chosen_texel = -1;
+      double t_sum = 0.0, t_target = 0.0, t_s = 0.0;
+      auto ends = [&](const TexelSegment& segment, Eigen::Vector3d* y0, Eigen::Vector3d* y1) {
+        const Eigen::Vector3i& corners = scene.faces()[segment.face];
+        y0->setZero();
+        y1->setZero();
+        for (int k = 0; k < 3; ++k) {
+          *y0 += segment.b0[k] * positions[corners[k]];
+          *y1 += segment.b1[k] * positions[corners[k]];
+        }
+      };
+      for (int k = 0; k < kSecondaryCandidates; ++k) {
+        const int c = secondary.texels_by_weight.Sample(texel_sampler.Next1D());
+        const double xi = texel_sampler.Next1D();
+        const double pick = texel_sampler.Next1D();
+        const TexelSegment& segment = secondary.texels[c];
+        if (segment.face == face || segment.other == face) continue;  // on x's plane: cos = 0.
+        Eigen::Vector3d y0, y1;
+        ends(segment, &y0, &y1);
+        if (!(std::max(n.dot(y0 - x), n.dot(y1 - x)) > 0.0)) continue;
+        double s_k = 0.0, subtended = 0.0;
+        if (!AngleUniformEdgePoint(y0, y1, x, xi, &s_k, &subtended)) continue;
+        const Eigen::Vector3d omega = (y0 + s_k * (y1 - y0) - x).normalized();
+        const double target = integrand(omega, Eigen::Vector3d::Ones()).sum();
+        const double w =
+            target * subtended * secondary.texels_by_weight.total() / secondary.texel_weights[c];
+        if (!(w > 0.0) || !std::isfinite(w)) continue;
+        t_sum += w;
+        if (pick * t_sum < w) {
+          chosen_texel = c;
+          t_target = target;
+          t_s = s_k;
+        }
+      }
+      if (chosen_texel >= 0) {
+        const TexelSegment& segment = secondary.texels[chosen_texel];
+        Eigen::Vector3d y0, y1;
+        ends(segment, &y0, &y1);
+        const Eigen::Vector3d to_y = y0 + t_s * (y1 - y0) - x;
+        const double r = to_y.norm();
+        const Eigen::Vector3d omega = to_y / r;
+        const Eigen::Matrix3d tangent_projection =
+            (Eigen::Matrix3d::Identity() - omega * omega.transpose()) / r;
+        Eigen::Vector3d m, sides[2];
+        double speed;
+        if (r > offset && n.dot(omega) > 0.0 &&
+            SphereSides(omega, tangent_projection * (y1 - y0), r, extent, &m, sides, &speed)) {
+          RayHit hits[2];
+          for (int k = 0; k < 2; ++k) hits[k] = scene.Intersect(x, sides[k], offset, kInfinity);
+          stats->bounce_rays += 2;
+          const bool seen = hits[0].hit && hits[1].hit &&
+                            ((hits[0].face == segment.face && hits[1].face == segment.other) ||
+                             (hits[0].face == segment.other && hits[1].face == segment.face));
+          if (seen) {
+            Eigen::Vector3d g[2];
+            for (int k = 0; k < 2; ++k) {
+              Sampler copy = texel_sampler;
+              g[k] = integrand(sides[k], TraceRadiance(ctx, &copy, sides[k], hits[k], stats,
+                                                       nullptr, depth + 1));
+            }
+            const Eigen::Vector3d jump = g[0] - g[1];
+            if (!jump.isZero() && jump.allFinite()) {
+              const double inv_pdf = t_sum / (t_target * kSecondaryCandidates * num_samples);
+              const Eigen::Vector3d m_row = m / r;  // m·∂ω/∂y; ∂y/∂p_k = b_k·I.
+              const Eigen::Vector3d b = segment.b0 + t_s * (segment.b1 - segment.b0);
+              const Eigen::Vector3i& corners = scene.faces()[segment.face];
+              const int vertices[3] = {corners[0], corners[1], corners[2]};
+              const Eigen::Vector3d rows[3] = {b[0] * m_row, b[1] * m_row, b[2] * m_row};
+              path->AddBoundary(throughput.cwiseProduct(jump) * inv_pdf, vertices, rows, 3, -m_row);
             }
           }
         }
@@ -1757,7 +1861,8 @@ void RenderImpl(const RenderScene& scene, const Material& material, const ViewSe
       request->params.vertices && options.pass == RenderPass::kColor &&
       request->secondary_edge_samples > 0 &&
       ((environment != nullptr && options.effects.shadows) || max_segments > 1)) {
-    secondary = BuildSecondaryEdges(scene, view, options, environment != nullptr, max_segments);
+    secondary =
+        BuildSecondaryEdges(scene, material, view, options, environment != nullptr, max_segments);
   }
   const Context ctx{scene,
                     material,
