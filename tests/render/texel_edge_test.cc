@@ -220,9 +220,10 @@ TEST(TexelEdgeTest, GlossyRoughnessCheckerboard) {
 //
 // The finite difference is noisy here (bounce rays near the boundary switch texels over the ±h
 // step), so h is long (0.1; the irradiance is smooth in the boundary's position) and the samples
-// many. Block error with the term: 4.8%, 5.0%, 5.6%, 5.0% for seeds 0–3 at 2048 spp; 4.1% at
-// 4096 and 3.4% at 8192 spp (seed 0); at h = 0.05: 13% (1024 spp), 5.3% (4096). Hence 8% at 2048
-// spp (~9 s on 2 cores), above the 5% because of that noise, not of the term.
+// many. Block error with the term sampled at every secondary sample: 4.8%, 5.0%, 5.6%, 5.0% for
+// seeds 0–3 at 2048 spp; 4.1% at 4096 and 3.4% at 8192 spp (seed 0); at h = 0.05: 13% (1024 spp),
+// 5.3% (4096); at a quarter of them (the default, kSecondaryTexelProbability) 5.2% at 2048 spp.
+// Hence 8% at 2048 spp (~7 s on 2 cores), above the 5% because of that noise.
 TEST(TexelEdgeTest, BoundarySeenThroughABounce) {
   PlaneScene s = MakePlane();
   s.delta.clear();
