@@ -1357,6 +1357,46 @@ bool AngleUniformEdgePoint(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
   return std::isfinite(*s);
 }
 
+// One (segment, point) pair drawn for a secondary sample by resampled importance sampling
+// (Talbot et al. 2005), see (A) below: kSecondaryCandidates segments drawn from `table` (pdf
+// weights[c]/total), each with a point uniform in the angle it subtends at x, weighted
+// w_k = p̂_k·Θ_k/p_k with p̂ = `target`(ω_k), one kept ∝ w_k. `ends(c, &a, &b)` gives candidate
+// c's endpoints, or false where it cannot be a jump seen from x (p̂ = 0). The first candidate
+// uses (u_index, u_point), the rest `sampler`.
+struct ResampledPoint {
+  int index = -1;        // the kept candidate; −1 when none had a positive weight.
+  double s = 0.0;        // its point a + s(b − a).
+  double inv_pdf = 0.0;  // Θ/(p·p̂) replaced by (1/K)Σ_k w_k/p̂: the estimate's weight/jump.
+};
+
+template <typename Ends, typename Target>
+ResampledPoint ResampleSegmentPoint(const AliasTable& table, const std::vector<double>& weights,
+                                    const Eigen::Vector3d& x, double u_index, double u_point,
+                                    Sampler* sampler, const Ends& ends, const Target& target) {
+  ResampledPoint out;
+  double w_sum = 0.0, kept_target = 0.0;
+  for (int k = 0; k < kSecondaryCandidates; ++k) {
+    const int c = table.Sample(k == 0 ? u_index : sampler->Next1D());
+    const double xi = k == 0 ? u_point : sampler->Next1D();
+    const double pick = sampler->Next1D();
+    Eigen::Vector3d a, b;
+    if (!ends(c, &a, &b)) continue;
+    double s_k = 0.0, subtended = 0.0;
+    if (!AngleUniformEdgePoint(a, b, x, xi, &s_k, &subtended)) continue;
+    const double p_hat = target((a + s_k * (b - a) - x).normalized());
+    const double w = p_hat * subtended * table.total() / weights[c];
+    if (!(w > 0.0) || !std::isfinite(w)) continue;
+    w_sum += w;
+    if (pick * w_sum < w) {
+      out.index = c;
+      out.s = s_k;
+      kept_target = p_hat;
+    }
+  }
+  if (out.index >= 0) out.inv_pdf = w_sum / (kept_target * kSecondaryCandidates);
+  return out;
+}
+
 void AddSecondaryEdgeSamples(const Context& ctx, const Sampler& path_sampler, int depth, int face,
                              const Eigen::Vector3d& throughput, const Eigen::Vector3d& x,
                              const Eigen::Vector3d& n, const Eigen::Vector3d& wo,
@@ -1402,34 +1442,25 @@ void AddSecondaryEdgeSamples(const Context& ctx, const Sampler& path_sampler, in
     // can be non-zero. The BSDF factor in p̂ matters for glossy lobes: without it, the few
     // points that land in a narrow lobe carry weights in the hundreds (heavy-tailed noise that
     // hid the derivative on bunny_point_ggx_gi at two bounces).
-    int chosen = -1;
-    double w_sum = 0.0, chosen_target = 0.0, s_edge = 0.0;
+    // Target: the BSDF·cosine towards the point.
+    auto bsdf_cosine = [&](const Eigen::Vector3d& omega) {
+      return integrand(omega, Eigen::Vector3d::Ones()).sum();
+    };
+    ResampledPoint kept;
     if (!secondary.edges.empty()) {
-      for (int k = 0; k < kSecondaryCandidates; ++k) {
-        const int c = secondary.by_length.Sample(k == 0 ? u1 : sampler.Next1D());
-        const double xi = k == 0 ? u2 : sampler.Next1D();
-        const double pick = sampler.Next1D();
-        const double length = secondary.lengths[c];
+      auto edge_ends = [&](int c, Eigen::Vector3d* a, Eigen::Vector3d* b) {
         const MeshEdge& edge = scene.edges()[secondary.edges[c]];
-        if (edge.f0 == face || edge.f1 == face) continue;
-        const Eigen::Vector3d& a = positions[edge.v0];
-        const Eigen::Vector3d& b = positions[edge.v1];
-        if (!(std::max(n.dot(a - x), n.dot(b - x)) > 0.0)) continue;
-        if (!IsDiscontinuityEdge(scene, edge, x, /*creases=*/indirect)) continue;
-        double s_k = 0.0, subtended = 0.0;
-        if (!AngleUniformEdgePoint(a, b, x, xi, &s_k, &subtended)) continue;
-        const Eigen::Vector3d omega = (a + s_k * (b - a) - x).normalized();
-        const double target = integrand(omega, Eigen::Vector3d::Ones()).sum();
-        const double w = target * subtended * secondary.by_length.total() / length;
-        if (!(w > 0.0) || !std::isfinite(w)) continue;
-        w_sum += w;
-        if (pick * w_sum < w) {
-          chosen = c;
-          chosen_target = target;
-          s_edge = s_k;
-        }
-      }
+        if (edge.f0 == face || edge.f1 == face) return false;
+        *a = positions[edge.v0];
+        *b = positions[edge.v1];
+        if (!(std::max(n.dot(*a - x), n.dot(*b - x)) > 0.0)) return false;
+        return IsDiscontinuityEdge(scene, edge, x, /*creases=*/indirect);
+      };
+      kept = ResampleSegmentPoint(secondary.by_length, secondary.lengths, x, u1, u2, &sampler,
+                                  edge_ends, bsdf_cosine);
     }
+    const int chosen = kept.index;
+    const double s_edge = kept.s;
     if (chosen >= 0) {
       const MeshEdge& edge = scene.edges()[secondary.edges[chosen]];
       const Eigen::Vector3d& a = positions[edge.v0];
@@ -1465,7 +1496,7 @@ void AddSecondaryEdgeSamples(const Context& ctx, const Sampler& path_sampler, in
             }
             const Eigen::Vector3d jump = g[0] - g[1];
             if (!jump.isZero() && jump.allFinite()) {
-              const double inv_pdf = w_sum / (chosen_target * kSecondaryCandidates * num_samples);
+              const double inv_pdf = kept.inv_pdf / num_samples;
               const Eigen::Vector3d m_row = m / r;  // m·∂ω/∂y.
               const int vertices[2] = {edge.v0, edge.v1};
               const Eigen::Vector3d rows[2] = {(1.0 - s_edge) * m_row, s_edge * m_row};
@@ -1484,8 +1515,6 @@ void AddSecondaryEdgeSamples(const Context& ctx, const Sampler& path_sampler, in
     Sampler texel_sampler = sampler.Fork(1);
     if (indirect && !secondary.texels.empty() &&
         texel_sampler.Next1D() < kSecondaryTexelProbability) {
-      int chosen_texel = -1;
-      double t_sum = 0.0, t_target = 0.0, t_s = 0.0;
       auto ends = [&](const TexelSegment& segment, Eigen::Vector3d* y0, Eigen::Vector3d* y1) {
         const Eigen::Vector3i& corners = scene.faces()[segment.face];
         y0->setZero();
@@ -1495,29 +1524,18 @@ void AddSecondaryEdgeSamples(const Context& ctx, const Sampler& path_sampler, in
           *y1 += segment.b1[k] * positions[corners[k]];
         }
       };
-      for (int k = 0; k < kSecondaryCandidates; ++k) {
-        const int c = secondary.texels_by_weight.Sample(texel_sampler.Next1D());
-        const double xi = texel_sampler.Next1D();
-        const double pick = texel_sampler.Next1D();
+      auto texel_ends = [&](int c, Eigen::Vector3d* y0, Eigen::Vector3d* y1) {
         const TexelSegment& segment = secondary.texels[c];
-        if (segment.face == face || segment.other == face) continue;  // on x's plane: cos = 0.
-        Eigen::Vector3d y0, y1;
-        ends(segment, &y0, &y1);
-        if (!(std::max(n.dot(y0 - x), n.dot(y1 - x)) > 0.0)) continue;
-        double s_k = 0.0, subtended = 0.0;
-        if (!AngleUniformEdgePoint(y0, y1, x, xi, &s_k, &subtended)) continue;
-        const Eigen::Vector3d omega = (y0 + s_k * (y1 - y0) - x).normalized();
-        const double target = integrand(omega, Eigen::Vector3d::Ones()).sum();
-        const double w =
-            target * subtended * secondary.texels_by_weight.total() / secondary.texel_weights[c];
-        if (!(w > 0.0) || !std::isfinite(w)) continue;
-        t_sum += w;
-        if (pick * t_sum < w) {
-          chosen_texel = c;
-          t_target = target;
-          t_s = s_k;
-        }
-      }
+        if (segment.face == face || segment.other == face) return false;  // x's plane: cos = 0.
+        ends(segment, y0, y1);
+        return std::max(n.dot(*y0 - x), n.dot(*y1 - x)) > 0.0;
+      };
+      const double u_index = texel_sampler.Next1D(), u_point = texel_sampler.Next1D();
+      const ResampledPoint kept_texel =
+          ResampleSegmentPoint(secondary.texels_by_weight, secondary.texel_weights, x, u_index,
+                               u_point, &texel_sampler, texel_ends, bsdf_cosine);
+      const int chosen_texel = kept_texel.index;
+      const double t_s = kept_texel.s;
       if (chosen_texel >= 0) {
         const TexelSegment& segment = secondary.texels[chosen_texel];
         Eigen::Vector3d y0, y1;
@@ -1546,8 +1564,8 @@ void AddSecondaryEdgeSamples(const Context& ctx, const Sampler& path_sampler, in
             }
             const Eigen::Vector3d jump = g[0] - g[1];
             if (!jump.isZero() && jump.allFinite()) {
-              const double inv_pdf = t_sum / (t_target * kSecondaryCandidates * num_samples *
-                                              kSecondaryTexelProbability);
+              const double inv_pdf =
+                  kept_texel.inv_pdf / (num_samples * kSecondaryTexelProbability);
               const Eigen::Vector3d m_row = m / r;  // m·∂ω/∂y; ∂y/∂p_k = b_k·I.
               const Eigen::Vector3d b = segment.b0 + t_s * (segment.b1 - segment.b0);
               const Eigen::Vector3i& corners = scene.faces()[segment.face];
