@@ -208,6 +208,13 @@ TEST_F(LambertBunnyTest, EdgeBudgetsAndImages) {
   const Status status = RunGradcheck(dataset_, mesh_, material_, interior, &without_edges);
   EXPECT_FALSE(status.ok());
   EXPECT_THAT(status.message(), HasSubstr("primary-edge-ratio"));
+  // An image directory that cannot be created (below a regular file) is an error, not a crash.
+  testing::WriteTestFile(tmp.Join("file"), "x");
+  GradcheckOptions unwritable = options;
+  unwritable.image_dir = tmp.Join("file/images");
+  const Status image_status = RunGradcheck(dataset_, mesh_, material_, unwritable, &with_edges);
+  EXPECT_FALSE(image_status.ok());
+  EXPECT_THAT(image_status.message(), HasSubstr("file/images"));
 }
 
 // Vertex derivatives (interior terms and primary edge sampling) agree with finite differences
