@@ -92,6 +92,30 @@ Geometry Grid(int n, double half) {
   return g;
 }
 
+// The adjoint gradient of the image sum (all pixels and channels weighted 1) over the vertex
+// coordinates of `g`, with `primary_edge_ratio` (the other budgets at their defaults); *image
+// gets the rendered image.
+std::vector<double> ImageSumGradient(const Geometry& g, const Material& material,
+                                     const ViewSetup& view, const RenderOptions& options,
+                                     double primary_edge_ratio, Image* image) {
+  const Image ones(view.camera.width, view.camera.height, 3, 1.0f);
+  DerivativeRequest request;
+  request.params = ParameterSelection::Only(ParameterKind::kVertex);
+  request.adjoint_weights = &ones;
+  request.primary_edge_ratio = primary_edge_ratio;
+  DerivativeOutput out;
+  RenderViewWithDerivatives(RenderScene(g.positions, g.faces), material, view, options, request, 0,
+                            image, &out);
+  return out.gradient;
+}
+
+// Σ_i gradient_i·delta_i over delta's entries (the directional derivative along delta).
+double Directional(const std::vector<double>& gradient, const std::vector<double>& delta) {
+  double sum = 0.0;
+  for (size_t i = 0; i < delta.size(); ++i) sum += gradient[i] * delta[i];
+  return sum;
+}
+
 Material Lambert(const Geometry& g, double albedo) {
   return ConstantMaterial(static_cast<int>(g.faces.size()), Eigen::Vector3d::Constant(albedo), 0.5,
                           0.0);
@@ -313,22 +337,16 @@ TEST(VertexDerivativesTest, SphereSilhouetteMatchesAnalyticAreaDerivative) {
   for (size_t v = 0; v < sphere.positions.size(); ++v) {
     for (int k = 0; k < 3; ++k) delta[3 * v + k] = sphere.positions[v][k];
   }
-  Image ones(res, res, 3, 1.0f);
-  DerivativeRequest request;
-  request.params = ParameterSelection::Only(ParameterKind::kVertex);
-  request.adjoint_weights = &ones;
-  const RenderScene scene(sphere.positions, sphere.faces);
   Image image;
-  DerivativeOutput out;
-  RenderViewWithDerivatives(scene, material, view, options, request, 0, &image, &out);
+  const std::vector<double> gradient = ImageSumGradient(
+      sphere, material, view, options, DerivativeRequest().primary_edge_ratio, &image);
   double image_sum = 0.0;
   for (int y = 0; y < res; ++y) {
     for (int x = 0; x < res; ++x) {
       for (int c = 0; c < 3; ++c) image_sum += image.at(x, y, c);
     }
   }
-  double derivative = 0.0;
-  for (size_t i = 0; i < delta.size(); ++i) derivative += out.gradient[i] * delta[i];
+  const double derivative = Directional(gradient, delta);
 
   const double r = 1.0, d2 = distance * distance;
   const double area = M_PI * focal * focal * r * r / (d2 - r * r);
@@ -395,15 +413,10 @@ TEST(VertexDerivativesTest, SilhouetteAgainstBackgroundMatchesExactAreaDerivativ
   options.effects.bounces = false;
   options.effects.specular = false;
   options.sampling_material = &material;
-  Image ones(res, res, 3, 1.0f);
-  DerivativeRequest request;
-  request.params = ParameterSelection::Only(ParameterKind::kVertex);
-  request.adjoint_weights = &ones;
-  request.primary_edge_ratio = 4.0;  // 4 × 16 edge samples per pixel (the interior term is 0).
-  const RenderScene scene(sphere.positions, sphere.faces);
+  // Primary edge ratio 4: 4 × 16 edge samples per pixel (the interior term is 0).
   Image image;
-  DerivativeOutput out;
-  RenderViewWithDerivatives(scene, material, view, options, request, 0, &image, &out);
+  const std::vector<double> gradient =
+      ImageSumGradient(sphere, material, view, options, 4.0, &image);
 
   std::vector<double> scaling(3 * sphere.positions.size());
   for (size_t v = 0; v < sphere.positions.size(); ++v) {
@@ -420,8 +433,7 @@ TEST(VertexDerivativesTest, SilhouetteAgainstBackgroundMatchesExactAreaDerivativ
       return ProjectedConvexArea(p, view);
     };
     const double exact = -3.0 * radiance * (area(1e-6) - area(-1e-6)) / 2e-6;
-    double derivative = 0.0;
-    for (size_t i = 0; i < delta.size(); ++i) derivative += out.gradient[i] * delta[i];
+    const double derivative = Directional(gradient, delta);
     std::printf("%s field: derivative %.6g, exact %.6g (%+.3f%%)\n", name, derivative, exact,
                 100.0 * (derivative - exact) / std::abs(exact));
     EXPECT_NEAR(derivative, exact, 0.005 * std::abs(exact)) << name;
@@ -530,16 +542,10 @@ TEST(VertexDerivativesTest, SubpixelFlapNextToSilhouette) {
     delta[3 * v + 0] = g.positions[v].x();
     delta[3 * v + 2] = g.positions[v].z();
   }
-  Image ones(res, res, 3, 1.0f);
-  DerivativeRequest request;
-  request.params = ParameterSelection::Only(ParameterKind::kVertex);
-  request.adjoint_weights = &ones;
-  const RenderScene scene(g.positions, g.faces);
   Image image;
-  DerivativeOutput out;
-  RenderViewWithDerivatives(scene, material, view, options, request, 0, &image, &out);
-  double derivative = 0.0;
-  for (size_t i = 0; i < delta.size(); ++i) derivative += out.gradient[i] * delta[i];
+  const std::vector<double> gradient =
+      ImageSumGradient(g, material, view, options, DerivativeRequest().primary_edge_ratio, &image);
+  const double derivative = Directional(gradient, delta);
   auto area = [&](double t) {
     std::vector<Eigen::Vector3d> p = g.positions;
     for (size_t v = 0; v < p.size(); ++v) {
