@@ -51,6 +51,9 @@ Status ReadBenchMesh(const std::string& path, TriMesh* mesh) {
 Status RunBenchRender(const BenchRenderOptions& opts) {
   std::string why;
   if (!opts.throughput.Check(&why)) return Status::Error("--" + why);
+  if (!opts.json.empty()) {
+    SFT_RETURN_IF_ERROR(CheckOutputFile(opts.json, {{}, {opts.mesh}}, "--json"));
+  }
   TriMesh mesh;
   SFT_RETURN_IF_ERROR(ReadBenchMesh(opts.mesh, &mesh));
   ThroughputReport report;
@@ -68,6 +71,9 @@ Status RunBenchRender(const BenchRenderOptions& opts) {
 Status RunBenchGradient(const BenchGradientOptions& opts) {
   std::string why;
   if (!opts.cost.Check(&why)) return Status::Error("--" + why);
+  if (!opts.json.empty()) {
+    SFT_RETURN_IF_ERROR(CheckOutputFile(opts.json, {{}, {opts.mesh}}, "--json"));
+  }
   TriMesh mesh;
   SFT_RETURN_IF_ERROR(ReadBenchMesh(opts.mesh, &mesh));
   DerivativeCostOptions cost = opts.cost;

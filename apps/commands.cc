@@ -34,6 +34,10 @@ void AddEdgeBudgetOptions(CLI::App* app, DerivativeRequest* request) {
       ->capture_default_str();
 }
 
+std::string MaterialFile(const std::string& material) {
+  return (material.empty() || material[0] == '{') ? std::string() : material;
+}
+
 int PrintError(const std::string& command, const Status& status) {
   std::fprintf(stderr, "sft %s: error: %s\n", command.c_str(), status.message().c_str());
   return 1;

@@ -33,6 +33,10 @@ int RunCommandTable(int argc, char** argv);
 // `request`'s fields (defaults shown; DerivativeRequest::Check validates them).
 void AddEdgeBudgetOptions(CLI::App* app, DerivativeRequest* request);
 
+// The file a --material value names, or "" for inline JSON and the default material (for the
+// output checks of CheckOutputDirectory/CheckOutputFile).
+std::string MaterialFile(const std::string& material);
+
 // One per command file.
 CommandRunner SetupSynthCommand(CLI::App* app);
 CommandRunner SetupRenderCommand(CLI::App* app);

@@ -40,8 +40,13 @@ int RunGradcheckCommand(const GradcheckCommandOptions& opts) {
     return PrintError("gradcheck", Status::Error("--" + why));
   }
   if (!check.Check(&why)) return PrintError("gradcheck", Status::Error("--" + why));
+  const RunInputs inputs{{opts.dataset}, {opts.mesh, MaterialFile(opts.material)}};
+  Status status = Status::Ok();
+  if (!check.image_dir.empty()) status = CheckOutputDirectory(check.image_dir, inputs, "--images");
+  if (status.ok() && !opts.json.empty()) status = CheckOutputFile(opts.json, inputs, "--json");
+  if (!status.ok()) return PrintError("gradcheck", status);
   Dataset dataset;
-  Status status = ReadDataset(opts.dataset, &dataset);
+  status = ReadDataset(opts.dataset, &dataset);
   if (!status.ok()) return PrintError("gradcheck", status);
   TriMesh mesh;
   status = ReadMesh(opts.mesh, &mesh);

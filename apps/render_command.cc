@@ -1,5 +1,7 @@
 // sft render: renders every view of a dataset with a given mesh and material into DIR/images/
-// (EXR, same base names as the dataset's images), plus DIR/render.json with timings and counts.
+// (EXR; each view's image path mirrored under images/, see ViewOutputPaths), plus DIR/render.json
+// with timings and counts. It writes nothing outside DIR and refuses a DIR that is, is inside or
+// holds one of its inputs.
 // Unless --no-report, each render is also compared with its dataset image (CompareImages over the
 // view's mask, or the target's alpha when the view has no mask), the measures go into render.json
 // and DIR/report.html shows target, render and |difference| per view (PNGs in DIR/report_files/).
@@ -184,6 +186,8 @@ Status FinishRenderOptions(const std::string& pass, const std::string& effects,
 Status RunRender(const RenderCommandOptions& opts) {
   RenderOptions render = opts.render;
   SFT_RETURN_IF_ERROR(FinishRenderOptions(opts.pass, opts.effects, &render));
+  SFT_RETURN_IF_ERROR(CheckOutputDirectory(
+      opts.out, {{opts.dataset}, {opts.mesh, MaterialFile(opts.material)}}, "--out"));
   Dataset dataset;
   SFT_RETURN_IF_ERROR(ReadDataset(opts.dataset, &dataset));
   TriMesh mesh;
@@ -195,6 +199,7 @@ Status RunRender(const RenderCommandOptions& opts) {
   std::vector<int> selected;
   const Status selection = SelectViews(opts.views, static_cast<int>(views.views.size()), &selected);
   if (!selection.ok()) return Status::Error("--" + selection.message());
+  const std::vector<std::string> out_paths = ViewOutputPaths(dataset, ".exr");
   const RenderScene scene(mesh);
   Progress progress("render", static_cast<int64_t>(selected.size()), !opts.quiet);
   nlohmann::json report;
@@ -217,12 +222,9 @@ Status RunRender(const RenderCommandOptions& opts) {
     Image image;
     RenderStats stats;
     RenderView(scene, material, views.views[v], render, &image, &stats);
-    std::filesystem::path name(dataset.views[v].image);
-    name.replace_extension(".exr");
-    const std::string out_path = JoinPath(opts.out, name.string());
-    SFT_RETURN_IF_ERROR(WriteExr(out_path, image));
+    SFT_RETURN_IF_ERROR(WriteExr(JoinPath(opts.out, out_paths[v]), image));
     nlohmann::json entry = {{"view", v},
-                            {"image", name.string()},
+                            {"image", out_paths[v]},
                             {"seconds", stats.seconds},
                             {"camera_rays", stats.camera_rays},
                             {"shadow_rays", stats.shadow_rays},
@@ -241,6 +243,9 @@ Status RunRender(const RenderCommandOptions& opts) {
       } else {
         entry["comparison"] = nullptr;
         entry["comparison_skipped"] = c.why_not;
+        if (colour_pass) {
+          progress.Warn("view " + std::to_string(v) + " not compared: " + c.why_not);
+        }
         bar_values.push_back(std::numeric_limits<double>::quiet_NaN());
       }
       ImageRow row;

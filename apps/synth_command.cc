@@ -81,6 +81,10 @@ Status RunSynth(const SynthOptions& opts) {
   RenderOptions render = opts.render;
   if (!Effects::Parse(opts.effects, &render.effects, &why)) return Status::Error("--" + why);
   if (!render.Check(&why)) return Status::Error("--" + why);
+  // --overwrite removes OUT: it must never hold the mesh, material or probe being read.
+  const RunInputs inputs{{}, {opts.mesh, MaterialFile(opts.material), opts.envmap}};
+  SFT_RETURN_IF_ERROR(CheckOutputDirectory(opts.out, inputs, "--out"));
+  SFT_RETURN_IF_ERROR(CheckOutputDirectory(opts.out + ".partial", inputs, "--out (OUT.partial)"));
   std::error_code ec;
   if (fs::exists(opts.out, ec) && !fs::is_empty(opts.out, ec) && !opts.overwrite) {
     return Status::Error(opts.out + ": output exists and is not empty (use --overwrite)");

@@ -3,6 +3,8 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
+#include <cstring>
 #include <atomic>
 #include <filesystem>
 #include <fstream>
@@ -54,8 +56,9 @@ Status WriteAtomically(const std::string& path,
   }
   fs::rename(tmp, target, ec);
   if (ec) {
+    const std::string reason = ec.message();  // before remove() overwrites ec.
     fs::remove(tmp, ec);
-    return Status::Error(path + ": cannot write (" + ec.message() + ")");
+    return Status::Error(path + ": cannot write (" + reason + ")");
   }
   return Status::Ok();
 }
@@ -65,7 +68,7 @@ Status WriteTextFile(const std::string& path, const std::string& contents) {
     std::ofstream out(tmp, std::ios::binary);
     out << contents;
     out.close();
-    if (!out) return Status::Error(path + ": cannot write");
+    if (!out) return Status::Error(path + ": cannot write (" + std::strerror(errno) + ")");
     return Status::Ok();
   });
 }
@@ -79,6 +82,104 @@ Status ReadTextFile(const std::string& path, std::string* contents) {
   std::ostringstream ss;
   ss << in.rdbuf();
   *contents = ss.str();
+  return Status::Ok();
+}
+
+bool IsContainedRelativePath(const std::string& path, std::string* why) {
+  if (path.empty()) {
+    *why = "empty path";
+    return false;
+  }
+  const fs::path p(path);
+  if (p.is_absolute() || p.has_root_name() || p.has_root_directory()) {
+    *why = "absolute path \"" + path + "\" (must be relative to the dataset folder)";
+    return false;
+  }
+  for (const fs::path& part : p) {
+    if (part == "..") {
+      *why = "path \"" + path + "\" has a '..' component (must stay inside the dataset folder)";
+      return false;
+    }
+  }
+  if (p.lexically_normal() == "." || p.filename().empty()) {
+    *why = "path \"" + path + "\" names a folder, expected a file";
+    return false;
+  }
+  return true;
+}
+
+namespace {
+
+// `path` with symbolic links, "." and ".." resolved as far as it exists (absolute).
+fs::path Resolved(const std::string& path) {
+  std::error_code ec;
+  fs::path resolved = fs::weakly_canonical(fs::absolute(path, ec), ec);
+  if (ec) resolved = fs::absolute(path, ec).lexically_normal();
+  // weakly_canonical keeps a trailing separator ("D/" -> "D/"): drop it so "D/" == "D".
+  if (resolved.has_relative_path() && resolved.filename().empty()) {
+    resolved = resolved.parent_path();
+  }
+  return resolved;
+}
+
+// Whether `inner` is `outer` or lies below it (both resolved).
+bool IsWithin(const fs::path& inner, const fs::path& outer) {
+  auto i = inner.begin();
+  for (auto o = outer.begin(); o != outer.end(); ++o, ++i) {
+    if (i == inner.end() || *i != *o) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+Status CheckOutputDirectory(const std::string& out, const RunInputs& inputs,
+                            const std::string& flag) {
+  if (out.empty()) return Status::Error(flag + ": must not be empty");
+  std::error_code ec;
+  if (fs::exists(out, ec) && !fs::is_directory(out, ec)) {
+    return Status::Error(flag + " " + out + ": exists and is not a directory");
+  }
+  const fs::path o = Resolved(out);
+  for (const std::string& dir : inputs.directories) {
+    if (dir.empty()) continue;
+    const fs::path d = Resolved(dir);
+    if (IsWithin(o, d)) {
+      return Status::Error(flag + " " + out + ": is " + (o == d ? "" : "inside ") +
+                           "the input folder " + dir +
+                           "; outputs never go into an input (choose another folder)");
+    }
+    if (IsWithin(d, o)) {
+      return Status::Error(flag + " " + out + ": holds the input folder " + dir +
+                           "; outputs never go where inputs are (choose another folder)");
+    }
+  }
+  for (const std::string& file : inputs.files) {
+    if (file.empty()) continue;
+    if (IsWithin(Resolved(file), o)) {
+      return Status::Error(flag + " " + out + ": holds the input file " + file +
+                           "; outputs never go where inputs are (choose another folder)");
+    }
+  }
+  return Status::Ok();
+}
+
+Status CheckOutputFile(const std::string& file, const RunInputs& inputs, const std::string& flag) {
+  if (file.empty()) return Status::Error(flag + ": must not be empty");
+  std::error_code ec;
+  if (fs::is_directory(file, ec)) return Status::Error(flag + " " + file + ": is a directory");
+  const fs::path f = Resolved(file);
+  for (const std::string& dir : inputs.directories) {
+    if (!dir.empty() && IsWithin(f, Resolved(dir))) {
+      return Status::Error(flag + " " + file + ": is inside the input folder " + dir +
+                           "; outputs never go into an input");
+    }
+  }
+  for (const std::string& input : inputs.files) {
+    if (!input.empty() && f == Resolved(input)) {
+      return Status::Error(flag + " " + file + ": is an input file of this run");
+    }
+  }
   return Status::Ok();
 }
 

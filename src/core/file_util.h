@@ -5,6 +5,7 @@
 
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "src/core/status.h"
 
@@ -32,6 +33,30 @@ Status ReadTextFile(const std::string& path, std::string* contents);
 Status MakeDirectories(const std::string& path);
 
 bool FileExists(const std::string& path);
+
+// Whether `path` may name a file inside a dataset (DESIGN.md §2.5): non-empty, relative, and
+// without a ".." component, so that joining it to the dataset folder (or mirroring it under an
+// output folder) can never leave that folder. Otherwise false with the reason in *why.
+bool IsContainedRelativePath(const std::string& path, std::string* why);
+
+// What a command reads, for CheckOutputLocation: directories (a dataset) and files (a mesh, a
+// material JSON, a probe). Empty strings and inline values are ignored by the check.
+struct RunInputs {
+  std::vector<std::string> directories;
+  std::vector<std::string> files;
+};
+
+// Refuses an output directory that would put a run's outputs among its inputs: `out` empty, an
+// existing non-directory, equal to or inside an input directory, or an ancestor of an input
+// directory or file. Paths are compared after resolving symbolic links, "." and ".." (as far as
+// they exist), so "./D/" and a symlink to D count as D. `flag` names the option in the error
+// ("--out"). Every command that writes calls this before it reads or writes anything.
+Status CheckOutputDirectory(const std::string& out, const RunInputs& inputs,
+                            const std::string& flag);
+
+// The same for a single output file (--json FILE): refused when empty, a directory, equal to an
+// input file, or inside an input directory.
+Status CheckOutputFile(const std::string& file, const RunInputs& inputs, const std::string& flag);
 
 }  // namespace sft
 

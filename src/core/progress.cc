@@ -35,6 +35,14 @@ void Progress::Finish() {
   Print(true);
 }
 
+void Progress::Warn(const std::string& message) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const bool tty = isatty(fileno(stderr));
+  std::fprintf(stderr, "%ssft %s: warning: %s\n", (enabled_ && tty) ? "\r\033[K" : "",
+               label_.c_str(), message.c_str());
+  std::fflush(stderr);
+}
+
 void Progress::Print(bool final_line) {
   const int64_t done = done_.load();
   last_printed_ = done;

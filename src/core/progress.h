@@ -19,6 +19,9 @@ class Progress {
   void Advance(int64_t units = 1);
   void Finish();
   double ElapsedSeconds() const;
+  // Prints "sft LABEL: warning: MESSAGE" on its own line of stderr, also when the progress line
+  // is disabled (a warning is never quiet); on a terminal the progress line is redrawn below it.
+  void Warn(const std::string& message);
 
  private:
   void Print(bool final_line);

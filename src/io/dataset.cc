@@ -126,6 +126,15 @@ class SceneParser {
     return Status::Ok();
   }
 
+  // A file path inside the dataset: relative, no ".." (DESIGN.md §2.5). Readers reject anything
+  // else, so that no command can be led outside the dataset (or, mirroring the path under its
+  // output folder, outside that) by scene.json.
+  Status ContainedPath(const std::string& path, const std::string& value) const {
+    std::string why;
+    if (!IsContainedRelativePath(value, &why)) return Error(path, why);
+    return Status::Ok();
+  }
+
   Status RequiredString(const json& obj, const std::string& prefix, const char* key,
                         std::string* out) const {
     const json* value = nullptr;
@@ -267,6 +276,7 @@ class SceneParser {
   Status ParseEnvironmentLight(const json& entry, const std::string& path, LightSpec* light) const {
     light->type = LightType::kEnvironment;
     SFT_RETURN_IF_ERROR(RequiredString(entry, path, "image", &light->image));
+    SFT_RETURN_IF_ERROR(ContainedPath(Field(path, "image"), light->image));
     if (const json* matrix = Find(entry, "world_from_env")) {
       const std::string matrix_path = Field(path, "world_from_env");
       if (!matrix->is_array() || matrix->size() != 3) {
@@ -363,8 +373,10 @@ class SceneParser {
       if (!entry.is_object()) return Error(path, "expected an object, got " + Describe(entry));
       ViewSpec view;
       SFT_RETURN_IF_ERROR(RequiredString(entry, path, "image", &view.image));
+      SFT_RETURN_IF_ERROR(ContainedPath(Field(path, "image"), view.image));
       if (const json* mask = Find(entry, "mask"); mask != nullptr && !mask->is_null()) {
         SFT_RETURN_IF_ERROR(String(*mask, Field(path, "mask"), false, &view.mask));
+        SFT_RETURN_IF_ERROR(ContainedPath(Field(path, "mask"), view.mask));
       }
       SFT_RETURN_IF_ERROR(RequiredString(entry, path, "camera", &view.camera_id));
       for (size_t c = 0; c < dataset->cameras.size(); ++c) {
@@ -432,6 +444,7 @@ class SceneParser {
     dataset->ground_truth = *value;
     if (const json* mesh = Find(*value, "mesh"); mesh != nullptr && !mesh->is_null()) {
       SFT_RETURN_IF_ERROR(String(*mesh, "ground_truth.mesh", false, &dataset->gt_mesh));
+      SFT_RETURN_IF_ERROR(ContainedPath("ground_truth.mesh", dataset->gt_mesh));
     }
     return Status::Ok();
   }
@@ -694,6 +707,32 @@ Status LoadProbe(const Dataset& dataset, int light_index, Image* rgb) {
   }
   *rgb = std::move(result);
   return Status::Ok();
+}
+
+std::vector<std::string> ViewOutputPaths(const Dataset& dataset, const std::string& extension) {
+  std::vector<std::string> paths;
+  std::set<std::string> taken;
+  for (size_t v = 0; v < dataset.views.size(); ++v) {
+    std::filesystem::path relative(dataset.views[v].image);
+    auto first = relative.begin();
+    if (first != relative.end() && *first == "images" && std::next(first) != relative.end()) {
+      std::filesystem::path rest;
+      for (auto it = std::next(first); it != relative.end(); ++it) rest /= *it;
+      relative = rest;
+    }
+    relative.replace_extension(extension);
+    std::filesystem::path path = (std::filesystem::path("images") / relative).lexically_normal();
+    char suffix[32];
+    std::snprintf(suffix, sizeof(suffix), "_view%03zu", v);
+    std::string stem = path.stem().string();
+    while (taken.count(path.string()) > 0) {
+      stem += suffix;
+      path.replace_filename(stem + extension);
+    }
+    taken.insert(path.string());
+    paths.push_back(path.string());
+  }
+  return paths;
 }
 
 }  // namespace sft

@@ -99,6 +99,15 @@ Status CheckDatasetFiles(const Dataset& dataset);
 // JSON objects are ignored. camera_extra entries beyond cameras.size() are ignored.
 Status WriteSceneJson(const Dataset& dataset, const std::string& dir);
 
+// Where a command writing one image per view puts view v's, relative to its output folder: the
+// view's image path mirrored under "images/" (a leading "images/" component is not repeated) with
+// `extension` (".exr"), so that per-camera subfolders stay apart: "images/cam1/000.png" ->
+// "images/cam1/000.exr", "photos/a.jpg" -> "images/photos/a.exr". Views whose names would
+// coincide (the same image twice, or "000.png" and "000.exr") get "_view<NNN>" before the
+// extension, NNN the view index, so no output overwrites another. Paths are as read by
+// ReadDataset (relative, no ".."), so the results never leave the output folder.
+std::vector<std::string> ViewOutputPaths(const Dataset& dataset, const std::string& extension);
+
 // Loads view `index`'s image as linear RGB (alpha dropped; 3 channels), checking its size.
 Status LoadViewImage(const Dataset& dataset, int index, Image* rgb);
 // Loads view `index`'s mask as a 1-channel image of 0/1 (> 127 = object). Error if no mask.

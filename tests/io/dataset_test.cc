@@ -318,6 +318,45 @@ TEST(DatasetErrors, ViewWithoutImage) {
   EXPECT_THAT(ReadError(scene), HasSubstr("views[1].image: expected a string"));
 }
 
+// Paths in scene.json are relative to the dataset and never leave it (DESIGN.md §2.5): absolute
+// paths and ".." components are refused with one error naming the field, before any file is read.
+TEST(DatasetErrors, PathsMustStayInsideTheDataset) {
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"/views/0/image", "/etc/passwd"},
+      {"/views/1/image", "../outside.exr"},
+      {"/views/1/image", "images/../../outside.exr"},
+      {"/views/0/mask", "/tmp/m.png"},
+      {"/views/0/mask", "masks/../../m.png"},
+      {"/lights/1/image", "../probe.exr"},
+      {"/ground_truth/mesh", "/home/user/mesh.ply"},
+  };
+  const std::vector<std::string> fields = {"views[0].image", "views[1].image", "views[1].image",
+                                           "views[0].mask",  "views[0].mask",  "lights[1].image",
+                                           "ground_truth.mesh"};
+  for (size_t i = 0; i < cases.size(); ++i) {
+    json scene = MinimalScene();
+    scene[json::json_pointer(cases[i].first)] = cases[i].second;
+    const std::string error = ReadError(scene);
+    EXPECT_THAT(error, HasSubstr(fields[i])) << cases[i].second;
+    EXPECT_THAT(error, HasSubstr(cases[i].second)) << error;
+  }
+}
+
+TEST(DatasetOutputPaths, MirrorUnderImagesAndNeverCollide) {
+  Dataset dataset;
+  for (const char* image : {"images/000.exr", "images/cam1/000.png", "images/cam2/000.png",
+                            "photos/a.jpg", "images/000.png", "images/000.exr", "b.png"}) {
+    ViewSpec view;
+    view.image = image;
+    dataset.views.push_back(view);
+  }
+  EXPECT_THAT(ViewOutputPaths(dataset, ".exr"),
+              ::testing::ElementsAre("images/000.exr", "images/cam1/000.exr",
+                                     "images/cam2/000.exr", "images/photos/a.exr",
+                                     "images/000_view004.exr", "images/000_view005.exr",
+                                     "images/b.exr"));
+}
+
 TEST(DatasetErrors, NoViews) {
   json scene = MinimalScene();
   scene["views"] = json::array();
