@@ -14,6 +14,9 @@ const CommandEntry kCommands[] = {
     {"gradcheck",
      "Compare the renderer's derivatives with finite differences for one parameter kind",
      &SetupGradcheckCommand},
+    {"reconstruct",
+     "Refine a mesh and its material until path-traced renders match a dataset (Ceres)",
+     &SetupReconstructCommand},
     {"bench", "Measure throughput against the limit (raw Embree rays/s)", &SetupBenchCommand},
 };
 

@@ -144,6 +144,8 @@ void HtmlReport::AddTable(const std::vector<std::string>& header,
 
 void HtmlReport::AddBarChart(const BarChart& chart) { body_ += BarChartSvg(chart); }
 
+void HtmlReport::AddSvg(const std::string& svg) { body_ += svg; }
+
 Status HtmlReport::WriteImage(const std::string& file, const Image& image) {
   SFT_RETURN_IF_ERROR(CheckImageFile(file));
   CHECK(!image.empty()) << file;

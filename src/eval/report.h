@@ -80,6 +80,8 @@ class HtmlReport {
   void AddTable(const std::vector<std::string>& header,
                 const std::vector<std::vector<std::string>>& rows);
   void AddBarChart(const BarChart& chart);
+  // Appends an inline <svg> element made by this program (e.g. LineChartSvg); not escaped.
+  void AddSvg(const std::string& svg);
   // Writes `image` as an 8-bit sRGB-encoded PNG (colour clamped to [0, 1]; alpha dropped, so
   // thumbnails show on black) to dir/file, atomically. Errors: a file that is empty, absolute,
   // contains "..", or does not end in ".png"; a failed write.

@@ -1,0 +1,199 @@
+// sft reconstruct: refines a mesh and its material until path-traced renders match a dataset's
+// images (src/optim). Writes the state, metrics and an HTML report into OUT (src/optim/
+// run_outputs.h); Ctrl-C stops after the current iteration, writes a checkpoint and exits 130;
+// `--resume OUT` continues from it.
+#include <csignal>
+#include <cstdio>
+#include <nlohmann/json.hpp>
+
+#include "apps/commands.h"
+#include "src/eval/reconstruct_report.h"
+#include "src/core/file_util.h"
+#include "src/core/progress.h"
+#include "src/geometry/material.h"
+#include "src/geometry/mesh.h"
+#include "src/io/dataset.h"
+#include "src/io/light_scales.h"
+#include "src/optim/config.h"
+#include "src/optim/reconstruct.h"
+#include "src/optim/run_outputs.h"
+
+namespace sft {
+namespace {
+
+std::atomic<bool> g_interrupted{false};
+extern "C" void OnInterrupt(int) { g_interrupted = true; }
+
+// Command-line values; those left unset do not override the config file.
+struct ReconstructCommandOptions {
+  std::string dataset;   // dataset directory.
+  std::string init;      // initial mesh.
+  std::string out;       // output directory.
+  std::string resume;    // an earlier run's output directory to continue.
+  std::string config;    // config JSON file.
+  std::string material;  // initial material (JSON file or inline); "" = constant guess.
+  std::string phases, solver;
+  int outer = 0, steps = 0, spp = 0, bounces = 0, threads = -1;
+  int64_t seed = -1;
+  std::vector<int> views;
+  bool quiet = false;
+  bool no_report = false;
+};
+
+constexpr char kInitialGuess[] = R"({"albedo": [0.5, 0.5, 0.5], "roughness": 0.5})";
+
+// The effective options: defaults < config file < state.json (resume) < flags.
+Status MakeOptions(const ReconstructCommandOptions& cli, const nlohmann::json* resumed,
+                   ReconstructOptions* options) {
+  if (resumed != nullptr) {
+    SFT_RETURN_IF_ERROR(ApplyReconstructConfig(*resumed, cli.resume + "/state.json", options));
+  }
+  if (!cli.config.empty()) SFT_RETURN_IF_ERROR(ReadReconstructConfig(cli.config, options));
+  nlohmann::json flags = nlohmann::json::object();
+  if (!cli.phases.empty()) flags["phases"] = cli.phases;
+  if (!cli.solver.empty()) flags["solver"] = cli.solver;
+  if (cli.outer != 0) flags["outer_iterations"] = cli.outer;
+  if (cli.steps != 0) flags["steps"] = cli.steps;
+  if (cli.spp != 0) flags["spp"] = cli.spp;
+  if (cli.bounces != 0) flags["bounces"] = cli.bounces;
+  if (cli.threads >= 0) flags["threads"] = cli.threads;
+  if (cli.seed >= 0) flags["seed"] = static_cast<uint64_t>(cli.seed);
+  if (!cli.views.empty()) flags["views"] = cli.views;
+  // Flag errors name the flag ("--steps: ...").
+  for (const auto& [key, value] : flags.items()) {
+    const Status status = ApplyReconstructConfig({{key, value}}, "flag", options);
+    if (!status.ok()) {
+      std::string message = status.message();
+      message = message.substr(message.find(": ") + 2);  // "steps: expected ...".
+      return Status::Error("--" + message);
+    }
+  }
+  std::string why;
+  if (!options->Check(&why)) return Status::Error(why);
+  return Status::Ok();
+}
+
+Status RunReconstruct(const ReconstructCommandOptions& cli_in) {
+  ReconstructCommandOptions cli = cli_in;
+  RunState state;
+  nlohmann::json resumed_config;
+  if (!cli.resume.empty()) {
+    if (!cli.out.empty() && cli.out != cli.resume) {
+      return Status::Error("--resume continues in its own folder: drop --out or give the same");
+    }
+    cli.out = cli.resume;
+    SFT_RETURN_IF_ERROR(ReadRunState(cli.resume, &state));
+    if (cli.dataset.empty()) cli.dataset = state.dataset;
+    resumed_config = state.config;
+  } else if (cli.dataset.empty() || cli.init.empty() || cli.out.empty()) {
+    return Status::Error("--dataset, --init and --out are required (or --resume OUT)");
+  }
+  ReconstructOptions options;
+  SFT_RETURN_IF_ERROR(MakeOptions(cli, cli.resume.empty() ? nullptr : &resumed_config, &options));
+  RunInputs inputs{{cli.dataset}, {cli.init, MaterialFile(cli.material), cli.config}};
+  if (cli.resume.empty()) {
+    SFT_RETURN_IF_ERROR(CheckOutputDirectory(cli.out, inputs, "--out"));
+    if (FileExists(JoinPath(cli.out, "state.json"))) {
+      return Status::Error("--out " + cli.out +
+                           ": holds an earlier reconstruction (continue it with --resume " +
+                           cli.out + ", or choose another folder)");
+    }
+  } else {
+    SFT_RETURN_IF_ERROR(CheckOutputDirectory(cli.out, {{cli.dataset}, {}}, "--resume"));
+  }
+  Dataset dataset;
+  SFT_RETURN_IF_ERROR(ReadDataset(cli.dataset, &dataset));
+  TriMesh mesh;
+  Material material;
+  std::vector<double> light_scales;
+  if (cli.resume.empty()) {
+    SFT_RETURN_IF_ERROR(ReadMesh(cli.init, &mesh));
+    SFT_RETURN_IF_ERROR(
+        LoadMaterial(cli.material.empty() ? kInitialGuess : cli.material, mesh, &material));
+  } else {
+    SFT_RETURN_IF_ERROR(ReadMesh(JoinPath(cli.out, "mesh.ply"), &mesh));
+    SFT_RETURN_IF_ERROR(LoadMaterial(JoinPath(cli.out, "material.json"), mesh, &material));
+    SFT_RETURN_IF_ERROR(ReadLightScales(JoinPath(cli.out, "lights.json"), dataset, &light_scales));
+  }
+  std::unique_ptr<Reconstruction> reconstruction;
+  SFT_RETURN_IF_ERROR(
+      Reconstruction::Create(dataset, mesh, material, light_scales, options, &reconstruction));
+  reconstruction->elapsed_offset = state.seconds;
+  std::vector<IterationRecord> records;
+  if (!cli.resume.empty()) SFT_RETURN_IF_ERROR(ReadIterationRecords(cli.out, &records));
+  SFT_RETURN_IF_ERROR(MakeDirectories(cli.out));
+
+  state.dataset = cli.dataset;
+  state.config = ReconstructConfigJson(options);
+  const int phases_per_outer = options.phases == PhaseSchedule::kAlternate ? 2 : 1;
+  Progress progress("reconstruct",
+                    static_cast<int64_t>(options.outer_iterations - state.outer_done) *
+                        phases_per_outer * options.solver.steps,
+                    !cli.quiet);
+  std::signal(SIGINT, OnInterrupt);
+  const nlohmann::json run_info = {{"dataset", cli.dataset},
+                                   {"init", cli.init},
+                                   {"config", state.config},
+                                   {"views", reconstruction->view_indices()}};
+  for (int outer = state.outer_done; outer < options.outer_iterations && !g_interrupted; ++outer) {
+    SFT_RETURN_IF_ERROR(reconstruction->RunOuter(outer, [&](const IterationRecord& record) {
+      records.push_back(record);
+      progress.Advance();
+      return !g_interrupted.load();
+    }));
+    if (!g_interrupted) state.outer_done = outer + 1;
+    state.seconds = records.empty() ? 0.0 : records.back().seconds;
+    state.finished = state.outer_done == options.outer_iterations;
+    SFT_RETURN_IF_ERROR(WriteReconstructionState(cli.out, dataset, *reconstruction));
+    SFT_RETURN_IF_ERROR(WriteMetrics(cli.out, records, reconstruction->phases(), run_info));
+    SFT_RETURN_IF_ERROR(WriteRunState(cli.out, state));
+  }
+  progress.Finish();
+  std::signal(SIGINT, SIG_DFL);
+  if (!cli.no_report) {
+    SFT_RETURN_IF_ERROR(WriteReconstructReport(cli.out, dataset, records, reconstruction.get()));
+  }
+  if (g_interrupted) {
+    return Status::Error("interrupted after " + std::to_string(state.outer_done) +
+                         " outer iterations; state written to " + cli.out +
+                         " (continue with --resume " + cli.out + ")");
+  }
+  std::printf("sft reconstruct: %d outer iterations, %.1f s; mesh %s, report %s\n",
+              state.outer_done, state.seconds, JoinPath(cli.out, "mesh.ply").c_str(),
+              cli.no_report ? "(none)" : JoinPath(cli.out, "report.html").c_str());
+  return Status::Ok();
+}
+
+}  // namespace
+
+CommandRunner SetupReconstructCommand(CLI::App* app) {
+  auto opts = std::make_shared<ReconstructCommandOptions>();
+  app->add_option("--dataset", opts->dataset, "Dataset directory (sft-dataset/1)");
+  app->add_option("--init", opts->init, "Initial mesh (OBJ, PLY, OFF)");
+  app->add_option("--out", opts->out, "Output directory");
+  app->add_option("--resume", opts->resume, "Continue the run whose output directory is this");
+  app->add_option("--config", opts->config,
+                  "Config JSON (keys in docs/reconstruct.md); flags override it");
+  app->add_option("--material", opts->material,
+                  "Initial material (JSON file or inline); default: albedo 0.5, roughness 0.5");
+  app->add_option("--phases", opts->phases, "texture | geometry | alternate (default alternate)");
+  app->add_option("--solver", opts->solver, "lm | dogleg | lbfgs | adam (default lm)");
+  app->add_option("--outer", opts->outer, "Outer iterations (fresh seeds each; default 4)");
+  app->add_option("--steps", opts->steps, "Solver iterations per outer iteration and phase (5)");
+  app->add_option("--spp", opts->spp, "Samples per pixel of the fit's renders (16)");
+  app->add_option("--bounces", opts->bounces, "Path segments (2)");
+  app->add_option("--threads", opts->threads, "Render threads (0 = all cores)");
+  app->add_option("--seed", opts->seed, "Base seed");
+  app->add_option("--views", opts->views, "Only these view indices (comma-separated)")
+      ->delimiter(',');
+  app->add_flag("--quiet", opts->quiet, "No progress line");
+  app->add_flag("--no-report", opts->no_report, "Do not write OUT/report.html");
+  return [opts]() {
+    const Status status = RunReconstruct(*opts);
+    if (status.ok()) return 0;
+    PrintError("reconstruct", status);
+    return g_interrupted ? 130 : 1;
+  };
+}
+
+}  // namespace sft

@@ -1,0 +1,228 @@
+#include "src/optim/config.h"
+
+#include <cmath>
+#include <functional>
+#include <map>
+
+#include "src/core/file_util.h"
+
+namespace sft {
+namespace {
+
+using json = nlohmann::json;
+
+// One configuration key: how to apply a JSON value (returns "" or what is wrong) and read it back.
+struct Key {
+  std::function<std::string(const json&, ReconstructOptions*)> set;
+  std::function<json(const ReconstructOptions&)> get;
+};
+
+Key Int(std::function<int&(ReconstructOptions*)> field, int lo,
+        int hi) {
+  return {[field, lo, hi](const json& v, ReconstructOptions* o) -> std::string {
+            if (!v.is_number_integer() || v.get<int64_t>() < lo || v.get<int64_t>() > hi) {
+              return "expected an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) +
+                     "]";
+            }
+            field(o) = v.get<int>();
+            return "";
+          },
+          [field](const ReconstructOptions& o) {
+            return json(field(const_cast<ReconstructOptions*>(&o)));
+          }};
+}
+
+Key Real(std::function<double&(ReconstructOptions*)> field, double lo, double hi) {
+  return {[field, lo, hi](const json& v, ReconstructOptions* o) -> std::string {
+            if (!v.is_number() || !std::isfinite(v.get<double>()) || v.get<double>() < lo ||
+                v.get<double>() > hi) {
+              return "expected a number in [" + json(lo).dump() + ", " + json(hi).dump() + "]";
+            }
+            field(o) = v.get<double>();
+            return "";
+          },
+          [field](const ReconstructOptions& o) {
+            return json(field(const_cast<ReconstructOptions*>(&o)));
+          }};
+}
+
+Key Bool(std::function<bool&(ReconstructOptions*)> field) {
+  return {[field](const json& v, ReconstructOptions* o) -> std::string {
+            if (!v.is_boolean()) return "expected true or false";
+            field(o) = v.get<bool>();
+            return "";
+          },
+          [field](const ReconstructOptions& o) {
+            return json(field(const_cast<ReconstructOptions*>(&o)));
+          }};
+}
+
+// A string key with parse/print functions.
+Key Choice(std::function<std::string(const std::string&, ReconstructOptions*)> parse,
+           std::function<std::string(const ReconstructOptions&)> print) {
+  return {[parse](const json& v, ReconstructOptions* o) -> std::string {
+            if (!v.is_string()) return "expected a string";
+            return parse(v.get<std::string>(), o);
+          },
+          [print](const ReconstructOptions& o) { return json(print(o)); }};
+}
+
+std::string LinearSolverName(ceres::LinearSolverType type) {
+  switch (type) {
+    case ceres::CGNR:
+      return "cgnr";
+    case ceres::SPARSE_NORMAL_CHOLESKY:
+      return "sparse_normal_cholesky";
+    case ceres::DENSE_QR:
+      return "dense_qr";
+    default:
+      return "other";
+  }
+}
+
+const std::map<std::string, Key>& Keys() {
+  using O = ReconstructOptions;
+  static const std::map<std::string, Key> keys = {
+      {"spp", Int([](O* o) -> int& { return o->cache.render.spp; }, 1, 1 << 20)},
+      {"bounces", Int([](O* o) -> int& { return o->cache.render.bounces; }, 1, 16)},
+      {"threads", Int([](O* o) -> int& { return o->cache.render.threads; }, 0, 1024)},
+      {"effects", Choice(
+                      [](const std::string& s, O* o) -> std::string {
+                        std::string why;
+                        return Effects::Parse(s, &o->cache.render.effects, &why) ? "" : why;
+                      },
+                      [](const O& o) { return o.cache.render.effects.ToString(); })},
+      {"pyramid_levels", Int([](O* o) -> int& { return o->cache.pyramid_levels; }, 1, 12)},
+      {"level_weight", Real([](O* o) -> double& { return o->cache.level_weight; }, 1e-6, 64)},
+      {"mask_dilation", Int([](O* o) -> int& { return o->cache.mask_dilation; }, 0, 64)},
+      {"primary_edge_ratio",
+       Real([](O* o) -> double& { return o->cache.edges.primary_edge_ratio; }, 0, 16)},
+      {"shadow_edge_ratio",
+       Real([](O* o) -> double& { return o->cache.edges.shadow_edge_ratio; }, 0, 16)},
+      {"secondary_edge_samples",
+       Real([](O* o) -> double& { return o->cache.edges.secondary_edge_samples; }, 0, 16)},
+      {"texel_edge_ratio",
+       Real([](O* o) -> double& { return o->cache.edges.texel_edge_ratio; }, 0, 16)},
+      {"superset_renders",
+       Int([](O* o) -> int& { return o->problem.superset_renders; }, 1, 8)},
+      {"roughness_min", Real([](O* o) -> double& { return o->problem.bounds.roughness_min; }, 0,
+                             0.99)},
+      {"solver", Choice(
+                     [](const std::string& s, O* o) -> std::string {
+                       return SolverKindFromName(s, &o->solver.kind)
+                                  ? ""
+                                  : "expected lm, dogleg, lbfgs or adam";
+                     },
+                     [](const O& o) { return std::string(SolverKindName(o.solver.kind)); })},
+      {"steps", Int([](O* o) -> int& { return o->solver.steps; }, 1, 1000)},
+      {"linear_solver",
+       Choice(
+           [](const std::string& s, O* o) -> std::string {
+             ceres::LinearSolverType& t = o->solver.trust_region.linear_solver_type;
+             if (s == "cgnr") {
+               t = ceres::CGNR;
+             } else if (s == "sparse_normal_cholesky") {
+               t = ceres::SPARSE_NORMAL_CHOLESKY;
+             } else if (s == "dense_qr") {
+               t = ceres::DENSE_QR;
+             } else {
+               return "expected cgnr, sparse_normal_cholesky or dense_qr";
+             }
+             return "";
+           },
+           [](const O& o) { return LinearSolverName(o.solver.trust_region.linear_solver_type); })},
+      {"max_linear_solver_iterations",
+       Int([](O* o) -> int& { return o->solver.trust_region.max_linear_solver_iterations; },
+           1, 10000)},
+      {"initial_trust_region_radius",
+       Real([](O* o) -> double& { return o->solver.trust_region.initial_trust_region_radius; },
+            1e-12, 1e16)},
+      {"solver_threads",
+       Int([](O* o) -> int& { return o->solver.trust_region.num_threads; }, 1, 1024)},
+      {"lbfgs_rank",
+       Int([](O* o) -> int& { return o->solver.line_search.max_lbfgs_rank; }, 1, 1000)},
+      {"adam_lr_vertices",
+       Real([](O* o) -> double& { return o->solver.adam.learning_rate_vertices; }, 1e-12, 10)},
+      {"adam_lr_material",
+       Real([](O* o) -> double& { return o->solver.adam.learning_rate_material; }, 1e-12, 10)},
+      {"laplacian_weight",
+       Real([](O* o) -> double& { return o->regularizers.laplacian_weight; }, 0, 1e12)},
+      {"laplacian", Choice(
+                        [](const std::string& s, O* o) -> std::string {
+                          if (s != "uniform" && s != "cotangent") {
+                            return "expected uniform or cotangent";
+                          }
+                          o->regularizers.cotangent = s == "cotangent";
+                          return "";
+                        },
+                        [](const O& o) {
+                          return std::string(o.regularizers.cotangent ? "cotangent" : "uniform");
+                        })},
+      {"albedo_smoothness",
+       Real([](O* o) -> double& { return o->regularizers.albedo_smoothness; }, 0, 1e12)},
+      {"roughness_smoothness",
+       Real([](O* o) -> double& { return o->regularizers.roughness_smoothness; }, 0, 1e12)},
+      {"phases", Choice(
+                     [](const std::string& s, O* o) -> std::string {
+                       return PhaseScheduleFromName(s, &o->phases)
+                                  ? ""
+                                  : "expected texture, geometry or alternate";
+                     },
+                     [](const O& o) { return std::string(PhaseScheduleName(o.phases)); })},
+      {"outer_iterations",
+       Int([](O* o) -> int& { return o->outer_iterations; }, 1, 10000)},
+      {"fit_specular", Bool([](O* o) -> bool& { return o->fit_specular; })},
+      {"fit_lights", Bool([](O* o) -> bool& { return o->fit_lights; })},
+      {"seed", {[](const json& v, O* o) -> std::string {
+                  if (!v.is_number_unsigned()) return "expected a non-negative integer";
+                  o->seed = v.get<uint64_t>();
+                  return "";
+                },
+                [](const O& o) { return json(o.seed); }}},
+      {"views", {[](const json& v, O* o) -> std::string {
+                   if (!v.is_array()) return "expected an array of view indices";
+                   o->views.clear();
+                   for (const json& e : v) {
+                     if (!e.is_number_integer()) return "expected an array of view indices";
+                     o->views.push_back(e.get<int>());
+                   }
+                   return "";
+                 },
+                 [](const O& o) { return json(o.views); }}},
+  };
+  return keys;
+}
+
+}  // namespace
+
+Status ApplyReconstructConfig(const json& config, const std::string& source,
+                              ReconstructOptions* options) {
+  if (!config.is_object()) return Status::Error(source + ": expected a JSON object");
+  const auto& keys = Keys();
+  for (const auto& [name, value] : config.items()) {
+    const auto it = keys.find(name);
+    if (it == keys.end()) {
+      return Status::Error(source + ": " + name +
+                           ": unknown key (the keys are listed in docs/reconstruct.md)");
+    }
+    const std::string why = it->second.set(value, options);
+    if (!why.empty()) return Status::Error(source + ": " + name + ": " + why);
+  }
+  return Status::Ok();
+}
+
+Status ReadReconstructConfig(const std::string& path, ReconstructOptions* options) {
+  std::string text;
+  SFT_RETURN_IF_ERROR(ReadTextFile(path, &text));
+  const json config = json::parse(text, nullptr, /*allow_exceptions=*/false);
+  if (config.is_discarded()) return Status::Error(path + ": not valid JSON");
+  return ApplyReconstructConfig(config, path, options);
+}
+
+json ReconstructConfigJson(const ReconstructOptions& options) {
+  json config = json::object();
+  for (const auto& [name, key] : Keys()) config[name] = key.get(options);
+  return config;
+}
+
+}  // namespace sft

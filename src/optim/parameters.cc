@@ -1,0 +1,144 @@
+#include "src/optim/parameters.h"
+
+#include <glog/logging.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace sft {
+
+bool ParameterBounds::Check(std::string* why) const {
+  if (!(roughness_min >= 0.0 && roughness_min < 1.0)) {
+    *why = "roughness_min: must be in [0, 1)";
+    return false;
+  }
+  if (!(light_scale_min > 0.0 && light_scale_min < light_scale_max &&
+        std::isfinite(light_scale_max))) {
+    *why = "light_scale_min/light_scale_max: need 0 < min < max < infinity";
+    return false;
+  }
+  return true;
+}
+
+ParameterSelection ActiveParameters::ToSelection() const {
+  ParameterSelection selection;
+  selection.vertices = vertices;
+  selection.albedo = albedo;
+  selection.roughness = roughness;
+  selection.specular = specular;
+  selection.lights = lights;
+  return selection;
+}
+
+SceneParameters::SceneParameters(const std::vector<Eigen::Vector3d>& positions,
+                                 const Material& material, int num_lights) {
+  layout_.num_vertices = static_cast<int>(positions.size());
+  layout_.num_albedo_texels = material.albedo.num_texels();
+  layout_.num_roughness_texels = material.roughness.num_texels();
+  layout_.num_lights = num_lights;
+  values_.assign(layout_.size(), 0.0);
+  for (size_t v = 0; v < positions.size(); ++v) {
+    for (int k = 0; k < 3; ++k) values_[3 * v + k] = positions[v][k];
+  }
+  std::copy(material.albedo.values().begin(), material.albedo.values().end(),
+            values_.begin() + layout_.AlbedoOffset());
+  std::copy(material.roughness.values().begin(), material.roughness.values().end(),
+            values_.begin() + layout_.RoughnessOffset());
+  values_[layout_.SpecularIndex()] = material.specular;
+  for (int l = 0; l < num_lights; ++l) values_[layout_.LightOffset() + l] = 1.0;
+}
+
+std::vector<BlockSpan> SceneParameters::Blocks() const {
+  std::vector<BlockSpan> blocks;
+  blocks.reserve(layout_.num_vertices + layout_.num_albedo_texels + layout_.num_roughness_texels +
+                 1 + layout_.num_lights);
+  for (int v = 0; v < layout_.num_vertices; ++v) {
+    blocks.push_back({3 * v, 3, ParameterKind::kVertex});
+  }
+  for (int t = 0; t < layout_.num_albedo_texels; ++t) {
+    blocks.push_back({layout_.AlbedoOffset() + 3 * t, 3, ParameterKind::kAlbedo});
+  }
+  for (int t = 0; t < layout_.num_roughness_texels; ++t) {
+    blocks.push_back({layout_.RoughnessOffset() + t, 1, ParameterKind::kRoughness});
+  }
+  blocks.push_back({layout_.SpecularIndex(), 1, ParameterKind::kSpecular});
+  for (int l = 0; l < layout_.num_lights; ++l) {
+    blocks.push_back({layout_.LightOffset() + l, 1, ParameterKind::kLight});
+  }
+  return blocks;
+}
+
+BlockSpan SceneParameters::BlockOf(int index) const {
+  DCHECK(index >= 0 && index < layout_.size());
+  switch (layout_.KindOf(index)) {
+    case ParameterKind::kVertex:
+      return {index - index % 3, 3, ParameterKind::kVertex};
+    case ParameterKind::kAlbedo: {
+      const int local = index - layout_.AlbedoOffset();
+      return {index - local % 3, 3, ParameterKind::kAlbedo};
+    }
+    case ParameterKind::kRoughness:
+      return {index, 1, ParameterKind::kRoughness};
+    case ParameterKind::kSpecular:
+      return {index, 1, ParameterKind::kSpecular};
+    case ParameterKind::kLight:
+      return {index, 1, ParameterKind::kLight};
+  }
+  return {index, 1, ParameterKind::kLight};
+}
+
+void SceneParameters::Positions(std::vector<Eigen::Vector3d>* positions) const {
+  positions->resize(layout_.num_vertices);
+  for (int v = 0; v < layout_.num_vertices; ++v) {
+    (*positions)[v] = Eigen::Vector3d(values_[3 * v], values_[3 * v + 1], values_[3 * v + 2]);
+  }
+}
+
+void SceneParameters::WriteMaterial(Material* material) const {
+  CHECK_EQ(material->albedo.num_texels(), layout_.num_albedo_texels);
+  CHECK_EQ(material->roughness.num_texels(), layout_.num_roughness_texels);
+  std::copy(values_.begin() + layout_.AlbedoOffset(), values_.begin() + layout_.RoughnessOffset(),
+            material->albedo.values().begin());
+  std::copy(values_.begin() + layout_.RoughnessOffset(),
+            values_.begin() + layout_.SpecularIndex(), material->roughness.values().begin());
+  material->specular = values_[layout_.SpecularIndex()];
+}
+
+std::vector<double> SceneParameters::LightScales() const {
+  return std::vector<double>(values_.begin() + layout_.LightOffset(), values_.end());
+}
+
+double SceneParameters::Lower(int index, const ParameterBounds& bounds) const {
+  switch (layout_.KindOf(index)) {
+    case ParameterKind::kVertex:
+      return -std::numeric_limits<double>::infinity();
+    case ParameterKind::kAlbedo:
+    case ParameterKind::kSpecular:
+      return 0.0;
+    case ParameterKind::kRoughness:
+      return bounds.roughness_min;
+    case ParameterKind::kLight:
+      return bounds.light_scale_min;
+  }
+  return 0.0;
+}
+
+double SceneParameters::Upper(int index, const ParameterBounds& bounds) const {
+  switch (layout_.KindOf(index)) {
+    case ParameterKind::kVertex:
+      return std::numeric_limits<double>::infinity();
+    case ParameterKind::kLight:
+      return bounds.light_scale_max;
+    default:
+      return 1.0;
+  }
+}
+
+void SceneParameters::Project(const ParameterBounds& bounds, std::vector<double>* values) const {
+  for (int i = layout_.AlbedoOffset(); i < layout_.size(); ++i) {
+    (*values)[i] = std::clamp((*values)[i], Lower(i, bounds), Upper(i, bounds));
+  }
+}
+
+}  // namespace sft

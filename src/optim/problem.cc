@@ -1,0 +1,160 @@
+#include "src/optim/problem.h"
+
+#include <glog/logging.h>
+
+#include <algorithm>
+#include <chrono>
+#include <set>
+
+namespace sft {
+namespace {
+
+// Block offsets touched by each active pixel of each level of one view.
+using PixelBlocks = std::vector<std::vector<int>>;  // [pixel] -> sorted offsets.
+
+void AddTouchedBlocks(const SceneParameters& params, const LevelRows& rows,
+                      const std::vector<uint8_t>& active, PixelBlocks* blocks) {
+  std::vector<int> merged, fresh;
+  for (size_t p = 0; p + 1 < rows.offsets.size(); ++p) {
+    if (!active[p]) continue;
+    fresh.clear();
+    for (uint64_t i = rows.offsets[p]; i < rows.offsets[p + 1]; ++i) {
+      const int offset = params.BlockOf(rows.entries[i].param).offset;
+      if (fresh.empty() || fresh.back() != offset) fresh.push_back(offset);
+    }
+    std::vector<int>& have = (*blocks)[p];
+    merged.clear();
+    std::set_union(have.begin(), have.end(), fresh.begin(), fresh.end(),
+                   std::back_inserter(merged));
+    have.swap(merged);
+  }
+}
+
+}  // namespace
+
+bool ProblemOptions::Check(std::string* why) const {
+  if (superset_renders < 1 || superset_renders > 8) {
+    *why = "superset_renders: must be in [1, 8]";
+    return false;
+  }
+  return bounds.Check(why);
+}
+
+Status ReconstructionProblem::Build(RenderCache* cache, SceneParameters* params,
+                                    const ProblemOptions& options,
+                                    std::unique_ptr<ReconstructionProblem>* out) {
+  std::string why;
+  if (!options.Check(&why)) return Status::Error(why);
+  const auto start = std::chrono::steady_clock::now();
+  auto result = std::unique_ptr<ReconstructionProblem>(new ReconstructionProblem());
+  // Supersets: [view][level][pixel] -> block offsets.
+  std::vector<std::vector<PixelBlocks>> supersets(cache->num_views());
+  for (int v = 0; v < cache->num_views(); ++v) {
+    for (int l = 0; l < cache->num_levels(v); ++l) {
+      const Image& image = cache->level(v, l).target;
+      supersets[v].emplace_back(static_cast<size_t>(image.width) * image.height);
+    }
+  }
+  const uint64_t seed = cache->seed();
+  for (int k = 0; k < options.superset_renders; ++k) {
+    cache->SetSeed(seed * 1000003ull + 7919ull * (k + 1));
+    cache->Render(/*rows=*/true);
+    for (int v = 0; v < cache->num_views(); ++v) {
+      for (int l = 0; l < cache->num_levels(v); ++l) {
+        AddTouchedBlocks(*params, cache->level(v, l).rows, cache->targets(v).active[l],
+                         &supersets[v][l]);
+      }
+    }
+  }
+  cache->SetSeed(seed);
+
+  ceres::Problem::Options problem_options;
+  problem_options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  problem_options.evaluation_callback = cache;
+  result->problem_ = std::make_unique<ceres::Problem>(problem_options);
+  ceres::Problem* problem = result->problem_.get();
+  std::vector<bool> added(params->layout().size(), false);
+  ProblemStats& stats = result->stats_;
+  std::vector<double*> blocks;
+  std::vector<int> sizes;
+  for (int v = 0; v < cache->num_views(); ++v) {
+    for (int l = 0; l < cache->num_levels(v); ++l) {
+      const std::vector<uint8_t>& active = cache->targets(v).active[l];
+      for (size_t p = 0; p < active.size(); ++p) {
+        if (!active[p]) continue;
+        std::vector<int>& offsets = supersets[v][l][p];
+        if (offsets.empty()) {
+          ++stats.pixels_without_parameters;
+          continue;
+        }
+        blocks.clear();
+        sizes.clear();
+        for (int offset : offsets) {
+          const BlockSpan span = params->BlockOf(offset);
+          blocks.push_back(params->data() + offset);
+          sizes.push_back(span.size);
+          stats.superset_entries += span.size;
+          if (!added[offset]) {
+            added[offset] = true;
+            problem->AddParameterBlock(params->data() + offset, span.size);
+            ++stats.parameter_blocks;
+            for (int i = 0; i < span.size; ++i) {
+              const double lo = params->Lower(offset + i, options.bounds);
+              const double hi = params->Upper(offset + i, options.bounds);
+              if (std::isfinite(lo)) problem->SetParameterLowerBound(blocks.back(), i, lo);
+              if (std::isfinite(hi)) problem->SetParameterUpperBound(blocks.back(), i, hi);
+            }
+          }
+        }
+        auto cost = std::make_unique<PyramidPixelCost>(&cache->level(v, l), cache->finite(),
+                                                       static_cast<int>(p), offsets, sizes);
+        problem->AddResidualBlock(cost.get(), nullptr, blocks);
+        result->residuals_.push_back({v, l, static_cast<int>(p), cost.get()});
+        result->costs_.push_back(std::move(cost));
+        std::vector<int>().swap(offsets);
+      }
+    }
+  }
+  stats.residual_blocks = static_cast<int64_t>(result->residuals_.size());
+  stats.build_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  *out = std::move(result);
+  return Status::Ok();
+}
+
+double ReconstructionProblem::DroppedJacobianFraction(const RenderCache& cache) const {
+  double dropped = 0.0, total = 0.0;
+  for (const Residual& r : residuals_) {
+    const LevelRows& rows = cache.level(r.view, r.level).rows;
+    if (rows.offsets.empty()) continue;
+    const std::vector<int>& offsets = r.cost->block_offsets();
+    const std::vector<int32_t>& sizes = r.cost->parameter_block_sizes();
+    size_t b = 0;
+    for (uint64_t i = rows.offsets[r.pixel]; i < rows.offsets[r.pixel + 1]; ++i) {
+      const RowEntry& e = rows.entries[i];
+      const double mass = e.d[0] * e.d[0] + e.d[1] * e.d[1] + e.d[2] * e.d[2];
+      total += mass;
+      while (b < offsets.size() && offsets[b] + sizes[b] <= e.param) ++b;
+      if (b == offsets.size() || e.param < offsets[b]) dropped += mass;
+    }
+  }
+  return total > 0.0 ? dropped / total : 0.0;
+}
+
+void FillUnsampledTexels(MeshColors* colors) {
+  const int r = colors->resolution();
+  if (r < 1) return;
+  const int per_face = MeshColors::TexelsPerFace(r);
+  for (int f = 0; f < colors->num_faces(); ++f) {
+    for (int i = 0; i <= r; ++i) {
+      const int j = r - i;
+      const int source = j > 0 ? MeshColors::LocalIndex(r, i, j - 1)
+                               : MeshColors::LocalIndex(r, i - 1, j);
+      const double* from = colors->texel(f * per_face + source);
+      double* to = colors->texel(f * per_face + MeshColors::LocalIndex(r, i, j));
+      std::copy(from, from + colors->channels(), to);
+    }
+  }
+}
+
+}  // namespace sft

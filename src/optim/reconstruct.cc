@@ -1,0 +1,201 @@
+#include "src/optim/reconstruct.h"
+
+#include <glog/logging.h>
+
+#include <chrono>
+#include <cmath>
+
+#include "src/optim/problem.h"
+
+namespace sft {
+namespace {
+
+double NowSeconds() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
+
+ActiveParameters TexturePhase(const ReconstructOptions& options) {
+  ActiveParameters active;
+  active.vertices = false;
+  active.albedo = true;
+  active.roughness = true;
+  active.specular = options.fit_specular;
+  active.lights = options.fit_lights;
+  return active;
+}
+
+ActiveParameters GeometryPhase() {
+  ActiveParameters active;
+  active.vertices = true;
+  active.albedo = active.roughness = active.specular = active.lights = false;
+  return active;
+}
+
+}  // namespace
+
+bool PhaseScheduleFromName(const std::string& name, PhaseSchedule* schedule) {
+  if (name == "texture") {
+    *schedule = PhaseSchedule::kTexture;
+  } else if (name == "geometry") {
+    *schedule = PhaseSchedule::kGeometry;
+  } else if (name == "alternate") {
+    *schedule = PhaseSchedule::kAlternate;
+  } else {
+    return false;
+  }
+  return true;
+}
+
+const char* PhaseScheduleName(PhaseSchedule schedule) {
+  switch (schedule) {
+    case PhaseSchedule::kTexture:
+      return "texture";
+    case PhaseSchedule::kGeometry:
+      return "geometry";
+    case PhaseSchedule::kAlternate:
+      return "alternate";
+  }
+  return "?";
+}
+
+ReconstructOptions::ReconstructOptions() {
+  cache.render.spp = 16;
+  cache.render.bounces = 2;
+}
+
+bool ReconstructOptions::Check(std::string* why) const {
+  if (!cache.Check(why) || !problem.Check(why) || !solver.Check(why) ||
+      !regularizers.Check(why)) {
+    return false;
+  }
+  if (outer_iterations < 1 || outer_iterations > 10000) {
+    *why = "outer_iterations: must be in [1, 10000]";
+    return false;
+  }
+  return true;
+}
+
+double PsnrFromMse(double mse) {
+  if (!(mse > 1e-10)) return 100.0;
+  return -10.0 * std::log10(mse);
+}
+
+Status Reconstruction::Create(const Dataset& dataset, const TriMesh& mesh,
+                              const Material& material, const std::vector<double>& light_scales,
+                              const ReconstructOptions& options,
+                              std::unique_ptr<Reconstruction>* out) {
+  std::string why;
+  if (!options.Check(&why)) return Status::Error(why);
+  std::unique_ptr<Reconstruction> r(new Reconstruction());
+  r->dataset_ = &dataset;
+  r->options_ = options;
+  r->mesh_ = mesh;
+  r->material_ = material;
+  std::vector<Eigen::Vector3d> positions;
+  MeshToArrays(mesh, &positions, &r->faces_);
+  SFT_RETURN_IF_ERROR(MakeDatasetViews(dataset, &r->views_));
+  std::vector<int> views;
+  SFT_RETURN_IF_ERROR(SelectViews(options.views, static_cast<int>(dataset.views.size()), &views));
+  const int num_lights = static_cast<int>(dataset.lights.size());
+  r->params_ = SceneParameters(positions, material, num_lights);
+  if (!light_scales.empty()) {
+    if (static_cast<int>(light_scales.size()) != num_lights) {
+      return Status::Error("light scales: " + std::to_string(light_scales.size()) +
+                           " given, the dataset has " + std::to_string(num_lights) + " lights");
+    }
+    for (int l = 0; l < num_lights; ++l) {
+      r->params_.values()[r->params_.layout().LightOffset() + l] = light_scales[l];
+    }
+  }
+  SFT_RETURN_IF_ERROR(RenderCache::Create(dataset, &r->views_, views, r->faces_, material,
+                                          &r->params_, options.cache, &r->cache_));
+  r->start_time_ = NowSeconds();
+  *out = std::move(r);
+  return Status::Ok();
+}
+
+Status Reconstruction::RunOuter(int outer,
+                                const std::function<bool(const IterationRecord&)>& on_iteration) {
+  std::vector<std::pair<std::string, ActiveParameters>> phases;
+  if (options_.phases != PhaseSchedule::kGeometry) {
+    phases.push_back({"texture", TexturePhase(options_)});
+  }
+  if (options_.phases != PhaseSchedule::kTexture) phases.push_back({"geometry", GeometryPhase()});
+  bool stop = false;
+  for (size_t k = 0; k < phases.size() && !stop; ++k) {
+    const auto& [name, active] = phases[k];
+    cache_->SetActive(active);
+    cache_->SetSeed(options_.seed * 7919ull + 2ull * static_cast<uint64_t>(outer) + k);
+    const TriMesh rest = Mesh();
+    SolverHooks hooks;
+    hooks.add_regularizers = [&](ceres::Problem* problem) {
+      AddRegularizers(rest, active, options_.regularizers, options_.problem.bounds, material_,
+                      &params_, problem);
+    };
+    std::vector<double> last_psnr;
+    hooks.on_iteration = [&](const IterationInfo& info) {
+      IterationRecord record;
+      record.outer = outer;
+      record.phase = name;
+      record.iteration = info.iteration;
+      record.cost = info.cost;
+      record.accepted = info.accepted;
+      record.seconds = elapsed_offset + NowSeconds() - start_time_;
+      // A rejected trial leaves its render in the cache: report the accepted point's PSNR.
+      if (info.accepted || last_psnr.empty()) {
+        last_psnr.clear();
+        for (double mse : cache_->ViewMse()) last_psnr.push_back(PsnrFromMse(mse));
+      }
+      record.view_psnr = last_psnr;
+      const bool go_on = !on_iteration || on_iteration(record);
+      stop = stop || !go_on;
+      return go_on;
+    };
+    PhaseRecord phase_record;
+    phase_record.outer = outer;
+    phase_record.phase = name;
+    if (options_.solver.kind == SolverKind::kAdam) {
+      SFT_RETURN_IF_ERROR(RunAdam(options_.solver, options_.problem, cache_.get(), &params_,
+                                  hooks, &adam_, &phase_record.stats));
+    } else {
+      SFT_RETURN_IF_ERROR(RunSolver(options_.solver, options_.problem, cache_.get(), &params_,
+                                    hooks, &phase_record.stats));
+    }
+    phase_record.non_finite_values = cache_->non_finite_values();
+    phase_records_.push_back(phase_record);
+  }
+  return Status::Ok();
+}
+
+TriMesh Reconstruction::Mesh() const {
+  TriMesh mesh = mesh_;
+  std::vector<Eigen::Vector3d> positions;
+  params_.Positions(&positions);
+  int v = 0;
+  for (auto vh : mesh.vertices()) {
+    const Eigen::Vector3d& p = positions[v++];
+    mesh.set_point(vh, TriMesh::Point(p.x(), p.y(), p.z()));
+  }
+  return mesh;
+}
+
+Material Reconstruction::CurrentMaterial() const {
+  Material material = material_;
+  params_.WriteMaterial(&material);
+  FillUnsampledTexels(&material.albedo);
+  FillUnsampledTexels(&material.roughness);
+  return material;
+}
+
+std::vector<Image> Reconstruction::RenderViews(uint64_t seed) {
+  const uint64_t saved = cache_->seed();
+  cache_->SetSeed(seed);
+  cache_->Render(/*rows=*/false);
+  std::vector<Image> images;
+  for (int v = 0; v < cache_->num_views(); ++v) images.push_back(cache_->Rendered(v));
+  cache_->SetSeed(saved);
+  return images;
+}
+
+}  // namespace sft

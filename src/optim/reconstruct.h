@@ -1,0 +1,105 @@
+// The reconstruction schedule (DESIGN.md §1 steps 3–4, §2.2): outer iterations, each one phase or
+// two (texture, then geometry) of at most `solver.steps` solver iterations with a fixed seed; fresh
+// seeds per outer iteration. Each outer iteration of a trust-region solver builds a new problem
+// (supersets from renders at the current state), so that pixel supersets follow the moving mesh.
+#ifndef SFT_OPTIM_RECONSTRUCT_H_
+#define SFT_OPTIM_RECONSTRUCT_H_
+
+#include <atomic>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "src/geometry/mesh.h"
+#include "src/io/dataset.h"
+#include "src/io/scene_setup.h"
+#include "src/optim/regularizers.h"
+#include "src/optim/render_cache.h"
+#include "src/optim/solvers.h"
+
+namespace sft {
+
+enum class PhaseSchedule { kTexture, kGeometry, kAlternate };
+bool PhaseScheduleFromName(const std::string& name, PhaseSchedule* schedule);
+const char* PhaseScheduleName(PhaseSchedule schedule);
+
+struct ReconstructOptions {
+  RenderCacheOptions cache;        // render (spp, bounces, effects, threads), pyramid, mask.
+  ProblemOptions problem;          // supersets and bounds.
+  SolverOptions solver;            // which solver and its options.
+  RegularizerOptions regularizers; // Laplacian and texel smoothness weights.
+  PhaseSchedule phases = PhaseSchedule::kAlternate;  // texture, geometry or both alternating.
+  int outer_iterations = 4;  // outer iterations (fresh seeds each), [1, 10000].
+  bool fit_specular = false;  // the texture phase also fits the specular weight.
+  bool fit_lights = false;    // the texture phase also fits the light intensity scales.
+  uint64_t seed = 1;          // base seed of the renders.
+  std::vector<int> views;     // dataset views to fit; empty = all.
+
+  ReconstructOptions();
+  bool Check(std::string* why) const;
+};
+
+// One solver iteration, as metrics.csv writes it.
+struct IterationRecord {
+  int outer = 0;
+  std::string phase;  // "texture" | "geometry".
+  int iteration = 0;  // within the phase's solve.
+  double cost = 0.0;  // objective (image + regularizers) at the accepted point.
+  double seconds = 0.0;  // wall time since the start of the run (resumed runs continue it).
+  bool accepted = false;
+  std::vector<double> view_psnr;  // level-0 PSNR over active pixels, peak 1, per fitted view.
+};
+
+// One phase of one outer iteration.
+struct PhaseRecord {
+  int outer = 0;
+  std::string phase;
+  SolverRunStats stats;
+  int64_t non_finite_values = 0;  // in the last render.
+};
+
+class Reconstruction {
+ public:
+  // `mesh` and `material` are the initial state (copied). `light_scales` may be empty (all 1).
+  static Status Create(const Dataset& dataset, const TriMesh& mesh, const Material& material,
+                       const std::vector<double>& light_scales, const ReconstructOptions& options,
+                       std::unique_ptr<Reconstruction>* out);
+
+  // Runs outer iteration `outer` (its phases). `on_iteration` is called after every solver
+  // iteration; returning false stops the run (the state so far is kept).
+  Status RunOuter(int outer, const std::function<bool(const IterationRecord&)>& on_iteration);
+
+  // The current state.
+  TriMesh Mesh() const;
+  Material CurrentMaterial() const;  // unsampled texels filled from their neighbours.
+  std::vector<double> LightScales() const { return params_.LightScales(); }
+  // Renders every fitted view at the current state (seed `seed`) and returns level-0 images.
+  std::vector<Image> RenderViews(uint64_t seed);
+  const RenderCache& cache() const { return *cache_; }
+  const std::vector<PhaseRecord>& phases() const { return phase_records_; }
+  const std::vector<int>& view_indices() const { return cache_->view_indices(); }
+  double elapsed_offset = 0.0;  // seconds of earlier (resumed) runs, added to records.
+
+ private:
+  Reconstruction() = default;
+
+  const Dataset* dataset_ = nullptr;
+  ReconstructOptions options_;
+  TriMesh mesh_;
+  std::vector<Eigen::Vector3i> faces_;
+  Material material_;
+  DatasetViews views_;
+  SceneParameters params_;
+  std::unique_ptr<RenderCache> cache_;
+  AdamState adam_;
+  std::vector<PhaseRecord> phase_records_;
+  double start_time_ = 0.0;
+};
+
+// Peak-1 PSNR of a mean squared error (capped at 100 dB for a zero error).
+double PsnrFromMse(double mse);
+
+}  // namespace sft
+
+#endif  // SFT_OPTIM_RECONSTRUCT_H_

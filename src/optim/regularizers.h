@@ -1,0 +1,37 @@
+// Regularizer residual blocks of the reconstruction (cost_functions/vertex_laplacian.h,
+// cost_functions/texel_smoothness.h), added for the parameter kinds a phase varies.
+#ifndef SFT_OPTIM_REGULARIZERS_H_
+#define SFT_OPTIM_REGULARIZERS_H_
+
+#include <ceres/problem.h>
+
+#include <string>
+#include <vector>
+
+#include "src/geometry/mesh.h"
+#include "src/optim/parameters.h"
+
+namespace sft {
+
+struct RegularizerOptions {
+  // Weight of the vertex Laplacian term (√ of the weight multiplies each residual), ≥ 0; 0 = off.
+  // The residual is the Laplacian of the displacement from the phase's starting mesh, so the
+  // term smooths the update without shrinking the shape.
+  double laplacian_weight = 0.0;
+  bool cotangent = false;  // cotangent weights (at the starting mesh) instead of uniform ones.
+  double albedo_smoothness = 0.0;     // weight of albedo differences of neighbouring texels, ≥ 0.
+  double roughness_smoothness = 0.0;  // the same for roughness, ≥ 0.
+
+  bool Check(std::string* why) const;
+};
+
+// Adds the regularizers of the active kinds to `problem`. Their parameter blocks point into
+// `params`; blocks new to the problem get the bounds of `bounds`. `rest` is the mesh whose
+// positions the Laplacian measures displacements from (and whose connectivity it uses).
+void AddRegularizers(const TriMesh& rest, const ActiveParameters& active,
+                     const RegularizerOptions& options, const ParameterBounds& bounds,
+                     const Material& material, SceneParameters* params, ceres::Problem* problem);
+
+}  // namespace sft
+
+#endif  // SFT_OPTIM_REGULARIZERS_H_

@@ -1,0 +1,295 @@
+#include "src/optim/render_cache.h"
+
+#include <glog/logging.h>
+
+#include <chrono>
+#include <cmath>
+#include <opencv2/imgproc.hpp>
+
+namespace sft {
+namespace {
+
+double Seconds(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+Image Rgb(const Image& image) {
+  if (image.channels == 3) return image;
+  Image rgb(image.width, image.height, 3);
+  for (int y = 0; y < image.height; ++y) {
+    for (int x = 0; x < image.width; ++x) {
+      for (int c = 0; c < 3; ++c) rgb.at(x, y, c) = image.at(x, y, std::min(c, image.channels - 1));
+    }
+  }
+  return rgb;
+}
+
+// The view's active level-0 pixels: its mask dilated by `dilation` pixels, or every pixel.
+Status ActivePixels(const Dataset& dataset, int view, int width, int height, int dilation,
+                    std::vector<uint8_t>* active, bool* has_mask) {
+  *has_mask = !dataset.views[view].mask.empty();
+  if (!*has_mask) {
+    active->assign(static_cast<size_t>(width) * height, 1);
+    return Status::Ok();
+  }
+  Image mask;
+  SFT_RETURN_IF_ERROR(LoadViewMask(dataset, view, &mask));
+  cv::Mat m(height, width, CV_8U);
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) m.at<uint8_t>(y, x) = mask.at(x, y) > 0.5f ? 1 : 0;
+  }
+  if (dilation > 0) {
+    cv::dilate(m, m, cv::getStructuringElement(cv::MORPH_RECT,
+                                               cv::Size(2 * dilation + 1, 2 * dilation + 1)));
+  }
+  active->assign(m.begin<uint8_t>(), m.end<uint8_t>());
+  return Status::Ok();
+}
+
+}  // namespace
+
+bool RenderCacheOptions::Check(std::string* why) const {
+  if (!render.Check(why)) return false;
+  if (!edges.Check(why)) return false;
+  if (pyramid_levels < 1 || pyramid_levels > 12) {
+    *why = "pyramid_levels: must be in [1, 12]";
+    return false;
+  }
+  if (!(level_weight > 0.0 && level_weight <= 64.0)) {
+    *why = "level_weight: must be in (0, 64]";
+    return false;
+  }
+  if (mask_dilation < 0 || mask_dilation > 64) {
+    *why = "mask_dilation: must be in [0, 64]";
+    return false;
+  }
+  return true;
+}
+
+Status RenderCache::Create(const Dataset& dataset, const DatasetViews* views,
+                           const std::vector<int>& view_indices,
+                           const std::vector<Eigen::Vector3i>& faces, const Material& material,
+                           SceneParameters* params, const RenderCacheOptions& options,
+                           std::unique_ptr<RenderCache>* cache) {
+  std::string why;
+  if (!options.Check(&why)) return Status::Error(why);
+  std::unique_ptr<RenderCache> c(new RenderCache());
+  c->dataset_ = &dataset;
+  c->views_ = views;
+  c->view_indices_ = view_indices;
+  c->params_ = params;
+  c->options_ = options;
+  c->material_ = material;
+  params->Positions(&c->scene_positions_);
+  c->scene_ = std::make_unique<RenderScene>(c->scene_positions_, faces);
+  for (int v : view_indices) {
+    Image target;
+    SFT_RETURN_IF_ERROR(LoadViewImage(dataset, v, &target));
+    ViewTargets targets;
+    std::vector<uint8_t> active;
+    SFT_RETURN_IF_ERROR(ActivePixels(dataset, v, target.width, target.height,
+                                     options.mask_dilation, &active, &targets.has_mask));
+    const std::vector<Image> pyramid = BuildPyramid(Rgb(target), options.pyramid_levels);
+    targets.active = MaskPyramid(active, target.width, target.height,
+                                 static_cast<int>(pyramid.size()));
+    std::vector<std::unique_ptr<LevelCache>> levels;
+    for (size_t l = 0; l < pyramid.size(); ++l) {
+      auto level = std::make_unique<LevelCache>();
+      level->target = pyramid[l];
+      level->render = Image(pyramid[l].width, pyramid[l].height, 3);
+      level->sqrt_weight = std::pow(options.level_weight, 0.5 * l);
+      levels.push_back(std::move(level));
+    }
+    c->targets_.push_back(std::move(targets));
+    c->levels_.push_back(std::move(levels));
+  }
+  *cache = std::move(c);
+  return Status::Ok();
+}
+
+void RenderCache::PrepareForEvaluation(bool evaluate_jacobians, bool new_evaluation_point) {
+  if (new_evaluation_point || (evaluate_jacobians && !has_rows_)) Render(/*rows=*/true);
+}
+
+void RenderCache::UpdateScene() {
+  std::vector<Eigen::Vector3d> positions;
+  params_->Positions(&positions);
+  if (positions != scene_positions_) {
+    scene_->SetVertices(positions);
+    scene_positions_ = std::move(positions);
+  }
+  params_->WriteMaterial(&material_);
+}
+
+ViewSetup RenderCache::ScaledView(int v) const {
+  ViewSetup view = views_->views[view_indices_[v]];
+  for (PointLight& light : view.point_lights) {
+    if (light.light_index >= 0) light.intensity *= params_->LightScale(light.light_index);
+  }
+  if (view.environment_light_index >= 0) {
+    view.environment_scale *= params_->LightScale(view.environment_light_index);
+  }
+  return view;
+}
+
+void RenderCache::Render(bool rows) {
+  UpdateScene();
+  finite_ = true;
+  non_finite_ = 0;
+  RenderOptions render = options_.render;
+  render.seed = seed_;
+  DerivativeRequest request = options_.edges;
+  request.params = active_.ToSelection();
+  request.jacobian_rows = true;
+  const int num_lights = params_->layout().num_lights;
+  for (int v = 0; v < num_views(); ++v) {
+    const auto start = std::chrono::steady_clock::now();
+    Image image;
+    const ViewSetup view = ScaledView(v);
+    if (rows && active_.Any()) {
+      DerivativeOutput output;
+      RenderViewWithDerivatives(*scene_, material_, view, render, request, num_lights, &image,
+                                &output);
+      render_seconds_ += Seconds(start);
+      StoreRender(v, image, &output.rows);
+    } else {
+      RenderView(*scene_, material_, view, render, &image);
+      render_seconds_ += Seconds(start);
+      StoreRender(v, image, nullptr);
+    }
+    ++renders_;
+  }
+  has_rows_ = rows && active_.Any();
+}
+
+void RenderCache::StoreRender(int v, const Image& image, const JacobianRows* rows) {
+  const auto start = std::chrono::steady_clock::now();
+  std::vector<Image> pyramid = BuildPyramid(Rgb(image), num_levels(v));
+  for (float value : pyramid[0].data) non_finite_ += !std::isfinite(value);
+  LevelRows level_rows;
+  if (rows != nullptr) {
+    level_rows = RowsFromRenderer(*rows);
+    const ParameterLayout& layout = params_->layout();
+    for (RowEntry& e : level_rows.entries) {
+      // The renderer differentiates light l at the rendered intensity I·s_l, i.e. it returns
+      // s_l·∂I/∂s_l; the fit's parameter is s_l itself.
+      if (e.param >= layout.LightOffset()) {
+        const double scale = params_->LightScale(e.param - layout.LightOffset());
+        for (double& d : e.d) d /= scale;
+      }
+      for (double d : e.d) non_finite_ += !std::isfinite(d);
+    }
+  }
+  for (int l = 0; l < num_levels(v); ++l) {
+    LevelCache& level = *levels_[v][l];
+    level.render = std::move(pyramid[l]);
+    if (rows == nullptr) {
+      level.rows = LevelRows();
+      continue;
+    }
+    if (l > 0) level_rows = DownsampleRows(levels_[v][l - 1]->rows);
+    level.rows = std::move(level_rows);
+  }
+  if (non_finite_ > 0) finite_ = false;
+  pyramid_seconds_ += Seconds(start);
+}
+
+double RenderCache::ImageCost() const {
+  double cost = 0.0;
+  for (int v = 0; v < num_views(); ++v) {
+    for (int l = 0; l < num_levels(v); ++l) {
+      const LevelCache& level = *levels_[v][l];
+      const std::vector<uint8_t>& active = targets_[v].active[l];
+      double sum = 0.0;
+      for (int y = 0; y < level.render.height; ++y) {
+        for (int x = 0; x < level.render.width; ++x) {
+          if (!active[static_cast<size_t>(y) * level.render.width + x]) continue;
+          for (int c = 0; c < 3; ++c) {
+            const double r = level.render.at(x, y, c) - level.target.at(x, y, c);
+            sum += r * r;
+          }
+        }
+      }
+      cost += 0.5 * level.sqrt_weight * level.sqrt_weight * sum;
+    }
+  }
+  return cost;
+}
+
+std::vector<double> RenderCache::ViewMse() const {
+  std::vector<double> mse(num_views(), 0.0);
+  for (int v = 0; v < num_views(); ++v) {
+    const LevelCache& level = *levels_[v][0];
+    const std::vector<uint8_t>& active = targets_[v].active[0];
+    double sum = 0.0;
+    int64_t n = 0;
+    for (int y = 0; y < level.render.height; ++y) {
+      for (int x = 0; x < level.render.width; ++x) {
+        if (!active[static_cast<size_t>(y) * level.render.width + x]) continue;
+        for (int c = 0; c < 3; ++c) {
+          const double r = level.render.at(x, y, c) - level.target.at(x, y, c);
+          sum += r * r;
+          ++n;
+        }
+      }
+    }
+    mse[v] = n > 0 ? sum / n : 0.0;
+  }
+  return mse;
+}
+
+size_t RenderCache::RowMemoryBytes() const {
+  size_t bytes = 0;
+  for (const auto& view : levels_) {
+    for (const auto& level : view) bytes += level->rows.MemoryBytes();
+  }
+  return bytes;
+}
+
+Image RenderCache::AdjointWeights(int v) const {
+  Image acc;
+  for (int l = num_levels(v) - 1; l >= 0; --l) {
+    const LevelCache& level = *levels_[v][l];
+    if (!acc.empty()) acc = DownsampleMeanAdjoint(acc, level.render.width, level.render.height);
+    if (acc.empty()) acc = Image(level.render.width, level.render.height, 3);
+    const std::vector<uint8_t>& active = targets_[v].active[l];
+    const double w = level.sqrt_weight * level.sqrt_weight;
+    for (int y = 0; y < level.render.height; ++y) {
+      for (int x = 0; x < level.render.width; ++x) {
+        if (!active[static_cast<size_t>(y) * level.render.width + x]) continue;
+        for (int c = 0; c < 3; ++c) {
+          acc.at(x, y, c) +=
+              static_cast<float>(w * (level.render.at(x, y, c) - level.target.at(x, y, c)));
+        }
+      }
+    }
+  }
+  return acc;
+}
+
+bool RenderCache::AddAdjointGradient(int v, const Image& weights, std::vector<double>* gradient) {
+  UpdateScene();
+  RenderOptions render = options_.render;
+  render.seed = seed_;
+  DerivativeRequest request = options_.edges;
+  request.params = active_.ToSelection();
+  request.adjoint_weights = &weights;
+  const auto start = std::chrono::steady_clock::now();
+  Image image;
+  DerivativeOutput output;
+  RenderViewWithDerivatives(*scene_, material_, ScaledView(v), render, request,
+                            params_->layout().num_lights, &image, &output);
+  render_seconds_ += Seconds(start);
+  ++renders_;
+  const ParameterLayout& layout = params_->layout();
+  bool finite = true;
+  for (int i = 0; i < layout.size(); ++i) {
+    double g = output.gradient[i];
+    if (i >= layout.LightOffset()) g /= params_->LightScale(i - layout.LightOffset());
+    finite = finite && std::isfinite(g);
+    (*gradient)[i] += g;
+  }
+  return finite;
+}
+
+}  // namespace sft

@@ -1,0 +1,129 @@
+// The render cache (DESIGN.md §2.2): a ceres::EvaluationCallback that, before Ceres evaluates a
+// point, moves the mesh (refitting one Embree scene), writes the material and light scales from
+// the flat parameter vector, renders every view once — with Jacobian rows of the active parameter
+// kinds whenever Ceres may ask for them — and turns each render into its pyramid levels and their
+// rows. Residual blocks (cost_functions/pyramid_pixel.h) then only copy from it.
+//
+// Rows are rendered at every new point, also at trial points evaluated for their cost only:
+// Ceres asks for the Jacobian of an accepted point after evaluating its cost, and rendering with
+// rows once costs less than rendering twice. All renders of one outer iteration use the same seed
+// (common random numbers: a cost decrease between a trial and the linearization point is not
+// sampling noise); SetSeed starts a new outer iteration.
+#ifndef SFT_OPTIM_RENDER_CACHE_H_
+#define SFT_OPTIM_RENDER_CACHE_H_
+
+#include <ceres/evaluation_callback.h>
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "src/core/status.h"
+#include "src/io/dataset.h"
+#include "src/io/scene_setup.h"
+#include "src/optim/parameters.h"
+#include "src/optim/pyramid.h"
+#include "src/render/render.h"
+
+namespace sft {
+
+struct RenderCacheOptions {
+  RenderOptions render;         // spp, bounces, effects, threads (seed: see SetSeed).
+  DerivativeRequest edges;      // edge-sampling budgets of vertex derivatives (params ignored).
+  int pyramid_levels = 4;       // levels 0..L−1 (level l has 2^-l of the resolution), [1, 12].
+  double level_weight = 1.0;    // level l's residuals are weighted by level_weight^l, (0, 64].
+  int mask_dilation = 2;        // level-0 pixels within this many pixels of the mask count, [0, 64].
+
+  bool Check(std::string* why) const;
+};
+
+// Per view: the targets and the active pixels of every level.
+struct ViewTargets {
+  std::vector<std::vector<uint8_t>> active;  // per level, 1 = the pixel has a residual block.
+  bool has_mask = false;
+};
+
+class RenderCache : public ceres::EvaluationCallback {
+ public:
+  // Loads the targets (images and masks) of `view_indices`. `params` is the state that Ceres
+  // updates (its blocks point into params->values()); it and `dataset`/`views` must outlive the
+  // cache. `material` gives the texel layout and fresnel mode.
+  static Status Create(const Dataset& dataset, const DatasetViews* views,
+                       const std::vector<int>& view_indices,
+                       const std::vector<Eigen::Vector3i>& faces, const Material& material,
+                       SceneParameters* params, const RenderCacheOptions& options,
+                       std::unique_ptr<RenderCache>* cache);
+
+  void PrepareForEvaluation(bool evaluate_jacobians, bool new_evaluation_point) override;
+
+  // Renders every view at the current parameters: rows of the `active` kinds when `rows`.
+  void Render(bool rows);
+  // The seed of the renders from now on (a new outer iteration).
+  void SetSeed(uint64_t seed) { seed_ = seed; }
+  uint64_t seed() const { return seed_; }
+  void SetActive(const ActiveParameters& active) { active_ = active; }
+  const ActiveParameters& active() const { return active_; }
+
+  int num_views() const { return static_cast<int>(levels_.size()); }
+  int num_levels(int v) const { return static_cast<int>(levels_[v].size()); }
+  const LevelCache& level(int v, int l) const { return *levels_[v][l]; }
+  const ViewTargets& targets(int v) const { return targets_[v]; }
+  // Whether the last render (image and rows) was finite everywhere.
+  const bool* finite() const { return &finite_; }
+  // Number of non-finite values in the last render (pixels and row entries).
+  int64_t non_finite_values() const { return non_finite_; }
+
+  // ½ Σ r² of the image residuals over the active pixels of every level, at the last render.
+  double ImageCost() const;
+  // Mean squared error of level 0 over its active pixels and RGB, per view, at the last render.
+  std::vector<double> ViewMse() const;
+  // The last render of view v (level 0, RGB) and its target.
+  const Image& Rendered(int v) const { return levels_[v][0]->render; }
+  const Image& Target(int v) const { return levels_[v][0]->target; }
+
+  // Statistics for reports.
+  int64_t renders() const { return renders_; }
+  double render_seconds() const { return render_seconds_; }
+  double pyramid_seconds() const { return pyramid_seconds_; }
+  size_t RowMemoryBytes() const;
+
+  const std::vector<int>& view_indices() const { return view_indices_; }
+  const SceneParameters& params() const { return *params_; }
+
+  // The adjoint weight image of view v for the gradient of ImageCost: Σ_l w_l D_lᵀ(P_l(I) − P_l(T))
+  // over active pixels (D_lᵀ the adjoint of the pyramid's downsampling chain), as RGB.
+  Image AdjointWeights(int v) const;
+  // Renders view v at the current parameters with the adjoint gradient for `weights`
+  // (no rows stored); adds it to *gradient (layout size). Returns false on non-finite output.
+  bool AddAdjointGradient(int v, const Image& weights, std::vector<double>* gradient);
+
+ private:
+  RenderCache() = default;
+  void UpdateScene();
+  ViewSetup ScaledView(int v) const;
+  void StoreRender(int v, const Image& image, const JacobianRows* rows);
+
+  const Dataset* dataset_ = nullptr;
+  const DatasetViews* views_ = nullptr;
+  std::vector<int> view_indices_;
+  SceneParameters* params_ = nullptr;
+  RenderCacheOptions options_;
+  ActiveParameters active_;
+  Material material_;
+  std::unique_ptr<RenderScene> scene_;
+  std::vector<Eigen::Vector3d> scene_positions_;
+  std::vector<ViewTargets> targets_;
+  std::vector<std::vector<std::unique_ptr<LevelCache>>> levels_;
+  uint64_t seed_ = 0;
+  bool finite_ = true;
+  bool has_rows_ = false;
+  int64_t non_finite_ = 0;
+  int64_t renders_ = 0;
+  double render_seconds_ = 0.0;
+  double pyramid_seconds_ = 0.0;
+};
+
+}  // namespace sft
+
+#endif  // SFT_OPTIM_RENDER_CACHE_H_

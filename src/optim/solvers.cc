@@ -1,0 +1,282 @@
+#include "src/optim/solvers.h"
+
+#include <glog/logging.h>
+
+#include <chrono>
+#include <cmath>
+
+namespace sft {
+namespace {
+
+double Since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// Forwards Ceres iterations to the hooks.
+class HookCallback : public ceres::IterationCallback {
+ public:
+  explicit HookCallback(const SolverHooks& hooks) : hooks_(hooks) {}
+  ceres::CallbackReturnType operator()(const ceres::IterationSummary& summary) override {
+    if (summary.iteration == 0 || !hooks_.on_iteration) return ceres::SOLVER_CONTINUE;
+    IterationInfo info;
+    info.iteration = summary.iteration;
+    info.cost = summary.cost;
+    info.accepted = summary.step_is_successful;
+    return hooks_.on_iteration(info) ? ceres::SOLVER_CONTINUE
+                                     : ceres::SOLVER_TERMINATE_SUCCESSFULLY;
+  }
+
+ private:
+  const SolverHooks& hooks_;
+};
+
+// The regularizers alone, for the adjoint objective.
+std::unique_ptr<ceres::Problem> RegularizerProblem(const SolverHooks& hooks) {
+  ceres::Problem::Options options;
+  auto problem = std::make_unique<ceres::Problem>(options);
+  if (hooks.add_regularizers) hooks.add_regularizers(problem.get());
+  return problem;
+}
+
+}  // namespace
+
+bool SolverKindFromName(const std::string& name, SolverKind* kind) {
+  if (name == "lm") {
+    *kind = SolverKind::kLevenbergMarquardt;
+  } else if (name == "dogleg") {
+    *kind = SolverKind::kDogleg;
+  } else if (name == "lbfgs") {
+    *kind = SolverKind::kLbfgs;
+  } else if (name == "adam") {
+    *kind = SolverKind::kAdam;
+  } else {
+    return false;
+  }
+  return true;
+}
+
+const char* SolverKindName(SolverKind kind) {
+  switch (kind) {
+    case SolverKind::kLevenbergMarquardt:
+      return "lm";
+    case SolverKind::kDogleg:
+      return "dogleg";
+    case SolverKind::kLbfgs:
+      return "lbfgs";
+    case SolverKind::kAdam:
+      return "adam";
+  }
+  return "?";
+}
+
+SolverOptions::SolverOptions() {
+  trust_region.linear_solver_type = ceres::CGNR;
+  trust_region.preconditioner_type = ceres::JACOBI;
+  trust_region.max_linear_solver_iterations = 20;
+  trust_region.num_threads = 2;
+  trust_region.logging_type = ceres::SILENT;
+  line_search.line_search_direction_type = ceres::LBFGS;
+  line_search.logging_type = ceres::SILENT;
+}
+
+bool SolverOptions::Check(std::string* why) const {
+  if (steps < 1 || steps > 1000) {
+    *why = "steps: must be in [1, 1000]";
+    return false;
+  }
+  ceres::Solver::Options tr = trust_region;
+  tr.trust_region_strategy_type =
+      kind == SolverKind::kDogleg ? ceres::DOGLEG : ceres::LEVENBERG_MARQUARDT;
+  std::string error;
+  if (kind != SolverKind::kLbfgs && kind != SolverKind::kAdam && !tr.IsValid(&error)) {
+    *why = "solver: " + error;
+    return false;
+  }
+  if (kind == SolverKind::kLbfgs && !line_search.IsValid(&error)) {
+    *why = "solver: " + error;
+    return false;
+  }
+  const AdamOptions& a = adam;
+  if (!(a.learning_rate_vertices > 0 && a.learning_rate_material > 0 && a.beta1 >= 0 &&
+        a.beta1 < 1 && a.beta2 >= 0 && a.beta2 < 1 && a.epsilon > 0)) {
+    *why = "adam: learning rates and epsilon must be > 0, beta1 and beta2 in [0, 1)";
+    return false;
+  }
+  return true;
+}
+
+AdjointObjective::AdjointObjective(RenderCache* cache, SceneParameters* params,
+                                   const ParameterBounds& bounds, ceres::Problem* regularizers)
+    : cache_(cache), params_(params), bounds_(bounds), regularizers_(regularizers) {
+  const ParameterLayout& layout = params->layout();
+  const ActiveParameters& a = cache->active();
+  for (int i = 0; i < layout.size(); ++i) {
+    const ParameterKind kind = layout.KindOf(i);
+    const bool on = (kind == ParameterKind::kVertex && a.vertices) ||
+                    (kind == ParameterKind::kAlbedo && a.albedo) ||
+                    (kind == ParameterKind::kRoughness && a.roughness) ||
+                    (kind == ParameterKind::kSpecular && a.specular) ||
+                    (kind == ParameterKind::kLight && a.lights);
+    if (on) active_.push_back(i);
+  }
+}
+
+std::vector<double> AdjointObjective::Current() const {
+  std::vector<double> x(active_.size());
+  for (size_t k = 0; k < active_.size(); ++k) x[k] = params_->values()[active_[k]];
+  return x;
+}
+
+void AdjointObjective::Store(const double* x) const {
+  for (size_t k = 0; k < active_.size(); ++k) {
+    const int i = active_[k];
+    params_->values()[i] = std::clamp(x[k], params_->Lower(i, bounds_), params_->Upper(i, bounds_));
+  }
+}
+
+bool AdjointObjective::Evaluate(const double* x, double* cost, double* gradient) const {
+  Store(x);
+  cache_->Render(/*rows=*/false);
+  if (!*cache_->finite()) return false;
+  *cost = cache_->ImageCost();
+  std::vector<double> full;
+  if (gradient != nullptr) {
+    full.assign(params_->layout().size(), 0.0);
+    for (int v = 0; v < cache_->num_views(); ++v) {
+      if (!cache_->AddAdjointGradient(v, cache_->AdjointWeights(v), &full)) return false;
+    }
+  }
+  if (regularizers_ != nullptr && regularizers_->NumResidualBlocks() > 0) {
+    std::vector<double*> blocks;
+    regularizers_->GetParameterBlocks(&blocks);
+    ceres::Problem::EvaluateOptions options;
+    options.parameter_blocks = blocks;
+    double reg_cost = 0.0;
+    std::vector<double> reg_gradient;
+    if (!regularizers_->Evaluate(options, &reg_cost, nullptr,
+                                 gradient != nullptr ? &reg_gradient : nullptr, nullptr)) {
+      return false;
+    }
+    *cost += reg_cost;
+    if (gradient != nullptr) {
+      size_t k = 0;
+      for (double* block : blocks) {
+        const int offset = static_cast<int>(block - params_->data());
+        const int size = regularizers_->ParameterBlockSize(block);
+        for (int i = 0; i < size; ++i) full[offset + i] += reg_gradient[k++];
+      }
+    }
+  }
+  if (!std::isfinite(*cost)) return false;
+  if (gradient != nullptr) {
+    for (size_t k = 0; k < active_.size(); ++k) {
+      const int i = active_[k];
+      double g = full[i];
+      const double value = params_->values()[i];
+      // Projected gradient: no descent direction through an active bound.
+      if ((value <= params_->Lower(i, bounds_) && g > 0) ||
+          (value >= params_->Upper(i, bounds_) && g < 0)) {
+        g = 0.0;
+      }
+      gradient[k] = g;
+    }
+  }
+  return true;
+}
+
+Status RunSolver(const SolverOptions& options, const ProblemOptions& problem_options,
+                 RenderCache* cache, SceneParameters* params, const SolverHooks& hooks,
+                 SolverRunStats* stats) {
+  std::string why;
+  if (!options.Check(&why)) return Status::Error(why);
+  const auto start = std::chrono::steady_clock::now();
+  HookCallback callback(hooks);
+  if (options.kind == SolverKind::kLbfgs) {
+    std::unique_ptr<ceres::Problem> regularizers = RegularizerProblem(hooks);
+    auto* objective =
+        new AdjointObjective(cache, params, problem_options.bounds, regularizers.get());
+    std::vector<double> x = objective->Current();
+    ceres::GradientProblem problem(objective);  // takes ownership.
+    ceres::GradientProblemSolver::Options solver = options.line_search;
+    solver.max_num_iterations = options.steps;
+    solver.callbacks.push_back(&callback);
+    ceres::GradientProblemSolver::Summary summary;
+    ceres::Solve(solver, problem, x.data(), &summary);
+    objective->Store(x.data());
+    stats->iterations = static_cast<int>(summary.iterations.size()) - 1;
+    stats->termination = summary.message;
+  } else {
+    std::unique_ptr<ReconstructionProblem> problem;
+    SFT_RETURN_IF_ERROR(ReconstructionProblem::Build(cache, params, problem_options, &problem));
+    if (hooks.add_regularizers) hooks.add_regularizers(problem->problem());
+    stats->problem = problem->stats();
+    stats->setup_seconds = problem->stats().build_seconds;
+    ceres::Solver::Options solver = options.trust_region;
+    solver.minimizer_type = ceres::TRUST_REGION;
+    solver.trust_region_strategy_type =
+        options.kind == SolverKind::kDogleg ? ceres::DOGLEG : ceres::LEVENBERG_MARQUARDT;
+    solver.max_num_iterations = options.steps;
+    solver.callbacks.push_back(&callback);
+    ceres::Solver::Summary summary;
+    ceres::Solve(solver, problem->problem(), &summary);
+    stats->iterations = static_cast<int>(summary.iterations.size()) - 1;
+    stats->termination = summary.message;
+    stats->dropped_jacobian_fraction = problem->DroppedJacobianFraction(*cache);
+  }
+  stats->seconds = Since(start);
+  return Status::Ok();
+}
+
+Status RunAdam(const SolverOptions& options, const ProblemOptions& problem_options,
+               RenderCache* cache, SceneParameters* params, const SolverHooks& hooks,
+               AdamState* state, SolverRunStats* stats) {
+  std::string why;
+  if (!options.Check(&why)) return Status::Error(why);
+  const auto start = std::chrono::steady_clock::now();
+  std::unique_ptr<ceres::Problem> regularizers = RegularizerProblem(hooks);
+  AdjointObjective objective(cache, params, problem_options.bounds, regularizers.get());
+  const int n = objective.NumParameters();
+  const size_t size = params->layout().size();
+  if (state->m.size() != size) {
+    state->m.assign(size, 0.0);
+    state->v.assign(size, 0.0);
+  }
+  std::vector<double> x = objective.Current(), gradient(n);
+  const std::vector<int>& index = objective.active_indices();
+  const AdamOptions& adam = options.adam;
+  double cost = 0.0;
+  stats->termination = "steps";
+  for (int step = 1; step <= options.steps; ++step) {
+    if (!objective.Evaluate(x.data(), &cost, gradient.data())) {
+      stats->termination = "non-finite render";
+      break;
+    }
+    ++state->t;
+    const double c1 = 1.0 - std::pow(adam.beta1, static_cast<double>(state->t));
+    const double c2 = 1.0 - std::pow(adam.beta2, static_cast<double>(state->t));
+    for (int k = 0; k < n; ++k) {
+      const int i = index[k];
+      double& m = state->m[i];
+      double& v = state->v[i];
+      m = adam.beta1 * m + (1.0 - adam.beta1) * gradient[k];
+      v = adam.beta2 * v + (1.0 - adam.beta2) * gradient[k] * gradient[k];
+      const double lr = params->layout().KindOf(i) == ParameterKind::kVertex
+                            ? adam.learning_rate_vertices
+                            : adam.learning_rate_material;
+      x[k] -= lr * (m / c1) / (std::sqrt(v / c2) + adam.epsilon);
+      x[k] = std::clamp(x[k], params->Lower(i, problem_options.bounds),
+                        params->Upper(i, problem_options.bounds));
+    }
+    objective.Store(x.data());
+    stats->iterations = step;
+    // Adam reports the cost at the point where its gradient was taken (before the step).
+    if (hooks.on_iteration && !hooks.on_iteration({step, cost, true})) {
+      stats->termination = "stopped";
+      break;
+    }
+  }
+  stats->seconds = Since(start);
+  return Status::Ok();
+}
+
+}  // namespace sft

@@ -1,0 +1,121 @@
+// The solvers over one objective (DESIGN.md §2.2): ½ Σ r² of the pyramid pixel residuals of every
+// view (plus regularizers), minimised over the active parameter kinds within the feasible set.
+//   lm, dogleg  Ceres trust region over the ReconstructionProblem (Jacobian rows from the render
+//               cache; bounds as Ceres parameter bounds). Linear solver CGNR + Jacobi with capped
+//               iterations by default; sparse normal Cholesky or dense QR for small problems.
+//   lbfgs       Ceres line search (GradientProblemSolver) over an AdjointObjective: each
+//               evaluation renders every view forward, then again with the adjoint gradient
+//               Jᵀr (same seed, so the same image), storing no Jacobian. Bounds by projection:
+//               the objective is evaluated at the projection P(x) of the iterate, with the
+//               gradient components that push through an active bound set to zero.
+//   adam        Adam (Kingma & Ba 2015) on the same adjoint gradient, projected onto the bounds
+//               after every step; the baseline of first-order inverse renderers.
+// One call runs one outer iteration of one phase: a fixed seed (common random numbers) and at most
+// `steps` iterations.
+#ifndef SFT_OPTIM_SOLVERS_H_
+#define SFT_OPTIM_SOLVERS_H_
+
+#include <ceres/ceres.h>
+
+#include <atomic>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "src/optim/parameters.h"
+#include "src/optim/problem.h"
+#include "src/optim/render_cache.h"
+
+namespace sft {
+
+enum class SolverKind { kLevenbergMarquardt, kDogleg, kLbfgs, kAdam };
+bool SolverKindFromName(const std::string& name, SolverKind* kind);
+const char* SolverKindName(SolverKind kind);
+
+struct AdamOptions {
+  double learning_rate_vertices = 1e-3;  // step size of vertex coordinates, scene units, > 0.
+  double learning_rate_material = 2e-2;  // step size of texels, specular, light scales, > 0.
+  double beta1 = 0.9;                    // first-moment decay, [0, 1).
+  double beta2 = 0.999;                  // second-moment decay, [0, 1).
+  double epsilon = 1e-8;                 // denominator guard, > 0.
+};
+
+struct SolverOptions {
+  SolverKind kind = SolverKind::kLevenbergMarquardt;
+  int steps = 5;  // iterations per outer iteration and phase, [1, 1000].
+  // Trust-region options (lm, dogleg). Defaults set by the constructor: CGNR + Jacobi, at most
+  // 20 CG iterations, 2 threads. The minimizer and strategy follow `kind`; max_num_iterations
+  // follows `steps`.
+  ceres::Solver::Options trust_region;
+  // Line-search options (lbfgs); max_num_iterations follows `steps`.
+  ceres::GradientProblemSolver::Options line_search;
+  AdamOptions adam;
+
+  SolverOptions();
+  bool Check(std::string* why) const;
+};
+
+// What one iteration reports.
+struct IterationInfo {
+  int iteration = 0;      // within the call.
+  double cost = 0.0;      // objective after the iteration (of the accepted point).
+  bool accepted = false;  // the step was taken.
+};
+
+// Hooks of a run: `on_iteration` after every iteration (return false to stop early, e.g. on
+// Ctrl-C); `add_regularizers` adds regularizer residual blocks for the active kinds to a problem
+// whose parameter blocks point into the SceneParameters.
+struct SolverHooks {
+  std::function<bool(const IterationInfo&)> on_iteration;
+  std::function<void(ceres::Problem*)> add_regularizers;
+};
+
+// Counters of one call, for the report.
+struct SolverRunStats {
+  int iterations = 0;
+  double seconds = 0.0;
+  double setup_seconds = 0.0;   // problem build (supersets included), trust region only.
+  double dropped_jacobian_fraction = 0.0;  // trust region: at the last linearization.
+  ProblemStats problem;
+  std::string termination;  // Ceres' message or "steps".
+};
+
+// The objective evaluated by adjoint renders over the active parameters (lbfgs, adam).
+class AdjointObjective : public ceres::FirstOrderFunction {
+ public:
+  AdjointObjective(RenderCache* cache, SceneParameters* params, const ParameterBounds& bounds,
+                   ceres::Problem* regularizers);
+  bool Evaluate(const double* x, double* cost, double* gradient) const override;
+  int NumParameters() const override { return static_cast<int>(active_.size()); }
+  // The active parameters' current values (from the SceneParameters).
+  std::vector<double> Current() const;
+  // Flat indices of the active parameters, increasing (x[k] is parameter active_indices()[k]).
+  const std::vector<int>& active_indices() const { return active_; }
+  // Projects `x` and writes it into the SceneParameters.
+  void Store(const double* x) const;
+
+ private:
+  RenderCache* cache_;
+  SceneParameters* params_;
+  ParameterBounds bounds_;
+  ceres::Problem* regularizers_;  // may be null or empty.
+  std::vector<int> active_;       // flat indices of the active parameters.
+};
+
+// Runs one outer iteration of one phase (the cache's active kinds and seed are set by the caller).
+Status RunSolver(const SolverOptions& options, const ProblemOptions& problem_options,
+                 RenderCache* cache, SceneParameters* params, const SolverHooks& hooks,
+                 SolverRunStats* stats);
+
+// Adam's moments, kept across outer iterations (indexed like the flat parameter vector).
+struct AdamState {
+  std::vector<double> m, v;
+  int64_t t = 0;
+};
+Status RunAdam(const SolverOptions& options, const ProblemOptions& problem_options,
+               RenderCache* cache, SceneParameters* params, const SolverHooks& hooks,
+               AdamState* state, SolverRunStats* stats);
+
+}  // namespace sft
+
+#endif  // SFT_OPTIM_SOLVERS_H_
