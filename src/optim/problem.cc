@@ -12,16 +12,46 @@ namespace {
 // Block offsets touched by each active pixel of each level of one view.
 using PixelBlocks = std::vector<std::vector<int>>;  // [pixel] -> sorted offsets.
 
-void AddTouchedBlocks(const SceneParameters& params, const LevelRows& rows,
-                      const std::vector<uint8_t>& active, PixelBlocks* blocks) {
+// The blocks a touched parameter brings into a pixel's superset: its own block and, for a texel,
+// every texel of the same face that surface points sample (i + j < r). Texels are often smaller
+// than pixels, so a few renders' samples miss most of the texels a pixel covers; their face is
+// the better predictor.
+void ExpandBlock(const SceneParameters& params, const Material& material, int param,
+                 std::vector<int>* out) {
+  const BlockSpan span = params.BlockOf(param);
+  const ParameterLayout& layout = params.layout();
+  const bool albedo = span.kind == ParameterKind::kAlbedo;
+  if (!albedo && span.kind != ParameterKind::kRoughness) {
+    out->push_back(span.offset);
+    return;
+  }
+  const int r = (albedo ? material.albedo : material.roughness).resolution();
+  const int per_face = MeshColors::TexelsPerFace(r);
+  const int base = albedo ? layout.AlbedoOffset() : layout.RoughnessOffset();
+  const int size = albedo ? 3 : 1;
+  const int face = (span.offset - base) / size / per_face;
+  for (int i = 0; i < r || (r == 0 && i == 0); ++i) {
+    for (int j = 0; i + j < std::max(r, 1); ++j) {
+      out->push_back(base + size * (face * per_face + MeshColors::LocalIndex(r, i, j)));
+    }
+  }
+}
+
+void AddTouchedBlocks(const SceneParameters& params, const Material& material,
+                      const LevelRows& rows, const std::vector<uint8_t>& active,
+                      PixelBlocks* blocks) {
   std::vector<int> merged, fresh;
   for (size_t p = 0; p + 1 < rows.offsets.size(); ++p) {
     if (!active[p]) continue;
     fresh.clear();
+    int last_block = -1;
     for (uint64_t i = rows.offsets[p]; i < rows.offsets[p + 1]; ++i) {
-      const int offset = params.BlockOf(rows.entries[i].param).offset;
-      if (fresh.empty() || fresh.back() != offset) fresh.push_back(offset);
+      const int block = params.BlockOf(rows.entries[i].param).offset;
+      if (block != last_block) ExpandBlock(params, material, rows.entries[i].param, &fresh);
+      last_block = block;
     }
+    std::sort(fresh.begin(), fresh.end());
+    fresh.erase(std::unique(fresh.begin(), fresh.end()), fresh.end());
     std::vector<int>& have = (*blocks)[p];
     merged.clear();
     std::set_union(have.begin(), have.end(), fresh.begin(), fresh.end(),
@@ -61,8 +91,8 @@ Status ReconstructionProblem::Build(RenderCache* cache, SceneParameters* params,
     cache->Render(/*rows=*/true);
     for (int v = 0; v < cache->num_views(); ++v) {
       for (int l = 0; l < cache->num_levels(v); ++l) {
-        AddTouchedBlocks(*params, cache->level(v, l).rows, cache->targets(v).active[l],
-                         &supersets[v][l]);
+        AddTouchedBlocks(*params, cache->material(), cache->level(v, l).rows,
+                         cache->targets(v).active[l], &supersets[v][l]);
       }
     }
   }

@@ -89,6 +89,8 @@ class RenderCache : public ceres::EvaluationCallback {
   size_t RowMemoryBytes() const;
 
   const std::vector<int>& view_indices() const { return view_indices_; }
+  // The material of the last render (texel layout: resolutions, fresnel mode).
+  const Material& material() const { return material_; }
   const SceneParameters& params() const { return *params_; }
 
   // The adjoint weight image of view v for the gradient of ImageCost: Σ_l w_l D_lᵀ(P_l(I) − P_l(T))
