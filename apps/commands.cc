@@ -17,6 +17,8 @@ const CommandEntry kCommands[] = {
     {"reconstruct",
      "Refine a mesh and its material until path-traced renders match a dataset (Ceres)",
      &SetupReconstructCommand},
+    {"perturb", "Displace a mesh by a smooth random field (starting meshes for tests)",
+     &SetupPerturbCommand},
     {"bench", "Measure throughput against the limit (raw Embree rays/s)", &SetupBenchCommand},
 };
 

@@ -43,6 +43,7 @@ CommandRunner SetupRenderCommand(CLI::App* app);
 CommandRunner SetupGradcheckCommand(CLI::App* app);
 CommandRunner SetupBenchCommand(CLI::App* app);
 CommandRunner SetupReconstructCommand(CLI::App* app);
+CommandRunner SetupPerturbCommand(CLI::App* app);
 
 }  // namespace sft
 

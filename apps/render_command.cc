@@ -19,6 +19,7 @@
 #include "src/geometry/mesh.h"
 #include "src/io/dataset.h"
 #include "src/io/image_io.h"
+#include "src/io/light_scales.h"
 #include "src/io/scene_setup.h"
 #include "src/render/render.h"
 
@@ -31,6 +32,7 @@ struct RenderCommandOptions {
   std::string mesh;             // mesh to render (OBJ, PLY, OFF).
   std::string material;         // material JSON file or inline JSON; "" = default material.
   std::string out;              // output directory (images/, render.json, report.html).
+  std::string lights;           // light scales (lights.json of sft reconstruct); "" = none.
   std::string pass = "color";   // color | albedo | roughness | normal | depth.
   std::string effects = "all";  // enabled effects (Effects::Parse).
   std::vector<int> views;       // view indices; empty = all.
@@ -187,9 +189,14 @@ Status RunRender(const RenderCommandOptions& opts) {
   RenderOptions render = opts.render;
   SFT_RETURN_IF_ERROR(FinishRenderOptions(opts.pass, opts.effects, &render));
   SFT_RETURN_IF_ERROR(CheckOutputDirectory(
-      opts.out, {{opts.dataset}, {opts.mesh, MaterialFile(opts.material)}}, "--out"));
+      opts.out, {{opts.dataset}, {opts.mesh, MaterialFile(opts.material), opts.lights}}, "--out"));
   Dataset dataset;
   SFT_RETURN_IF_ERROR(ReadDataset(opts.dataset, &dataset));
+  if (!opts.lights.empty()) {
+    std::vector<double> scales;
+    SFT_RETURN_IF_ERROR(ReadLightScales(opts.lights, dataset, &scales));
+    ApplyLightScales(scales, &dataset);
+  }
   TriMesh mesh;
   SFT_RETURN_IF_ERROR(ReadMesh(opts.mesh, &mesh));
   Material material;
@@ -321,6 +328,8 @@ CommandRunner SetupRenderCommand(CLI::App* app) {
   app->add_option("--material", opts->material,
                   "Material: JSON file or inline JSON (see README); default albedo 0.7");
   app->add_option("--out", opts->out, "Output directory; images go to OUT/images/")->required();
+  app->add_option("--lights", opts->lights,
+                  "Light scales to apply (lights.json written by sft reconstruct)");
   app->add_option("--spp", opts->render.spp, "Samples per pixel")->capture_default_str();
   app->add_option("--bounces", opts->render.bounces,
                   "Path segments: 1 = direct light only, 2 = one indirect bounce")
