@@ -15,6 +15,8 @@ const CommandEntry kCommands[] = {
      "Compare the renderer's derivatives with finite differences for one parameter kind",
      &SetupGradcheckCommand},
     {"bench", "Measure throughput against the limit (raw Embree rays/s)", &SetupBenchCommand},
+    {"eval", "Measure a reconstructed mesh against a reference mesh (F1, Chamfer) as JSON",
+     &SetupEvalCommand},
 };
 
 }  // namespace

@@ -38,6 +38,7 @@ CommandRunner SetupSynthCommand(CLI::App* app);
 CommandRunner SetupRenderCommand(CLI::App* app);
 CommandRunner SetupGradcheckCommand(CLI::App* app);
 CommandRunner SetupBenchCommand(CLI::App* app);
+CommandRunner SetupEvalCommand(CLI::App* app);
 
 }  // namespace sft
 
