@@ -166,11 +166,10 @@ Status ComputeSsim(const Image& ours, const Image& reference, const Image& mask,
   SFT_RETURN_IF_ERROR(CheckInputs(ours, reference, mask, options, &channels, &masked));
   // QualitySSIM's constants are those of L = 255.
   const double scale = 255.0 / options.peak;
-  std::vector<cv::Mat> maps;
+  cv::Mat quality_map, map;  // one multi-channel map (OpenCV 4.6's single-image interface).
   cv::quality::QualitySSIM::compute(ToMat(reference, channels, scale),
-                                    ToMat(ours, channels, scale), maps);
-  cv::Mat map;
-  maps.at(0).convertTo(map, CV_64F);
+                                    ToMat(ours, channels, scale), quality_map);
+  quality_map.convertTo(map, CV_64F);
   *ssim = MaskedMapMean(map, mask);
   return Status::Ok();
 #else
