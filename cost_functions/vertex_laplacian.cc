@@ -33,7 +33,8 @@ double EdgeCotangentWeight(const TriMesh& mesh, TriMesh::HalfedgeHandle h) {
   double sum = 0.0;
   for (TriMesh::HalfedgeHandle side : {h, mesh.opposite_halfedge_handle(h)}) {
     if (mesh.is_boundary(side)) continue;  // no face on this side.
-    const Eigen::Vector3d apex = Position(mesh, mesh.to_vertex_handle(mesh.next_halfedge_handle(side)));
+    const Eigen::Vector3d apex =
+        Position(mesh, mesh.to_vertex_handle(mesh.next_halfedge_handle(side)));
     sum += Cotangent(apex, pi, pj);
   }
   return 0.5 * sum;

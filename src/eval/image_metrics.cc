@@ -25,14 +25,13 @@ Status CheckInputs(const Image& ours, const Image& reference, const Image& mask,
   if (ours.empty() || reference.empty()) return Status::Error("image is empty");
   if (ours.width != reference.width || ours.height != reference.height ||
       ours.channels != reference.channels) {
-    return Status::Error("image sizes differ: " + std::to_string(ours.width) + "x" +
-                         std::to_string(ours.height) + "x" + std::to_string(ours.channels) +
-                         " vs reference " + std::to_string(reference.width) + "x" +
-                         std::to_string(reference.height) + "x" +
-                         std::to_string(reference.channels));
+    return Status::Error(
+        "image sizes differ: " + std::to_string(ours.width) + "x" + std::to_string(ours.height) +
+        "x" + std::to_string(ours.channels) + " vs reference " + std::to_string(reference.width) +
+        "x" + std::to_string(reference.height) + "x" + std::to_string(reference.channels));
   }
-  if (!mask.empty() && (mask.width != ours.width || mask.height != ours.height ||
-                        mask.channels != 1)) {
+  if (!mask.empty() &&
+      (mask.width != ours.width || mask.height != ours.height || mask.channels != 1)) {
     return Status::Error("mask must be one channel of the image's size");
   }
   *channels = std::min(ours.channels, 3);
@@ -167,8 +166,8 @@ Status ComputeSsim(const Image& ours, const Image& reference, const Image& mask,
   // QualitySSIM's constants are those of L = 255.
   const double scale = 255.0 / options.peak;
   cv::Mat quality_map, map;  // one multi-channel map (OpenCV 4.6's single-image interface).
-  cv::quality::QualitySSIM::compute(ToMat(reference, channels, scale),
-                                    ToMat(ours, channels, scale), quality_map);
+  cv::quality::QualitySSIM::compute(ToMat(reference, channels, scale), ToMat(ours, channels, scale),
+                                    quality_map);
   quality_map.convertTo(map, CV_64F);
   *ssim = MaskedMapMean(map, mask);
   return Status::Ok();

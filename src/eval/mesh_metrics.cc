@@ -31,8 +31,9 @@ struct PointCloudAdaptor {
   }
 };
 
-using KdTree = nanoflann::KDTreeSingleIndexAdaptor<
-    nanoflann::L2_Simple_Adaptor<double, PointCloudAdaptor>, PointCloudAdaptor, 3, uint32_t>;
+using KdTree =
+    nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, PointCloudAdaptor>,
+                                        PointCloudAdaptor, 3, uint32_t>;
 
 double SegmentDistanceSquared(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
                               const Eigen::Vector3d& b) {
@@ -50,23 +51,23 @@ std::vector<double> DirectedDistances(const SurfaceSamples& from, const SurfaceS
   PointCloudAdaptor adaptor{&to.points};
   KdTree tree(3, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(16));
   std::vector<double> distances(from.points.size());
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, from.points.size(), 4096),
-                    [&](const tbb::blocked_range<size_t>& range) {
-                      uint32_t indices[kCandidates];
-                      double squared[kCandidates];
-                      for (size_t s = range.begin(); s != range.end(); ++s) {
-                        const Eigen::Vector3d& p = from.points[s];
-                        const size_t found = tree.knnSearch(p.data(), kCandidates, indices, squared);
-                        double best = found > 0 ? std::sqrt(squared[0]) : HUGE_VAL;
-                        for (size_t k = 0; k < found; ++k) {
-                          const Eigen::Vector3i& f = faces[to.faces[indices[k]]];
-                          best = std::min(best, PointTriangleDistance(p, positions[f[0]],
-                                                                      positions[f[1]],
-                                                                      positions[f[2]]));
-                        }
-                        distances[s] = best;
-                      }
-                    });
+  tbb::parallel_for(
+      tbb::blocked_range<size_t>(0, from.points.size(), 4096),
+      [&](const tbb::blocked_range<size_t>& range) {
+        uint32_t indices[kCandidates];
+        double squared[kCandidates];
+        for (size_t s = range.begin(); s != range.end(); ++s) {
+          const Eigen::Vector3d& p = from.points[s];
+          const size_t found = tree.knnSearch(p.data(), kCandidates, indices, squared);
+          double best = found > 0 ? std::sqrt(squared[0]) : HUGE_VAL;
+          for (size_t k = 0; k < found; ++k) {
+            const Eigen::Vector3i& f = faces[to.faces[indices[k]]];
+            best = std::min(
+                best, PointTriangleDistance(p, positions[f[0]], positions[f[1]], positions[f[2]]));
+          }
+          distances[s] = best;
+        }
+      });
   return distances;
 }
 
@@ -95,8 +96,10 @@ Status NormalisedArrays(const TriMesh& mesh, const Eigen::Vector3d& centre, doub
 
 bool MeshMetricsOptions::Check(std::string* why) const {
   if (!(tolerance > 0.0 && tolerance <= 1.0)) {
-    *why = "tolerance: must be in (0, 1] (a fraction of the reference's bounding-box diagonal), "
-           "got " + std::to_string(tolerance);
+    *why =
+        "tolerance: must be in (0, 1] (a fraction of the reference's bounding-box diagonal), "
+        "got " +
+        std::to_string(tolerance);
     return false;
   }
   if (samples < kMinSamples || samples > kMaxSamples) {

@@ -44,8 +44,8 @@ TEST(EvalCommandTest, PrintsJsonAndWritesIt) {
   EXPECT_EQ(printed["samples"], 20000);
   EXPECT_EQ(printed["seed"], 3);
   EXPECT_EQ(printed["tolerance"], 0.01);
-  for (const char* key : {"mean_mesh_to_reference", "mean_reference_to_mesh",
-                          "chamfer_definition", "reference_diagonal", "reference", "mesh"}) {
+  for (const char* key : {"mean_mesh_to_reference", "mean_reference_to_mesh", "chamfer_definition",
+                          "reference_diagonal", "reference", "mesh"}) {
     EXPECT_TRUE(printed.contains(key)) << key;
   }
   std::ifstream file(tmp.Join("sub/eval.json"));
@@ -70,10 +70,10 @@ TEST(EvalCommandTest, DifferentMeshes) {
   }
   testing::WriteTestFile(tmp.Join("moved.obj"), moved.str());
   std::string out;
-  ASSERT_EQ(Sft("eval --reference " + Sphere() + " --mesh " + tmp.Join("moved.obj") +
-                    " --samples 50000",
-                &out),
-            0)
+  ASSERT_EQ(
+      Sft("eval --reference " + Sphere() + " --mesh " + tmp.Join("moved.obj") + " --samples 50000",
+          &out),
+      0)
       << out;
   const nlohmann::json j = nlohmann::json::parse(out);
   EXPECT_NEAR(j["f1"].get<double>(), 0.5, 0.03);

@@ -4,8 +4,8 @@
 #include "cost_functions/texel_smoothness.h"
 
 #include <ceres/ceres.h>
-#include <glog/logging.h>
 #include <ceres/gradient_checker.h>
+#include <glog/logging.h>
 #include <gtest/gtest.h>
 
 #include <numeric>
@@ -151,7 +151,8 @@ TEST(TexelSmoothnessTest, FillsZeroAreaTexelsFromTheirNeighbours) {
   ceres::Problem problem;
   EXPECT_EQ(AddTexelSmoothness(pairs, 1, TexelSmoothnessOptions(), blocks, &problem), 18);
   for (int i = 0; i <= r; ++i) {
-    for (int j = 0; i + j < r; ++j) problem.SetParameterBlockConstant(blocks[MeshColors::LocalIndex(r, i, j)]);
+    for (int j = 0; i + j < r; ++j)
+      problem.SetParameterBlockConstant(blocks[MeshColors::LocalIndex(r, i, j)]);
   }
   ceres::Solver::Options options;
   options.linear_solver_type = ceres::DENSE_QR;

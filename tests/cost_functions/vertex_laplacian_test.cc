@@ -120,7 +120,8 @@ TEST(VertexLaplacianTest, UniformIsZeroOnAPlanarGridInterior) {
   const std::vector<LaplacianStencil> all = LaplacianStencils(grid, options);
   EXPECT_EQ(all.size(), 36u);
   double max_boundary = 0.0;
-  for (const LaplacianStencil& s : all) max_boundary = std::max(max_boundary, StencilResidual(grid, s).norm());
+  for (const LaplacianStencil& s : all)
+    max_boundary = std::max(max_boundary, StencilResidual(grid, s).norm());
   EXPECT_GT(max_boundary, 0.1);  // boundary rings are one-sided.
 }
 
@@ -203,7 +204,8 @@ TEST(VertexLaplacianTest, CeresSolveSmoothsANoisyMesh) {
     EXPECT_GT(summary.initial_cost, 1e-3);
     EXPECT_LT(summary.final_cost, 1e-12 * summary.initial_cost);
     double max_height = 0.0;
-    for (size_t v = 0; v < rest.n_vertices(); ++v) max_height = std::max(max_height, std::abs(xyz[3 * v + 2]));
+    for (size_t v = 0; v < rest.n_vertices(); ++v)
+      max_height = std::max(max_height, std::abs(xyz[3 * v + 2]));
     EXPECT_LT(max_height, 1e-6);
   }
 }

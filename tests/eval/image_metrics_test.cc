@@ -20,8 +20,8 @@ Image Pattern(int width, int height, int shift = 0) {
     for (int x = 0; x < width; ++x) {
       const double u = x + shift;
       for (int c = 0; c < 3; ++c) {
-        image.at(x, y, c) = static_cast<float>(
-            0.5 + 0.2 * std::sin(0.4 * u + 0.3 * y + c) + 0.2 * std::cos(0.23 * u * (c + 1) - 0.5 * y));
+        image.at(x, y, c) = static_cast<float>(0.5 + 0.2 * std::sin(0.4 * u + 0.3 * y + c) +
+                                               0.2 * std::cos(0.23 * u * (c + 1) - 0.5 * y));
       }
     }
   }

@@ -63,11 +63,11 @@ MeshMetricsOptions TestOptions(double tolerance = 0.01) {
 
 TEST(PointTriangleDistanceTest, RegionsOfTheTriangle) {
   const Eigen::Vector3d a(0, 0, 0), b(1, 0, 0), c(0, 1, 0);
-  EXPECT_NEAR(PointTriangleDistance({0.2, 0.3, 0.5}, a, b, c), 0.5, 1e-15);    // above the face.
-  EXPECT_NEAR(PointTriangleDistance({0.2, 0.3, -2.0}, a, b, c), 2.0, 1e-15);   // below it.
-  EXPECT_NEAR(PointTriangleDistance({0.5, -1.0, 0.0}, a, b, c), 1.0, 1e-15);   // edge ab.
+  EXPECT_NEAR(PointTriangleDistance({0.2, 0.3, 0.5}, a, b, c), 0.5, 1e-15);   // above the face.
+  EXPECT_NEAR(PointTriangleDistance({0.2, 0.3, -2.0}, a, b, c), 2.0, 1e-15);  // below it.
+  EXPECT_NEAR(PointTriangleDistance({0.5, -1.0, 0.0}, a, b, c), 1.0, 1e-15);  // edge ab.
   EXPECT_NEAR(PointTriangleDistance({1.0, 1.0, 0.0}, a, b, c), std::sqrt(0.5), 1e-15);  // edge bc.
-  EXPECT_NEAR(PointTriangleDistance({-3.0, -4.0, 0.0}, a, b, c), 5.0, 1e-15);  // corner a.
+  EXPECT_NEAR(PointTriangleDistance({-3.0, -4.0, 0.0}, a, b, c), 5.0, 1e-15);           // corner a.
   EXPECT_NEAR(PointTriangleDistance({2.0, 0.0, 1.0}, a, b, c), std::sqrt(2.0), 1e-15);  // corner b.
   // Degenerate (collinear) triangle: the distance to the segment it covers.
   EXPECT_NEAR(PointTriangleDistance({0.5, 1.0, 0.0}, a, b, {0.5, 0, 0}), 1.0, 1e-15);
@@ -76,7 +76,7 @@ TEST(PointTriangleDistanceTest, RegionsOfTheTriangle) {
 
 TEST(SampleSurfaceTest, AreaUniformAndDeterministic) {
   // Two triangles of areas 1 and 3 (and a zero-area one that must get nothing).
-  const std::vector<Eigen::Vector3d> p = {{0, 0, 0}, {2, 0, 0}, {0, 1, 0}, {10, 0, 0},
+  const std::vector<Eigen::Vector3d> p = {{0, 0, 0},  {2, 0, 0},  {0, 1, 0},  {10, 0, 0},
                                           {16, 0, 0}, {10, 1, 0}, {20, 0, 0}, {21, 0, 0}};
   const std::vector<Eigen::Vector3i> f = {{0, 1, 2}, {6, 7, 6}, {3, 4, 5}};
   const SurfaceSamples s = SampleSurface(p, f, 4000, 7, 0);
