@@ -15,8 +15,8 @@
 // Both kinds have Σ_j w_ij = 1, so r_i is invariant under translation and zero for a vertex at the
 // weighted average of its ring: any interior vertex of a planar uniform grid (uniform) or of any
 // planar mesh (cotangent). On a curved surface the cotangent residual points along the normal
-// (it is the mean-curvature normal scaled by the rest-mesh weights) and the uniform one also has
-// tangential parts that even out the vertex distribution.
+// (at the rest mesh it is the discrete mean-curvature normal divided by Σ_k c_ik), while the
+// uniform one also has tangential parts that even out the vertex distribution.
 //
 // Why fixed weights: the residual is then linear in the positions, the term is an ordinary linear
 // least-squares term whose Jacobian is constant, and Gauss–Newton/Levenberg–Marquardt sees a fixed

@@ -171,8 +171,9 @@ TEST(VertexLaplacianTest, CotangentPointsAlongTheNormalOnASphere) {
   for (auto& a : angles) std::sort(a.begin(), a.end());
   const double cot_median = angles[0][angles[0].size() / 2];
   const double uniform_median = angles[1][angles[1].size() / 2];
-  EXPECT_LT(cot_median, 0.05);  // radians
-  EXPECT_GT(uniform_median, 2.0 * cot_median);
+  EXPECT_LT(cot_median, 0.05);       // radians
+  EXPECT_LT(angles[0].back(), 0.1);  // the worst vertex too
+  EXPECT_GT(uniform_median, 0.3);    // the uniform residual is far from normal on irregular rings
 }
 
 // A noisy grid with its boundary held fixed: the Laplacian alone flattens it (its minimum, cost 0,
