@@ -20,9 +20,10 @@
 // The duplicated edge and vertex texels of the layout are therefore *smoothed* towards each other
 // with the same weight as in-face neighbours, not tied by a hard or strong constraint: the term is
 // one uniform smoothness over the texel adjacency graph (`cross_face_weight` can change the
-// balance). Pairing by the lookup, not by lattice points, matters: the lattice point i/r of an
-// edge belongs to texel i in one face and, seen from the other face (which runs along the edge the
-// other way), to the texel on the far side of that point.
+// balance). Pairing by the lookup, not by duplicated lattice points, matters: a lattice-point texel
+// covers the interval *after* its point along its own face's grid, so when the two faces' grids
+// run along the shared edge in opposite directions the duplicates of a lattice point cover
+// intervals on opposite sides of it (off by one), and the far-corner duplicates have no area.
 //
 // The r + 1 texels with i + j = r of each face cover no area (only lattice points on the edge
 // α + β = 1 map to them), so no rendering residual depends on them. This term ties them to their

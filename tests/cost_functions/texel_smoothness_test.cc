@@ -99,10 +99,27 @@ TEST(TexelNeighbourPairsTest, ExactPairsAtResolutionOne) {
 // The quad's faces are (v0, v1, v2) and (v0, v2, v3), sharing v0–v2. At r = 2, the half of the
 // edge next to v0 is texel (0,0) in both faces (global 0 and 6); the half next to v2 is (0,1) in
 // face 0 (v2 is its third vertex: β = 1 there; local 1) and (1,0) in face 1 (v2 is its second
-// vertex: α; local 3, global 9). Pairing by lattice points instead would give (1, 6+5) etc.
+// vertex: α; local 3, global 9).
 TEST(TexelNeighbourPairsTest, CrossFacePairsCoverTheSameStretchOfTheEdge) {
   EXPECT_EQ(Unordered(TexelNeighbourPairs(Quad(), 2), true),
             (std::set<std::pair<int, int>>{{0, 6}, {1, 9}}));
+}
+
+// The same quad with the second face written (v2, v3, v0): its grid runs along the shared edge
+// from v2 (β = 0) to v0 (β = 1). The half next to v0 is (0,1) there (β ∈ [0.5, 1): local 1, global
+// 7), the half next to v2 is (0,0) (global 6). Pairing duplicated lattice points instead would
+// give (0,8), (1,7), (2,6): shifted by one interval, and tying area texels to zero-area ones.
+TEST(TexelNeighbourPairsTest, CrossFacePairsWhenTheGridsRunOppositeWays) {
+  TriMesh mesh;
+  std::vector<TriMesh::VertexHandle> v;
+  for (const auto& p : {TriMesh::Point(-1, -1, 0), TriMesh::Point(1, -1, 0),
+                        TriMesh::Point(1, 1, 0), TriMesh::Point(-1, 1, 0)}) {
+    v.push_back(mesh.add_vertex(p));
+  }
+  mesh.add_face(v[0], v[1], v[2]);
+  mesh.add_face(v[2], v[3], v[0]);
+  EXPECT_EQ(Unordered(TexelNeighbourPairs(mesh, 2), true),
+            (std::set<std::pair<int, int>>{{0, 7}, {1, 6}}));
 }
 
 // On a closed mesh every texel, the zero-area ones included, is linked to every other: the
