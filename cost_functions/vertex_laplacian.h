@@ -9,9 +9,11 @@
 //   uniform:    w_ij = 1/n (umbrella operator);
 //   cotangent:  w_ij = c_ij / Σ_k c_ik, c_ij = (cot α_ij + cot β_ij)/2, α_ij and β_ij the angles
 //               opposite the edge ij in its two faces (one face at a boundary edge), measured on
-//               the *rest* mesh handed to the builder. If Σ_k c_ik is not clearly positive
-//               (≤ 1e-9 · Σ_k |c_ik|, possible with obtuse triangles) the vertex falls back to
-//               uniform weights.
+//               the *rest* mesh handed to the builder. Single c_ij are negative across obtuse
+//               angles, but each face adds sin α/(sin β·sin γ)/2 > 0 to Σ_k c_ik (α its angle at
+//               i), so the sum is positive unless every face of the ring is degenerate (a
+//               degenerate corner contributes no cotangent); then (Σ_k c_ik ≤ 1e-9 · Σ_k |c_ik|)
+//               the vertex falls back to uniform weights.
 // Both kinds have Σ_j w_ij = 1, so r_i is invariant under translation and zero for a vertex at the
 // weighted average of its ring: any interior vertex of a planar uniform grid (uniform) or of any
 // planar mesh (cotangent). On a curved surface the cotangent residual points along the normal

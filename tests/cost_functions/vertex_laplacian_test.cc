@@ -104,6 +104,22 @@ TEST(VertexLaplacianTest, WeightsSumToOne) {
   }
 }
 
+// A ring of degenerate faces has no cotangents at all: uniform weights instead of 0/0.
+TEST(VertexLaplacianTest, DegenerateRingFallsBackToUniformWeights) {
+  TriMesh mesh;
+  mesh.add_face(mesh.add_vertex({0, 0, 0}), mesh.add_vertex({1, 0, 0}), mesh.add_vertex({2, 0, 0}));
+  VertexLaplacianOptions options;
+  options.kind = LaplacianKind::kCotangent;
+  options.include_boundary = true;
+  const std::vector<LaplacianStencil> stencils = LaplacianStencils(mesh, options);
+  ASSERT_EQ(stencils.size(), 3u);
+  for (const LaplacianStencil& s : stencils) {
+    ASSERT_EQ(s.weights.size(), 2u);
+    EXPECT_EQ(s.weights[0], 0.5);
+    EXPECT_EQ(s.weights[1], 0.5);
+  }
+}
+
 // A regular planar grid: every interior vertex is the uniform average of its ring. Boundary
 // vertices get no residual by default (their one-sided ring would pull them inwards).
 TEST(VertexLaplacianTest, UniformIsZeroOnAPlanarGridInterior) {
