@@ -24,8 +24,8 @@
 // least-squares term whose Jacobian is constant, and Gauss–Newton/Levenberg–Marquardt sees a fixed
 // (I − W) operator, which is what makes it act as a preconditioner-like smoother of the rendering
 // gradient ("Large Steps", Nicolet et al. 2021, use the fixed matrix I + λL). Recomputing the
-// cotangents from the current positions would make the term nonlinear, and its exact derivative
-// would need ∂w_ij/∂p, which vanishes for the optimiser's purposes only if the mesh barely moves.
+// cotangents from the current positions would make the term nonlinear, and its exact Jacobian
+// would need ∂w_ij/∂p, negligible only while the mesh stays near the rest mesh.
 // Rebuild the blocks (from the current mesh as the new rest mesh) after remeshing or large motion.
 //
 // Parameter blocks: [p_i, p_j1, ..., p_jn], each 3 doubles (x, y, z), in that order.
