@@ -20,6 +20,8 @@ const CommandEntry kCommands[] = {
     {"perturb", "Displace a mesh by a smooth random field (starting meshes for tests)",
      &SetupPerturbCommand},
     {"bench", "Measure throughput against the limit (raw Embree rays/s)", &SetupBenchCommand},
+    {"eval", "Measure a reconstructed mesh against a reference mesh (F1, Chamfer) as JSON",
+     &SetupEvalCommand},
 };
 
 }  // namespace

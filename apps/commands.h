@@ -44,6 +44,7 @@ CommandRunner SetupGradcheckCommand(CLI::App* app);
 CommandRunner SetupBenchCommand(CLI::App* app);
 CommandRunner SetupReconstructCommand(CLI::App* app);
 CommandRunner SetupPerturbCommand(CLI::App* app);
+CommandRunner SetupEvalCommand(CLI::App* app);
 
 }  // namespace sft
 

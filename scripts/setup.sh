@@ -15,6 +15,8 @@ PACKAGES=(
   libopencv-dev libopencv-contrib-dev libtinyexr-dev
   # meshes
   libopenmesh-dev
+  # nearest neighbours (sft eval)
+  libnanoflann-dev
   # CLI, JSON
   libcli11-dev nlohmann-json3-dev
   # tests and benchmarks

@@ -1,0 +1,101 @@
+// sft eval: accuracy of a reconstruction against ground truth, printed as JSON on stdout (and
+// written to --json when given).
+//
+// Modes, chosen by the options present:
+//   mesh   --reference GT --mesh M [--tolerance 0.01] [--samples N] [--seed S]
+//          F1 at the tolerance, precision, recall and the Chamfer distance in units of the
+//          reference's bounding-box diagonal (src/eval/mesh_metrics.h).
+// A second mode (`--dataset D --reconstruction O`: PSNR/SSIM of re-renders against the dataset's
+// images, src/eval/image_metrics.h) is to be added beside RunMeshEval, with its own options
+// struct and a branch in RunEvalCommand.
+#include <cstdio>
+#include <memory>
+#include <nlohmann/json.hpp>
+
+#include "apps/commands.h"
+#include "src/core/file_util.h"
+#include "src/eval/mesh_metrics.h"
+#include "src/geometry/mesh.h"
+
+namespace sft {
+namespace {
+
+// Options of the mesh mode.
+struct MeshEvalOptions {
+  std::string reference;       // ground-truth mesh (OBJ, PLY, OFF).
+  std::string mesh;            // mesh to evaluate (OBJ, PLY, OFF).
+  MeshMetricsOptions metrics;  // tolerance, samples, seed.
+};
+
+struct EvalCommandOptions {
+  MeshEvalOptions mesh;
+  std::string json;  // optional copy of the printed JSON.
+};
+
+Status RunMeshEval(const MeshEvalOptions& opts, nlohmann::json* report) {
+  std::string why;
+  if (!opts.metrics.Check(&why)) return Status::Error("--" + why);
+  TriMesh reference, mesh;
+  SFT_RETURN_IF_ERROR(ReadMesh(opts.reference, &reference));
+  SFT_RETURN_IF_ERROR(ReadMesh(opts.mesh, &mesh));
+  MeshMetrics m;
+  SFT_RETURN_IF_ERROR(
+      ComputeMeshMetrics(reference, mesh, opts.metrics, &m, opts.reference, opts.mesh));
+  *report = {
+      {"mode", "mesh"},
+      {"reference", opts.reference},
+      {"mesh", opts.mesh},
+      {"units", "fraction of the reference's bounding-box diagonal"},
+      {"reference_diagonal", m.reference_diagonal},
+      {"tolerance", m.tolerance},
+      {"precision", m.precision},
+      {"recall", m.recall},
+      {"f1", m.f1},
+      {"chamfer", m.chamfer},
+      {"chamfer_definition",
+       "(mean_mesh_to_reference + mean_reference_to_mesh) / 2, unsquared point-to-surface "
+       "distances"},
+      {"mean_mesh_to_reference", m.mean_mesh_to_reference},
+      {"mean_reference_to_mesh", m.mean_reference_to_mesh},
+      {"samples", m.samples},
+      {"seed", opts.metrics.seed},
+  };
+  return Status::Ok();
+}
+
+int RunEvalCommand(const EvalCommandOptions& opts) {
+  if (opts.mesh.reference.empty() || opts.mesh.mesh.empty()) {
+    return PrintError("eval", Status::Error("--reference and --mesh are both required"));
+  }
+  nlohmann::json report;
+  Status status = RunMeshEval(opts.mesh, &report);
+  if (!status.ok()) return PrintError("eval", status);
+  const std::string text = report.dump(1) + "\n";
+  if (!opts.json.empty()) {
+    status = WriteTextFile(opts.json, text);
+    if (!status.ok()) return PrintError("eval", status.Prefixed("--json"));
+  }
+  std::fputs(text.c_str(), stdout);
+  return 0;
+}
+
+}  // namespace
+
+CommandRunner SetupEvalCommand(CLI::App* app) {
+  auto opts = std::make_shared<EvalCommandOptions>();
+  app->add_option("--reference", opts->mesh.reference, "Ground-truth mesh (OBJ, PLY, OFF)");
+  app->add_option("--mesh", opts->mesh.mesh, "Mesh to evaluate (OBJ, PLY, OFF)");
+  app->add_option("--tolerance", opts->mesh.metrics.tolerance,
+                  "F1 distance threshold, fraction of the reference's bounding-box diagonal, "
+                  "(0, 1]")
+      ->capture_default_str();
+  app->add_option("--samples", opts->mesh.metrics.samples,
+                  "Surface samples per mesh, [" + std::to_string(MeshMetricsOptions::kMinSamples) +
+                      ", " + std::to_string(MeshMetricsOptions::kMaxSamples) + "]")
+      ->capture_default_str();
+  app->add_option("--seed", opts->mesh.metrics.seed, "Sampling seed")->capture_default_str();
+  app->add_option("--json", opts->json, "Also write the JSON to this file");
+  return [opts]() { return RunEvalCommand(*opts); };
+}
+
+}  // namespace sft
