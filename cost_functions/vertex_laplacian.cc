@@ -55,7 +55,7 @@ bool VertexLaplacianCost::Evaluate(double const* const* parameters, double* resi
   for (size_t k = 0; k < neighbour_weights_.size(); ++k) {
     for (int c = 0; c < 3; ++c) residuals[c] -= neighbour_weights_[k] * parameters[k + 1][c];
   }
-  for (int c = 0; c < 3; ++c) residuals[c] *= weight_;
+  for (int c = 0; c < 3; ++c) residuals[c] = weight_ * (residuals[c] - rest_laplacian_[c]);
   if (jacobians == nullptr) return true;
   // Row-major 3×3 blocks: ∂r_c/∂p_d = scale·δ_cd.
   const auto fill = [](double* jacobian, double scale) {
@@ -111,7 +111,21 @@ int AddVertexLaplacian(const TriMesh& rest, const VertexLaplacianOptions& option
     blocks.clear();
     blocks.push_back(vertex_blocks[s.vertex]);
     for (int n : s.neighbours) blocks.push_back(vertex_blocks[n]);
-    problem->AddResidualBlock(new VertexLaplacianCost(options.weight, s.weights), nullptr, blocks);
+    auto* cost = new VertexLaplacianCost(options.weight, s.weights);
+    if (options.relative_to_rest) {
+      // L(p_rest)_i: the residual then measures the Laplacian of the displacement.
+      Eigen::Vector3d rest_laplacian = Eigen::Vector3d::Zero();
+      const auto at = [&](int v) {
+        const auto p = rest.point(rest.vertex_handle(v));
+        return Eigen::Vector3d(p[0], p[1], p[2]);
+      };
+      rest_laplacian = at(s.vertex);
+      for (size_t k = 0; k < s.neighbours.size(); ++k) {
+        rest_laplacian -= s.weights[k] * at(s.neighbours[k]);
+      }
+      cost->set_rest_laplacian(rest_laplacian);
+    }
+    problem->AddResidualBlock(cost, nullptr, blocks);
   }
   return static_cast<int>(stencils.size());
 }

@@ -3,7 +3,11 @@
 //
 // Residual (3 residuals, one per coordinate), for vertex i with one-ring neighbours j = 1..n:
 //
-//   r_i = w · (p_i − Σ_j w_ij · p_j)
+//   r_i = w · (p_i − Σ_j w_ij · p_j − c_i)
+//
+// with c_i = 0 (the Laplacian of the shape: it smooths and shrinks it) or, with
+// `relative_to_rest`, c_i = the same Laplacian of the rest mesh (the Laplacian of the
+// displacement from the rest mesh: it smooths the update and leaves the rest shape's detail).
 //
 // where w is the term's weight and the w_ij are fixed numbers chosen when the block is built:
 //   uniform:    w_ij = 1/n (umbrella operator);
@@ -36,6 +40,7 @@
 #ifndef SFT_COST_FUNCTIONS_VERTEX_LAPLACIAN_H_
 #define SFT_COST_FUNCTIONS_VERTEX_LAPLACIAN_H_
 
+#include <Eigen/Core>
 #include <ceres/cost_function.h>
 #include <ceres/problem.h>
 
@@ -61,10 +66,13 @@ class VertexLaplacianCost : public ceres::CostFunction {
   VertexLaplacianCost(double weight, std::vector<double> neighbour_weights);
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override;
+  // c_i of the top comment (zero unless set).
+  void set_rest_laplacian(const Eigen::Vector3d& c) { rest_laplacian_ = c; }
 
  private:
   double weight_;
   std::vector<double> neighbour_weights_;
+  Eigen::Vector3d rest_laplacian_ = Eigen::Vector3d::Zero();
 };
 
 struct VertexLaplacianOptions {
@@ -75,6 +83,9 @@ struct VertexLaplacianOptions {
   // Whether boundary vertices get a residual. Their ring is one-sided, so the residual pulls them
   // inwards even on a flat mesh (an open boundary would shrink): off by default.
   bool include_boundary = false;
+  // Whether residuals measure the Laplacian of the displacement from `rest` (c_i above) rather
+  // than of the shape.
+  bool relative_to_rest = false;
 
   bool Check(std::string* why) const;
 };

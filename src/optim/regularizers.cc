@@ -2,7 +2,35 @@
 
 #include <cmath>
 
+#include "cost_functions/texel_smoothness.h"
+#include "cost_functions/vertex_laplacian.h"
+
 namespace sft {
+namespace {
+
+// Smoothness over one mesh-colors attribute whose texel k is the block at offset + channels·k.
+void AddSmoothness(const TriMesh& rest, int resolution, int channels, int offset, double weight,
+                   const ParameterBounds& bounds, SceneParameters* params,
+                   ceres::Problem* problem) {
+  const std::vector<TexelPair> pairs = TexelNeighbourPairs(rest, resolution);
+  const int num_texels = rest.n_faces() * MeshColors::TexelsPerFace(resolution);
+  std::vector<double*> blocks(num_texels);
+  for (int k = 0; k < num_texels; ++k) blocks[k] = params->data() + offset + channels * k;
+  TexelSmoothnessOptions options;
+  options.weight = std::sqrt(weight);
+  AddTexelSmoothness(pairs, channels, options, blocks, problem);
+  // Texels no render touches (i + j = r) enter the problem here: give every texel the bounds.
+  for (int k = 0; k < num_texels; ++k) {
+    if (!problem->HasParameterBlock(blocks[k])) continue;
+    for (int c = 0; c < channels; ++c) {
+      const int index = offset + channels * k + c;
+      problem->SetParameterLowerBound(blocks[k], c, params->Lower(index, bounds));
+      problem->SetParameterUpperBound(blocks[k], c, params->Upper(index, bounds));
+    }
+  }
+}
+
+}  // namespace
 
 bool RegularizerOptions::Check(std::string* why) const {
   for (double w : {laplacian_weight, albedo_smoothness, roughness_smoothness}) {
@@ -17,7 +45,24 @@ bool RegularizerOptions::Check(std::string* why) const {
 void AddRegularizers(const TriMesh& rest, const ActiveParameters& active,
                      const RegularizerOptions& options, const ParameterBounds& bounds,
                      const Material& material, SceneParameters* params, ceres::Problem* problem) {
-  // Filled in with the cost functions of cost_functions/ (merge pending).
+  const ParameterLayout& layout = params->layout();
+  if (active.vertices && options.laplacian_weight > 0.0) {
+    VertexLaplacianOptions laplacian;
+    laplacian.kind = options.cotangent ? LaplacianKind::kCotangent : LaplacianKind::kUniform;
+    laplacian.weight = std::sqrt(options.laplacian_weight);
+    laplacian.relative_to_rest = true;
+    std::vector<double*> blocks(layout.num_vertices);
+    for (int v = 0; v < layout.num_vertices; ++v) blocks[v] = params->data() + 3 * v;
+    AddVertexLaplacian(rest, laplacian, blocks, problem);
+  }
+  if (active.albedo && options.albedo_smoothness > 0.0) {
+    AddSmoothness(rest, material.albedo.resolution(), 3, layout.AlbedoOffset(),
+                  options.albedo_smoothness, bounds, params, problem);
+  }
+  if (active.roughness && options.roughness_smoothness > 0.0) {
+    AddSmoothness(rest, material.roughness.resolution(), 1, layout.RoughnessOffset(),
+                  options.roughness_smoothness, bounds, params, problem);
+  }
 }
 
 }  // namespace sft
