@@ -5,9 +5,9 @@
 //   mesh   --reference GT --mesh M [--tolerance 0.01] [--samples N] [--seed S]
 //          F1 at the tolerance, precision, recall and the Chamfer distance in units of the
 //          reference's bounding-box diagonal (src/eval/mesh_metrics.h).
-// A second mode (`--dataset D --reconstruction O`: PSNR/SSIM of re-renders against the dataset's
-// images, src/eval/image_metrics.h) is to be added beside RunMeshEval, with its own options
-// struct and a branch in RunEvalCommand.
+//   reconstruction   --dataset D --reconstruction O [--spp 64] [--bounces 2] [--views ...]
+//          PSNR and SSIM of re-renders of O against D's images and true albedo/roughness
+//          (src/eval/reconstruction_eval.h).
 #include <cstdio>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -15,6 +15,7 @@
 #include "apps/commands.h"
 #include "src/core/file_util.h"
 #include "src/eval/mesh_metrics.h"
+#include "src/eval/reconstruction_eval.h"
 #include "src/geometry/mesh.h"
 
 namespace sft {
@@ -29,6 +30,9 @@ struct MeshEvalOptions {
 
 struct EvalCommandOptions {
   MeshEvalOptions mesh;
+  std::string dataset;                    // reconstruction mode: the dataset.
+  std::string reconstruction;             // reconstruction mode: sft reconstruct's output folder.
+  ReconstructionEvalOptions images;       // reconstruction mode: re-render settings.
   std::string json;  // optional copy of the printed JSON.
 };
 
@@ -64,11 +68,24 @@ Status RunMeshEval(const MeshEvalOptions& opts, nlohmann::json* report) {
 }
 
 int RunEvalCommand(const EvalCommandOptions& opts) {
-  if (opts.mesh.reference.empty() || opts.mesh.mesh.empty()) {
-    return PrintError("eval", Status::Error("--reference and --mesh are both required"));
+  const bool images = !opts.dataset.empty() || !opts.reconstruction.empty();
+  if (images && (opts.dataset.empty() || opts.reconstruction.empty())) {
+    return PrintError("eval", Status::Error("--dataset and --reconstruction go together"));
+  }
+  if (!images && (opts.mesh.reference.empty() || opts.mesh.mesh.empty())) {
+    return PrintError("eval", Status::Error("--reference and --mesh are both required (or "
+                                            "--dataset and --reconstruction)"));
+  }
+  if (!opts.json.empty()) {
+    const Status where = CheckOutputFile(
+        opts.json, {{opts.dataset, opts.reconstruction}, {opts.mesh.reference, opts.mesh.mesh}},
+        "--json");
+    if (!where.ok()) return PrintError("eval", where);
   }
   nlohmann::json report;
-  Status status = RunMeshEval(opts.mesh, &report);
+  Status status = images ? EvaluateReconstruction(opts.dataset, opts.reconstruction, opts.images,
+                                                  &report)
+                         : RunMeshEval(opts.mesh, &report);
   if (!status.ok()) return PrintError("eval", status);
   const std::string text = report.dump(1) + "\n";
   if (!opts.json.empty()) {
@@ -94,6 +111,15 @@ CommandRunner SetupEvalCommand(CLI::App* app) {
                       ", " + std::to_string(MeshMetricsOptions::kMaxSamples) + "]")
       ->capture_default_str();
   app->add_option("--seed", opts->mesh.metrics.seed, "Sampling seed")->capture_default_str();
+  app->add_option("--dataset", opts->dataset, "Reconstruction mode: the dataset");
+  app->add_option("--reconstruction", opts->reconstruction,
+                  "Reconstruction mode: the output folder of sft reconstruct");
+  app->add_option("--spp", opts->images.spp, "Reconstruction mode: samples per pixel")
+      ->capture_default_str();
+  app->add_option("--bounces", opts->images.bounces, "Reconstruction mode: path segments")
+      ->capture_default_str();
+  app->add_option("--views", opts->images.views, "Reconstruction mode: only these views")
+      ->delimiter(',');
   app->add_option("--json", opts->json, "Also write the JSON to this file");
   return [opts]() { return RunEvalCommand(*opts); };
 }
