@@ -4,6 +4,7 @@
 // `--resume OUT` continues from it.
 #include <csignal>
 #include <cstdio>
+#include <set>
 #include <nlohmann/json.hpp>
 
 #include "apps/commands.h"
@@ -33,9 +34,10 @@ struct ReconstructCommandOptions {
   std::string config;    // config JSON file.
   std::string material;  // initial material (JSON file or inline); "" = constant guess.
   std::string phases, solver;
-  int outer = 0, steps = 0, spp = 0, bounces = 0, threads = -1;
-  int64_t seed = -1;
+  int outer = 0, steps = 0, spp = 0, bounces = 0, threads = 0;
+  int64_t seed = 0;
   std::vector<int> views;
+  std::set<std::string> given;  // config keys whose flag was on the command line.
   bool quiet = false;
   bool no_report = false;
 };
@@ -49,22 +51,22 @@ Status MakeOptions(const ReconstructCommandOptions& cli, const nlohmann::json* r
     SFT_RETURN_IF_ERROR(ApplyReconstructConfig(*resumed, cli.resume + "/state.json", options));
   }
   if (!cli.config.empty()) SFT_RETURN_IF_ERROR(ReadReconstructConfig(cli.config, options));
+  const nlohmann::json all = {{"phases", cli.phases},       {"solver", cli.solver},
+                              {"outer_iterations", cli.outer}, {"steps", cli.steps},
+                              {"spp", cli.spp},             {"bounces", cli.bounces},
+                              {"threads", cli.threads},     {"seed", cli.seed},
+                              {"views", cli.views}};
   nlohmann::json flags = nlohmann::json::object();
-  if (!cli.phases.empty()) flags["phases"] = cli.phases;
-  if (!cli.solver.empty()) flags["solver"] = cli.solver;
-  if (cli.outer != 0) flags["outer_iterations"] = cli.outer;
-  if (cli.steps != 0) flags["steps"] = cli.steps;
-  if (cli.spp != 0) flags["spp"] = cli.spp;
-  if (cli.bounces != 0) flags["bounces"] = cli.bounces;
-  if (cli.threads >= 0) flags["threads"] = cli.threads;
-  if (cli.seed >= 0) flags["seed"] = static_cast<uint64_t>(cli.seed);
-  if (!cli.views.empty()) flags["views"] = cli.views;
+  for (const auto& [key, value] : all.items()) {
+    if (cli.given.count(key) > 0) flags[key] = value;
+  }
   // Flag errors name the flag ("--steps: ...").
   for (const auto& [key, value] : flags.items()) {
     const Status status = ApplyReconstructConfig({{key, value}}, "flag", options);
     if (!status.ok()) {
       std::string message = status.message();
       message = message.substr(message.find(": ") + 2);  // "steps: expected ...".
+      if (message.rfind("outer_iterations", 0) == 0) message.replace(0, 16, "outer");
       return Status::Error("--" + message);
     }
   }
@@ -176,16 +178,30 @@ CommandRunner SetupReconstructCommand(CLI::App* app) {
                   "Config JSON (keys in docs/reconstruct.md); flags override it");
   app->add_option("--material", opts->material,
                   "Initial material (JSON file or inline); default: albedo 0.5, roughness 0.5");
-  app->add_option("--phases", opts->phases, "texture | geometry | alternate (default alternate)");
-  app->add_option("--solver", opts->solver, "lm | dogleg | lbfgs | adam (default lm)");
-  app->add_option("--outer", opts->outer, "Outer iterations (fresh seeds each; default 4)");
-  app->add_option("--steps", opts->steps, "Solver iterations per outer iteration and phase (5)");
-  app->add_option("--spp", opts->spp, "Samples per pixel of the fit's renders (16)");
-  app->add_option("--bounces", opts->bounces, "Path segments (2)");
-  app->add_option("--threads", opts->threads, "Render threads (0 = all cores)");
-  app->add_option("--seed", opts->seed, "Base seed");
-  app->add_option("--views", opts->views, "Only these view indices (comma-separated)")
-      ->delimiter(',');
+  // Flags that override config keys: recorded as given only when on the command line.
+  const auto key_flag = [&](CLI::Option* option, const std::string& key) {
+    option->each([opts, key](const std::string&) { opts->given.insert(key); });
+  };
+  key_flag(app->add_option("--phases", opts->phases,
+                           "texture | geometry | alternate (default alternate)"),
+           "phases");
+  key_flag(app->add_option("--solver", opts->solver, "lm | dogleg | lbfgs | adam (default lm)"),
+           "solver");
+  key_flag(app->add_option("--outer", opts->outer,
+                           "Outer iterations (fresh seeds each; default 4)"),
+           "outer_iterations");
+  key_flag(app->add_option("--steps", opts->steps,
+                           "Solver iterations per outer iteration and phase (5)"),
+           "steps");
+  key_flag(app->add_option("--spp", opts->spp, "Samples per pixel of the fit's renders (16)"),
+           "spp");
+  key_flag(app->add_option("--bounces", opts->bounces, "Path segments (2)"), "bounces");
+  key_flag(app->add_option("--threads", opts->threads, "Render threads (0 = all cores)"),
+           "threads");
+  key_flag(app->add_option("--seed", opts->seed, "Base seed"), "seed");
+  key_flag(app->add_option("--views", opts->views, "Only these view indices (comma-separated)")
+               ->delimiter(','),
+           "views");
   app->add_flag("--quiet", opts->quiet, "No progress line");
   app->add_flag("--no-report", opts->no_report, "Do not write OUT/report.html");
   return [opts]() {

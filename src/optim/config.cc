@@ -174,7 +174,9 @@ const std::map<std::string, Key>& Keys() {
       {"fit_specular", Bool([](O* o) -> bool& { return o->fit_specular; })},
       {"fit_lights", Bool([](O* o) -> bool& { return o->fit_lights; })},
       {"seed", {[](const json& v, O* o) -> std::string {
-                  if (!v.is_number_unsigned()) return "expected a non-negative integer";
+                  if (!v.is_number_integer() || (!v.is_number_unsigned() && v.get<int64_t>() < 0)) {
+                    return "expected a non-negative integer";
+                  }
                   o->seed = v.get<uint64_t>();
                   return "";
                 },
