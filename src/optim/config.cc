@@ -94,6 +94,17 @@ const std::map<std::string, Key>& Keys() {
                       [](const O& o) { return o.cache.render.effects.ToString(); })},
       {"pyramid_levels", Int([](O* o) -> int& { return o->cache.pyramid_levels; }, 1, 12)},
       {"level_weight", Real([](O* o) -> double& { return o->cache.level_weight; }, 1e-6, 64)},
+      {"image_weight", Real([](O* o) -> double& { return o->cache.image_weight; }, 0, 1e6)},
+      {"laplacian_target",
+       Choice(
+           [](const std::string& s, O* o) -> std::string {
+             if (s != "displacement" && s != "shape") return "expected displacement or shape";
+             o->regularizers.laplacian_of_shape = s == "shape";
+             return "";
+           },
+           [](const O& o) {
+             return std::string(o.regularizers.laplacian_of_shape ? "shape" : "displacement");
+           })},
       {"mask_dilation", Int([](O* o) -> int& { return o->cache.mask_dilation; }, 0, 64)},
       {"primary_edge_ratio",
        Real([](O* o) -> double& { return o->cache.edges.primary_edge_ratio; }, 0, 16)},

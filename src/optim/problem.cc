@@ -86,7 +86,9 @@ Status ReconstructionProblem::Build(RenderCache* cache, SceneParameters* params,
     }
   }
   const uint64_t seed = cache->seed();
-  for (int k = 0; k < options.superset_renders; ++k) {
+  // Without an image term (regularizers only) there are no pixel blocks to build.
+  const bool image_term = cache->level(0, 0).sqrt_weight > 0.0;
+  for (int k = 0; image_term && k < options.superset_renders; ++k) {
     cache->SetSeed(seed * 1000003ull + 7919ull * (k + 1));
     cache->Render(/*rows=*/true);
     for (int v = 0; v < cache->num_views(); ++v) {
@@ -111,7 +113,7 @@ Status ReconstructionProblem::Build(RenderCache* cache, SceneParameters* params,
     for (int l = 0; l < cache->num_levels(v); ++l) {
       const std::vector<uint8_t>& active = cache->targets(v).active[l];
       for (size_t p = 0; p < active.size(); ++p) {
-        if (!active[p]) continue;
+        if (!active[p] || !image_term) continue;
         std::vector<int>& offsets = supersets[v][l][p];
         if (offsets.empty()) {
           ++stats.pixels_without_parameters;

@@ -76,6 +76,28 @@ bool ReconstructOptions::Check(std::string* why) const {
   return true;
 }
 
+MeshQuality CompareMeshQuality(const TriMesh& initial, const TriMesh& mesh) {
+  std::vector<Eigen::Vector3d> p0, p1;
+  std::vector<Eigen::Vector3i> f0, f1;
+  MeshToArrays(initial, &p0, &f0);
+  MeshToArrays(mesh, &p1, &f1);
+  Eigen::Vector3d lo, hi;
+  MeshBounds(mesh, &lo, &hi);
+  const double min_area = 1e-12 * (hi - lo).squaredNorm();
+  MeshQuality quality;
+  for (size_t f = 0; f < f1.size() && f < f0.size(); ++f) {
+    const Eigen::Vector3i& t = f1[f];
+    const Eigen::Vector3d n1 = (p1[t[1]] - p1[t[0]]).cross(p1[t[2]] - p1[t[0]]);
+    const Eigen::Vector3d n0 = (p0[t[1]] - p0[t[0]]).cross(p0[t[2]] - p0[t[0]]);
+    if (0.5 * n1.norm() <= min_area) {
+      ++quality.degenerate_faces;
+    } else if (n1.dot(n0) < 0.0) {
+      ++quality.flipped_faces;
+    }
+  }
+  return quality;
+}
+
 double PsnrFromMse(double mse) {
   if (!(mse > 1e-10)) return 100.0;
   return -10.0 * std::log10(mse);

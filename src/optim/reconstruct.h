@@ -97,6 +97,15 @@ class Reconstruction {
   double start_time_ = 0.0;
 };
 
+// Faces of `mesh` whose normal turned by more than 90° from the same face of `initial`, and faces
+// of (nearly) zero area (≤ 1e-12 × the squared bounding-box diagonal): what a geometry fit must
+// not leave behind.
+struct MeshQuality {
+  int flipped_faces = 0;
+  int degenerate_faces = 0;
+};
+MeshQuality CompareMeshQuality(const TriMesh& initial, const TriMesh& mesh);
+
 // Peak-1 PSNR of a mean squared error (capped at 100 dB for a zero error).
 double PsnrFromMse(double mse);
 

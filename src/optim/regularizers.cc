@@ -50,7 +50,7 @@ void AddRegularizers(const TriMesh& rest, const ActiveParameters& active,
     VertexLaplacianOptions laplacian;
     laplacian.kind = options.cotangent ? LaplacianKind::kCotangent : LaplacianKind::kUniform;
     laplacian.weight = std::sqrt(options.laplacian_weight);
-    laplacian.relative_to_rest = true;
+    laplacian.relative_to_rest = !options.laplacian_of_shape;
     std::vector<double*> blocks(layout.num_vertices);
     for (int v = 0; v < layout.num_vertices; ++v) blocks[v] = params->data() + 3 * v;
     AddVertexLaplacian(rest, laplacian, blocks, problem);

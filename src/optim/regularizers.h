@@ -19,6 +19,9 @@ struct RegularizerOptions {
   // term smooths the update without shrinking the shape.
   double laplacian_weight = 0.0;
   bool cotangent = false;  // cotangent weights (at the starting mesh) instead of uniform ones.
+  // The Laplacian of the shape itself (smooths and shrinks it: what removes i.i.d. vertex noise)
+  // instead of the Laplacian of the displacement.
+  bool laplacian_of_shape = false;
   double albedo_smoothness = 0.0;     // weight of albedo differences of neighbouring texels, ≥ 0.
   double roughness_smoothness = 0.0;  // the same for roughness, ≥ 0.
 

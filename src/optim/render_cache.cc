@@ -59,6 +59,10 @@ bool RenderCacheOptions::Check(std::string* why) const {
     *why = "level_weight: must be in (0, 64]";
     return false;
   }
+  if (!(image_weight >= 0.0 && image_weight <= 1e6)) {
+    *why = "image_weight: must be in [0, 1e6]";
+    return false;
+  }
   if (mask_dilation < 0 || mask_dilation > 64) {
     *why = "mask_dilation: must be in [0, 64]";
     return false;
@@ -97,7 +101,7 @@ Status RenderCache::Create(const Dataset& dataset, const DatasetViews* views,
       auto level = std::make_unique<LevelCache>();
       level->target = pyramid[l];
       level->render = Image(pyramid[l].width, pyramid[l].height, 3);
-      level->sqrt_weight = std::pow(options.level_weight, 0.5 * l);
+      level->sqrt_weight = std::sqrt(options.image_weight) * std::pow(options.level_weight, 0.5 * l);
       levels.push_back(std::move(level));
     }
     c->targets_.push_back(std::move(targets));

@@ -103,6 +103,18 @@ Status WriteMetrics(const std::string& out, const std::vector<IterationRecord>& 
   return WriteTextFile(JoinPath(out, "metrics.json"), metrics.dump(1) + "\n");
 }
 
+Status ReadOuterRecords(const std::string& out, json* records) {
+  const std::string path = JoinPath(out, "metrics.json");
+  std::string text;
+  SFT_RETURN_IF_ERROR(ReadTextFile(path, &text));
+  const json j = json::parse(text, nullptr, /*allow_exceptions=*/false);
+  *records = json::array();
+  if (!j.is_discarded() && j.is_object() && j.contains("outer") && j["outer"].is_array()) {
+    *records = j["outer"];
+  }
+  return Status::Ok();
+}
+
 Status ReadIterationRecords(const std::string& out, std::vector<IterationRecord>* records) {
   const std::string path = JoinPath(out, "metrics.json");
   std::string text;

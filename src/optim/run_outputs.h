@@ -39,6 +39,8 @@ Status WriteReconstructionState(const std::string& out, const Dataset& dataset,
 // `extra` is merged into metrics.json's top level.
 Status WriteMetrics(const std::string& out, const std::vector<IterationRecord>& records,
                     const std::vector<PhaseRecord>& phases, const nlohmann::json& extra);
+// Reads the per-outer-iteration entries ("outer", an array; empty when absent) of metrics.json.
+Status ReadOuterRecords(const std::string& out, nlohmann::json* records);
 // Reads the iteration records of an earlier session back from metrics.json (for --resume).
 Status ReadIterationRecords(const std::string& out, std::vector<IterationRecord>* records);
 
