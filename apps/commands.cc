@@ -19,6 +19,8 @@ const CommandEntry kCommands[] = {
      &SetupReconstructCommand},
     {"perturb", "Displace a mesh by a smooth random field (starting meshes for tests)",
      &SetupPerturbCommand},
+    {"compare", "Cost, Chamfer and F1 against wall time over several reconstruct runs (CSV, HTML)",
+     &SetupCompareCommand},
     {"bench", "Measure throughput against the limit (raw Embree rays/s)", &SetupBenchCommand},
     {"eval", "Measure a reconstructed mesh against a reference mesh (F1, Chamfer) as JSON",
      &SetupEvalCommand},

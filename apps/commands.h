@@ -45,6 +45,7 @@ CommandRunner SetupBenchCommand(CLI::App* app);
 CommandRunner SetupReconstructCommand(CLI::App* app);
 CommandRunner SetupPerturbCommand(CLI::App* app);
 CommandRunner SetupEvalCommand(CLI::App* app);
+CommandRunner SetupCompareCommand(CLI::App* app);
 
 }  // namespace sft
 
