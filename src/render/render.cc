@@ -67,8 +67,8 @@ SurfaceMaterial LookUpMaterial(const Context& ctx, const Material& material, int
   return m;
 }
 
-double RayOffset(const Context& ctx, const Eigen::Vector3d& p) {
-  return SurfaceRayOffset(ctx.scene, p);
+double RayOffset(const Context& ctx, int face, const Eigen::Vector3d& p) {
+  return SurfaceRayOffset(ctx.scene, face, p);
 }
 
 // Direction, distance, cosine and BSDF value of a point light seen from the shading point p
@@ -82,12 +82,12 @@ struct PointLightSample {
 
 // False when the light is below the surface or closer than kMinRelativeLightDistance (the
 // contribution is then zero).
-bool SamplePointLight(const Context& ctx, const PointLight& light, const Eigen::Vector3d& p,
-                      const Eigen::Vector3d& n, const Eigen::Vector3d& wo, const BsdfParams& params,
-                      PointLightSample* sample) {
+bool SamplePointLight(const Context& ctx, const PointLight& light, int face,
+                      const Eigen::Vector3d& p, const Eigen::Vector3d& n, const Eigen::Vector3d& wo,
+                      const BsdfParams& params, PointLightSample* sample) {
   const Eigen::Vector3d to_light = light.position - p;
   const double dist2 = to_light.squaredNorm();
-  const double min_dist = kMinRelativeLightDistance * ctx.scene.extent();
+  const double min_dist = kMinRelativeLightDistance * SurfaceScale(ctx.scene, face, p);
   if (!(dist2 > min_dist * min_dist)) return false;
   sample->dist = std::sqrt(dist2);
   sample->wi = to_light / sample->dist;
@@ -409,7 +409,7 @@ Eigen::Vector3d TraceRadiance(const Context& ctx, Sampler* sampler, Eigen::Vecto
     const BsdfParams sampling =
         detached ? LookUpMaterial(ctx, ctx.sampling_material, hit.face, hit.u, hit.v).params
                  : params;
-    const double offset = RayOffset(ctx, p);
+    const double offset = RayOffset(ctx, hit.face, p);
     const Eigen::Vector3d p_off = p + offset * n;
     const bool lit_here = depth > 0 || effects.direct;
 
@@ -423,7 +423,7 @@ Eigen::Vector3d TraceRadiance(const Context& ctx, Sampler* sampler, Eigen::Vecto
     if (lit_here) {
       for (const PointLight& light : ctx.view.point_lights) {
         PointLightSample ls;
-        if (!SamplePointLight(ctx, light, p, n, wo, params, &ls)) continue;
+        if (!SamplePointLight(ctx, light, hit.face, p, n, wo, params, &ls)) continue;
         if (ls.f.isZero() && !path) continue;
         if (effects.shadows && !PointLightVisible(ctx, p, offset, ls, stats)) continue;
         LightTerm term;
@@ -1114,8 +1114,8 @@ bool DirectAtReceiver(const Context& ctx, const PointLight& light, const Eigen::
   if (n.dot(wo) < 0.0) n = -n;
   const BsdfParams params = LookUpMaterial(ctx, ctx.material, hit.face, hit.u, hit.v).params;
   PointLightSample ls;
-  if (!SamplePointLight(ctx, light, p, n, wo, params, &ls)) return true;
-  if (!PointLightVisible(ctx, p, RayOffset(ctx, p), ls, stats)) return true;
+  if (!SamplePointLight(ctx, light, hit.face, p, n, wo, params, &ls)) return true;
+  if (!PointLightVisible(ctx, p, RayOffset(ctx, hit.face, p), ls, stats)) return true;
   *radiance = ls.f.cwiseProduct(light.intensity) * (ls.cos_i / (ls.dist * ls.dist));
   return true;
 }
@@ -1163,9 +1163,12 @@ bool CastShadowPoint(const Context& ctx, const Eigen::Vector3d& light, const Mes
   const Eigen::Vector3d point = a + s * (b - a);
   const Eigen::Vector3d d = point - light;
   const double dist = d.norm();
-  if (!(dist > kMinRelativeLightDistance * scene.extent())) return false;
+  // The edge point lies on all of the edge's faces: the largest of their scales.
+  double scale = SurfaceScale(scene, edge.f0, point);
+  if (edge.f1 >= 0) scale = std::max(scale, SurfaceScale(scene, edge.f1, point));
+  if (!(dist > kMinRelativeLightDistance * scale)) return false;
   const Eigen::Vector3d dir = d / dist;
-  const double offset = SurfaceRayOffset(scene, point);
+  const double offset = kRelativeRayOffset * scale;
   // The light must reach the edge, and the ray grazing it must land on a receiver.
   ++stats->shadow_rays;
   if (scene.Occluded(light, dir, 0.0, dist - offset)) return false;
@@ -1415,7 +1418,7 @@ void AddSecondaryEdgeSamples(const Context& ctx, const Sampler& path_sampler, in
       path_sampler.Fork(kSecondaryEdgeKey - 1).Next1D() < num_samples - count) {
     ++count;
   }
-  const double offset = RayOffset(ctx, x);
+  const double offset = RayOffset(ctx, face, x);
   const double extent = scene.extent();
   const auto& positions = scene.positions();
   // g(ω) = f·(n·ω)·L_in for the incoming radiance `l_in` along ω (0 below the horizon).
@@ -2032,8 +2035,12 @@ void RenderImpl(const RenderScene& scene, const Material& material, const ViewSe
 
 }  // namespace
 
-double SurfaceRayOffset(const RenderScene& scene, const Eigen::Vector3d& p) {
-  return kRelativeRayOffset * std::max(scene.extent(), p.cwiseAbs().maxCoeff());
+double SurfaceScale(const RenderScene& scene, int face, const Eigen::Vector3d& p) {
+  return std::max(scene.FaceScale(face), p.cwiseAbs().maxCoeff());
+}
+
+double SurfaceRayOffset(const RenderScene& scene, int face, const Eigen::Vector3d& p) {
+  return kRelativeRayOffset * SurfaceScale(scene, face, p);
 }
 
 Eigen::Vector3d CameraSampleDirection(const ViewSetup& view,

@@ -40,6 +40,26 @@ RenderScene::~RenderScene() {
   if (scene_ != nullptr) rtcReleaseScene(scene_);
 }
 
+namespace {
+
+// Embree's limit on ray origin and direction coordinates (its FLT_LARGE): larger ones make the ray
+// invalid, which Embree asserts on.
+constexpr double kMaxEmbreeCoordinate = 1.8e18;
+
+// Whether Embree accepts a ray with these (float-converted) values.
+bool ValidRay(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, float t_near, float t_far) {
+  for (int k = 0; k < 3; ++k) {
+    if (!(std::abs(origin[k]) <= kMaxEmbreeCoordinate) ||
+        !(std::abs(dir[k]) <= kMaxEmbreeCoordinate)) {
+      return false;
+    }
+  }
+  if (dir.isZero()) return false;
+  return t_near >= 0.0f && std::isfinite(t_near) && t_far >= t_near;
+}
+
+}  // namespace
+
 void RenderScene::Build() {
   RTCDevice device = EmbreeDevice();
   scene_ = rtcNewScene(device);
@@ -56,10 +76,12 @@ void RenderScene::Build() {
   // An empty mesh still gets one (degenerate, never hit) primitive: Embree wants non-empty buffers.
   index_buffer[0] = index_buffer[1] = index_buffer[2] = 0;
   vertex_buffer_[0] = vertex_buffer_[1] = vertex_buffer_[2] = 0.0f;
+  referenced_.assign(positions_.size(), 0);
   for (size_t f = 0; f < faces_.size(); ++f) {
     for (int k = 0; k < 3; ++k) {
       CHECK(faces_[f][k] >= 0 && faces_[f][k] < static_cast<int>(positions_.size()));
       index_buffer[3 * f + k] = static_cast<unsigned>(faces_[f][k]);
+      referenced_[faces_[f][k]] = 1;
     }
   }
   BuildEdges();
@@ -102,21 +124,38 @@ void RenderScene::BuildEdges() {
 void RenderScene::UpdateDerived() {
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
   Eigen::Vector3d hi = -lo;
+  bool any = false;
   for (size_t i = 0; i < positions_.size(); ++i) {
     for (int k = 0; k < 3; ++k) vertex_buffer_[3 * i + k] = static_cast<float>(positions_[i][k]);
+    if (!referenced_[i]) continue;
     lo = lo.cwiseMin(positions_[i]);
     hi = hi.cwiseMax(positions_[i]);
+    any = true;
   }
-  extent_ = positions_.empty() ? 1.0 : (hi - lo).norm();
+  if (!any) lo = hi = Eigen::Vector3d::Zero();
+  lo_ = lo;
+  hi_ = hi;
+  extent_ = (hi - lo).norm();
   if (!(extent_ > 0) || !std::isfinite(extent_)) extent_ = 1.0;
   face_normals_.resize(faces_.size());
+  face_scales_.resize(faces_.size());
   for (size_t f = 0; f < faces_.size(); ++f) {
     const Eigen::Vector3d& p0 = positions_[faces_[f][0]];
     const Eigen::Vector3d n = (positions_[faces_[f][1]] - p0).cross(positions_[faces_[f][2]] - p0);
     const double len = n.norm();
     face_normals_[f] =
         len > 0 && std::isfinite(len) ? Eigen::Vector3d(n / len) : Eigen::Vector3d::Zero();
+    double scale = 0.0;
+    for (int k = 0; k < 3; ++k) {
+      scale = std::max(scale, positions_[faces_[f][k]].cwiseAbs().maxCoeff());
+    }
+    face_scales_[f] = scale;
   }
+}
+
+void RenderScene::Bounds(Eigen::Vector3d* lo, Eigen::Vector3d* hi) const {
+  *lo = lo_;
+  *hi = hi_;
 }
 
 void RenderScene::SetVertices(const std::vector<Eigen::Vector3d>& positions) {
@@ -130,6 +169,10 @@ void RenderScene::SetVertices(const std::vector<Eigen::Vector3d>& positions) {
 
 RayHit RenderScene::Intersect(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir,
                               double t_near, double t_far) const {
+  RayHit hit;
+  const float t_near_f = static_cast<float>(t_near);
+  const float t_far_f = static_cast<float>(std::min(t_far, 3.0e38));
+  if (!ValidRay(origin, dir, t_near_f, t_far_f)) return hit;
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
   RTCRayHit rh;
@@ -139,8 +182,8 @@ RayHit RenderScene::Intersect(const Eigen::Vector3d& origin, const Eigen::Vector
   rh.ray.dir_x = static_cast<float>(dir.x());
   rh.ray.dir_y = static_cast<float>(dir.y());
   rh.ray.dir_z = static_cast<float>(dir.z());
-  rh.ray.tnear = static_cast<float>(t_near);
-  rh.ray.tfar = static_cast<float>(std::min(t_far, 3.0e38));
+  rh.ray.tnear = t_near_f;
+  rh.ray.tfar = t_far_f;
   rh.ray.time = 0.0f;
   rh.ray.mask = 0xFFFFFFFFu;
   rh.ray.id = 0;
@@ -148,7 +191,6 @@ RayHit RenderScene::Intersect(const Eigen::Vector3d& origin, const Eigen::Vector
   rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
   rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
   rtcIntersect1(scene_, &context, &rh);
-  RayHit hit;
   if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return hit;
   hit.hit = true;
   hit.t = rh.ray.tfar;
@@ -167,7 +209,7 @@ void RenderScene::Intersect8(const Eigen::Vector3d& origin, const Eigen::Vector3
   alignas(32) int valid[8];
   alignas(32) RTCRayHit8 rh;
   for (int i = 0; i < 8; ++i) {
-    valid[i] = i < count ? -1 : 0;
+    valid[i] = i < count && ValidRay(origin, dirs[i], 0.0f, 3.0e38f) ? -1 : 0;
     const Eigen::Vector3d& dir = dirs[i < count ? i : 0];
     rh.ray.org_x[i] = static_cast<float>(origin.x());
     rh.ray.org_y[i] = static_cast<float>(origin.y());
@@ -188,6 +230,7 @@ void RenderScene::Intersect8(const Eigen::Vector3d& origin, const Eigen::Vector3
   for (int i = 0; i < count; ++i) {
     RayHit& hit = hits[i];
     hit = RayHit();
+    if (!valid[i]) continue;
     if (rh.hit.geomID[i] == RTC_INVALID_GEOMETRY_ID) continue;
     hit.hit = true;
     hit.t = rh.ray.tfar[i];
@@ -199,6 +242,9 @@ void RenderScene::Intersect8(const Eigen::Vector3d& origin, const Eigen::Vector3
 
 bool RenderScene::Occluded(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, double t_near,
                            double t_far) const {
+  const float t_near_f = static_cast<float>(t_near);
+  const float t_far_f = static_cast<float>(std::min(t_far, 3.0e38));
+  if (!ValidRay(origin, dir, t_near_f, t_far_f)) return false;
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
   RTCRay ray;
@@ -208,8 +254,8 @@ bool RenderScene::Occluded(const Eigen::Vector3d& origin, const Eigen::Vector3d&
   ray.dir_x = static_cast<float>(dir.x());
   ray.dir_y = static_cast<float>(dir.y());
   ray.dir_z = static_cast<float>(dir.z());
-  ray.tnear = static_cast<float>(t_near);
-  ray.tfar = static_cast<float>(std::min(t_far, 3.0e38));
+  ray.tnear = t_near_f;
+  ray.tfar = t_far_f;
   ray.time = 0.0f;
   ray.mask = 0xFFFFFFFFu;
   ray.id = 0;

@@ -46,6 +46,9 @@ class RenderScene {
   // Moves the vertices (same count) and refits the BVH.
   void SetVertices(const std::vector<Eigen::Vector3d>& positions);
 
+  // Ray queries. A ray Embree cannot take (non-finite or out-of-range origin or direction — Embree
+  // rejects coordinates beyond ~1.8e18 —, a t_near that is negative or not finite, t_far < t_near)
+  // is never passed to Embree: it hits nothing and is not occluded.
   RayHit Intersect(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, double t_near,
                    double t_far) const;
   // Up to 8 rays from a common origin (camera rays) as one Embree packet (rtcIntersect8); lanes
@@ -66,8 +69,16 @@ class RenderScene {
   // Unique edges (topology only, fixed by construction); edges of faces with repeated vertex
   // indices are left out (they have no length).
   const std::vector<MeshEdge>& edges() const { return edges_; }
-  // Length of the bounding box diagonal, for scale-relative ray offsets.
+  // Length of the bounding-box diagonal of the referenced vertices (those of some face: vertices
+  // no face uses are not part of the surface and change nothing), for scale-relative tolerances.
   double extent() const { return extent_; }
+  // Bounds of the referenced vertices (both zero when there are none).
+  void Bounds(Eigen::Vector3d* lo, Eigen::Vector3d* hi) const;
+  bool IsReferenced(int vertex) const { return referenced_[vertex] != 0; }
+  // max_k |p_k|∞ over the face's corners: the magnitude that float rounding of the face (Embree
+  // traces a float copy, and translates it to the ray origin) is relative to. Local ray offsets
+  // and distance thresholds scale with it, so far-away faces do not change those of the others.
+  double FaceScale(int face) const { return face_scales_[face]; }
   RTCScene embree_scene() const { return scene_; }
 
  private:
@@ -78,6 +89,9 @@ class RenderScene {
   std::vector<Eigen::Vector3d> positions_;
   std::vector<Eigen::Vector3i> faces_;
   std::vector<Eigen::Vector3d> face_normals_;
+  std::vector<double> face_scales_;
+  std::vector<char> referenced_;
+  Eigen::Vector3d lo_ = Eigen::Vector3d::Zero(), hi_ = Eigen::Vector3d::Zero();
   std::vector<MeshEdge> edges_;
   double extent_ = 1.0;
   RTCScene scene_ = nullptr;
