@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 #include <mutex>
+#include <tuple>
 
 namespace sft {
 
@@ -84,6 +85,7 @@ void RenderScene::Build() {
       referenced_[faces_[f][k]] = 1;
     }
   }
+  Weld();
   BuildEdges();
   UpdateDerived();
   rtcCommitGeometry(geometry_);
@@ -92,31 +94,107 @@ void RenderScene::Build() {
   rtcCommitScene(scene_);
 }
 
+void RenderScene::Weld() {
+  welded_.resize(positions_.size());
+  std::vector<int> order;
+  for (size_t v = 0; v < positions_.size(); ++v) {
+    welded_[v] = static_cast<int>(v);
+    if (referenced_[v] && positions_[v].allFinite()) order.push_back(static_cast<int>(v));
+  }
+  // Sorted by coordinates, then index: runs of equal coordinates start at their smallest index.
+  auto less = [this](int a, int b) {
+    const Eigen::Vector3d &p = positions_[a], &q = positions_[b];
+    if (p.x() != q.x()) return p.x() < q.x();
+    if (p.y() != q.y()) return p.y() < q.y();
+    if (p.z() != q.z()) return p.z() < q.z();
+    return a < b;
+  };
+  std::sort(order.begin(), order.end(), less);
+  for (size_t i = 1; i < order.size(); ++i) {
+    if (positions_[order[i]] == positions_[order[i - 1]]) welded_[order[i]] = welded_[order[i - 1]];
+  }
+}
+
+namespace {
+
+// A face's traversal of a welded edge: welded ends (v0 < v1), the face, the direction (+1: from
+// v0 to v1 in the face's winding) and the face's own vertices at v0 and v1.
+struct HalfEdge {
+  int v0, v1, face, direction, copy0, copy1;
+  bool operator<(const HalfEdge& o) const {
+    return std::tie(v0, v1, face) < std::tie(o.v0, o.v1, o.face);
+  }
+};
+
+// Copies of the faces' own vertices with weight `share` each, merged per vertex. At most
+// kMaxEdgeCopies distinct copies per end are kept (renormalized): only edges shared by that many
+// faces that all use different copies — pathological non-manifold input — lose exactness.
+constexpr int kMaxEdgeCopies = 8;
+int AddCopies(const std::vector<int>& vertices, std::vector<EdgeCopy>* out) {
+  const size_t first = out->size();
+  for (const int v : vertices) {
+    bool merged = false;
+    for (size_t i = first; i < out->size() && !merged; ++i) {
+      if ((*out)[i].vertex == v) {
+        (*out)[i].weight += 1.0;
+        merged = true;
+      }
+    }
+    if (!merged && out->size() - first < kMaxEdgeCopies) out->push_back({v, 1.0});
+  }
+  double total = 0.0;
+  for (size_t i = first; i < out->size(); ++i) total += (*out)[i].weight;
+  for (size_t i = first; i < out->size(); ++i) (*out)[i].weight /= total;
+  return static_cast<int>(out->size() - first);
+}
+
+}  // namespace
+
 void RenderScene::BuildEdges() {
-  // (v0, v1, face) triples sorted by edge, then grouped.
-  std::vector<std::array<int, 3>> half_edges;
+  std::vector<HalfEdge> half_edges;
   half_edges.reserve(3 * faces_.size());
   for (size_t f = 0; f < faces_.size(); ++f) {
     for (int k = 0; k < 3; ++k) {
       const int a = faces_[f][k], b = faces_[f][(k + 1) % 3];
-      if (a == b) continue;
-      half_edges.push_back({std::min(a, b), std::max(a, b), static_cast<int>(f)});
+      const int wa = welded_[a], wb = welded_[b];
+      if (wa == wb) continue;
+      if (wa < wb) {
+        half_edges.push_back({wa, wb, static_cast<int>(f), 1, a, b});
+      } else {
+        half_edges.push_back({wb, wa, static_cast<int>(f), -1, b, a});
+      }
     }
   }
   std::sort(half_edges.begin(), half_edges.end());
   edges_.clear();
+  edge_copies_.clear();
+  std::vector<int> copies0, copies1;
   for (size_t i = 0; i < half_edges.size();) {
     MeshEdge edge;
-    edge.v0 = half_edges[i][0];
-    edge.v1 = half_edges[i][1];
-    for (; i < half_edges.size() && half_edges[i][0] == edge.v0 && half_edges[i][1] == edge.v1;
+    edge.v0 = half_edges[i].v0;
+    edge.v1 = half_edges[i].v1;
+    int direction0 = 0;
+    copies0.clear();
+    copies1.clear();
+    for (; i < half_edges.size() && half_edges[i].v0 == edge.v0 && half_edges[i].v1 == edge.v1;
          ++i) {
-      const int face = half_edges[i][2];
-      if (edge.num_faces > 0 && face == edge.f0) continue;  // a face listing the edge twice.
-      if (edge.num_faces == 0) edge.f0 = face;
-      if (edge.num_faces == 1) edge.f1 = face;
+      const HalfEdge& h = half_edges[i];
+      if (edge.num_faces > 0 && h.face == half_edges[i - 1].face) continue;  // listed twice.
+      if (edge.num_faces == 0) {
+        edge.f0 = h.face;
+        direction0 = h.direction;
+      }
+      if (edge.num_faces == 1) {
+        edge.f1 = h.face;
+        edge.flip1 = h.direction != direction0 ? 1 : -1;
+      }
       ++edge.num_faces;
+      copies0.push_back(h.copy0);
+      copies1.push_back(h.copy1);
     }
+    edge.first_copy = static_cast<int>(edge_copies_.size());
+    edge.num_copies0 = AddCopies(copies0, &edge_copies_);
+    edge.num_copies1 = AddCopies(copies1, &edge_copies_);
     edges_.push_back(edge);
   }
 }
