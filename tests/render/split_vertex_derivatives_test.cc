@@ -5,9 +5,11 @@
 // the same: edges are built between welded positions and classified with face normals oriented
 // across each edge, not by the faces' winding. Each case is compared with central finite
 // differences along a smooth displacement field (a function of position, so copies move together)
-// on 8×8 block sums and the image sum, at the 5% of the other finite-difference tests
-// (vertex_derivatives_test.cc); the errors printed are ~1–3% (noise of the finite difference and of
-// edge sampling at 256 spp), while double-counted seams gave 20–80%.
+// on 8×8 block sums and the image sum. Tolerances: the welded sphere agrees at 0.4% (blocks) and
+// 0.1% (sum) at 256 spp, so the sphere cases allow 2%; the Möbius strip (1.1% / 0.2%, more of it
+// seen edge-on) the 5% of the other finite-difference tests. With each split copy's edges sampled
+// as boundaries of their own, the errors were: soup 26% / 33%, flipped faces as read from an OBJ
+// 23% / 30%, position seam 3.0% / 2.1%, Möbius soup 18% / 23%.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -35,9 +37,9 @@ constexpr double kStep = 1e-2;
 
 // A 64² view of `mesh` from `eye` towards the origin, a point light beside the camera, Lambert
 // albedo 0.6, direct light with shadows, 256 spp; compares the vertex derivative along a smooth
-// field with finite differences and expects 5% on blocks and on the sum.
+// field with finite differences and expects `tolerance` on blocks and on the sum.
 void ExpectMatchesFiniteDifferences(const Triangles& mesh, const Eigen::Vector3d& eye,
-                                    const char* name) {
+                                    const char* name, double tolerance = 0.02) {
   ViewSetup view = testing::LookAtView(eye, Eigen::Vector3d::Zero(), 64, OrbitFocal(64, 40.0));
   testing::AddPointLight(eye + Eigen::Vector3d(0.6, 0.3, 0.8), 10.0, &view);
   const Material material = ConstantMaterial(static_cast<int>(mesh.faces.size()),
@@ -53,8 +55,8 @@ void ExpectMatchesFiniteDifferences(const Triangles& mesh, const Eigen::Vector3d
   const testing::Comparison c = testing::CompareWithFiniteDifferences(
       mesh, delta, kStep * scene.extent(), material, view, options, name);
   EXPECT_TRUE(c.finite) << name;
-  EXPECT_LT(c.block_error, 0.05) << name;
-  EXPECT_LT(c.sum_error, 0.05) << name;
+  EXPECT_LT(c.block_error, tolerance) << name;
+  EXPECT_LT(c.sum_error, tolerance) << name;
   EXPECT_LT(c.adjoint_mismatch, 1e-4) << name;
 }
 
@@ -157,8 +159,8 @@ Triangles MobiusStrip() {
 
 TEST(SplitVertexDerivativesTest, MobiusStrip) {
   const Eigen::Vector3d eye(0.5, -2.4, 1.8);
-  ExpectMatchesFiniteDifferences(MobiusStrip(), eye, "Möbius strip, shared vertices");
-  ExpectMatchesFiniteDifferences(testing::Soup(MobiusStrip()), eye, "Möbius strip, soup");
+  ExpectMatchesFiniteDifferences(MobiusStrip(), eye, "Möbius strip, shared vertices", 0.05);
+  ExpectMatchesFiniteDifferences(testing::Soup(MobiusStrip()), eye, "Möbius strip, soup", 0.05);
 }
 
 // The welded edge table itself: a soup's edges are those of the welded mesh, each end shared half
