@@ -1954,6 +1954,9 @@ void AddEdgeTerms(const Context& ctx, std::vector<DerivativeList>* pixel_lists,
   }
 }
 
+// Camera samples are traced in fixed kTile × kTile pixel tiles (RenderImpl).
+constexpr int kTile = 8;
+
 void RenderImpl(const RenderScene& scene, const Material& material, const ViewSetup& view,
                 const RenderOptions& options, const DerivativeRequest* request,
                 const ParameterLayout* layout, Image* image, DerivativeOutput* output,
@@ -1994,7 +1997,6 @@ void RenderImpl(const RenderScene& scene, const Material& material, const ViewSe
   // Fixed 8×8 tiles; each tile row is one packet of camera rays per sample. The packet
   // composition depends only on the image size, never on scheduling, so images (and
   // derivatives, reduced in tile order) stay bit-identical for any thread count.
-  constexpr int kTile = 8;
   const int tiles_x = (width + kTile - 1) / kTile;
   const int tiles_y = (height + kTile - 1) / kTile;
   const int num_tiles = tiles_x * tiles_y;
@@ -2069,6 +2071,7 @@ void RenderImpl(const RenderScene& scene, const Material& material, const ViewSe
         if (want_rows) pixel_rows[static_cast<size_t>(y) * width + x] = merged;
       }
     }
+    if (options.on_tile_done) options.on_tile_done();
   };
   tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
   arena.execute([&] { tbb::parallel_for(0, num_tiles, render_tile); });
@@ -2110,6 +2113,10 @@ void RenderImpl(const RenderScene& scene, const Material& material, const ViewSe
 }
 
 }  // namespace
+
+int64_t RenderTileCount(int width, int height) {
+  return static_cast<int64_t>((width + kTile - 1) / kTile) * ((height + kTile - 1) / kTile);
+}
 
 double SurfaceScale(const RenderScene& scene, int face, const Eigen::Vector3d& p) {
   return std::max(scene.FaceScale(face), p.cwiseAbs().maxCoeff());

@@ -8,6 +8,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -54,9 +55,17 @@ struct RenderOptions {
   // materials then follow identical paths, as finite differences and linearizations need. Must
   // have the rendered material's mesh-colors layout.
   const Material* sampling_material = nullptr;
+  // Called once per finished tile of camera samples (RenderTileCount per view), from the worker
+  // threads (so it must be thread-safe), e.g. to advance a progress line within a long view. It
+  // does not change the image.
+  std::function<void()> on_tile_done;
 
   bool Check(std::string* why) const;
 };
+
+// Number of tiles (fixed 8×8 pixel blocks) of a width × height render: the units of
+// RenderOptions::on_tile_done.
+int64_t RenderTileCount(int width, int height);
 
 struct PointLight {
   Eigen::Vector3d position;   // world frame.
