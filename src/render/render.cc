@@ -1247,9 +1247,12 @@ bool CastShadowPoint(const Context& ctx, const Eigen::Vector3d& light, const Mes
   if (!(dist > kMinRelativeLightDistance * scale)) return false;
   const Eigen::Vector3d dir = d / dist;
   const double offset = kRelativeRayOffset * scale;
-  // The light must reach the edge, and the ray grazing it must land on a receiver.
+  // The light must reach the edge, and the ray grazing it must land on a receiver. A hit on the
+  // edge's own faces before the edge point is float noise of the grazing ray (a plane containing
+  // the point cannot be crossed on the way to it).
   ++stats->shadow_rays;
-  if (scene.Occluded(light, dir, 0.0, dist - offset)) return false;
+  const RayHit blocker = scene.Intersect(light, dir, 0.0, dist - offset);
+  if (blocker.hit && blocker.face != edge.f0 && blocker.face != edge.f1) return false;
   ++stats->shadow_rays;
   const RayHit hit = scene.Intersect(point, dir, offset, kInfinity);
   if (!hit.hit || hit.face == edge.f0 || hit.face == edge.f1) return false;
