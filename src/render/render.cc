@@ -1903,8 +1903,7 @@ void AddEdgeTerms(const Context& ctx, std::vector<DerivativeList>* pixel_lists,
       const Eigen::Vector2d q1 = camera.ImageFromCam(a_cam + s1 * (b_cam - a_cam));
       const double weight = (q1 - q0).norm() * segment.size;
       if (!(weight > 0.0) || !std::isfinite(weight)) return;
-      candidates.push_back(
-          {face, segment.other, b0, b1, segment.c0, segment.c1, s0, s1, weight});
+      candidates.push_back({face, segment.other, b0, b1, segment.c0, segment.c1, s0, s1, weight});
     };
     for (const TexelSegment& segment : TexelSegments(scene, material, glossy)) {
       // A coplanar edge seen edge-on from the camera is a primary edge there.

@@ -48,7 +48,8 @@ namespace {
 constexpr double kMaxEmbreeCoordinate = 1.8e18;
 
 // Whether Embree accepts a ray with these (float-converted) values.
-bool ValidRay(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, float t_near, float t_far) {
+bool ValidRay(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, float t_near,
+              float t_far) {
   for (int k = 0; k < 3; ++k) {
     if (!(std::abs(origin[k]) <= kMaxEmbreeCoordinate) ||
         !(std::abs(dir[k]) <= kMaxEmbreeCoordinate)) {

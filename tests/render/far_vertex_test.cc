@@ -33,8 +33,8 @@ Triangles SphereOnGround() {
 }
 
 Image Render(const Triangles& mesh) {
-  ViewSetup view = testing::LookAtView(Eigen::Vector3d(0.5, -3.5, 3.0),
-                                       Eigen::Vector3d(0, 0, -0.6), 48, OrbitFocal(48, 40.0));
+  ViewSetup view = testing::LookAtView(Eigen::Vector3d(0.5, -3.5, 3.0), Eigen::Vector3d(0, 0, -0.6),
+                                       48, OrbitFocal(48, 40.0));
   testing::AddPointLight(Eigen::Vector3d(1.5, -1.0, 3.0), 20.0, &view);
   const Material material = ConstantMaterial(static_cast<int>(mesh.faces.size()),
                                              Eigen::Vector3d(0.7, 0.6, 0.5), 0.4, 0.2);
@@ -106,10 +106,10 @@ TEST(FarVertexTest, FarReferencedTrianglesLeaveTheRestUnchanged) {
   sliver.faces.emplace_back(s, s + 1, s + 2);
   Triangles huge = scene;
   const int h = static_cast<int>(huge.positions.size());
-  huge.positions.insert(huge.positions.end(),
-                        {{-1e5, 1e5, -1e5}, {1e5, 1e5, -1e5}, {0, 1e5, 1e5}});
+  huge.positions.insert(huge.positions.end(), {{-1e5, 1e5, -1e5}, {1e5, 1e5, -1e5}, {0, 1e5, 1e5}});
   huge.faces.emplace_back(h, h + 1, h + 2);
-  for (const auto& [name, mesh] : {std::make_pair("sliver", sliver), std::make_pair("huge", huge)}) {
+  for (const auto& [name, mesh] :
+       {std::make_pair("sliver", sliver), std::make_pair("huge", huge)}) {
     const Image image = Render(mesh);
     bool finite = false;
     EXPECT_EQ(DifferentPixels(image, base, 1e-4, 1e-6, &finite), 0) << name;

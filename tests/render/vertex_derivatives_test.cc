@@ -46,8 +46,8 @@ using testing::LookAtView;
 
 using Geometry = testing::Triangles;
 using testing::CentralDifference;
-using testing::Comparison;
 using testing::CompareWithFiniteDifferences;
+using testing::Comparison;
 using testing::Sum;
 
 Geometry FromMesh(const std::string& file) { return testing::ReadTestMesh(file); }
@@ -99,7 +99,6 @@ Material Lambert(const Geometry& g, double albedo) {
   return ConstantMaterial(static_cast<int>(g.faces.size()), Eigen::Vector3d::Constant(albedo), 0.5,
                           0.0);
 }
-
 
 // ---------------------------------------------------------------------------------------------
 // (a) Silhouette of a sphere: analytic derivative of the projected area.

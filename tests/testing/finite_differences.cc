@@ -25,8 +25,8 @@ std::vector<double> RowsTimes(const DerivativeOutput& out, const std::vector<dou
   return image;
 }
 
-std::vector<double> CentralDifference(const Triangles& g, const std::vector<double>& delta, double h,
-                                      const Material& material, const ViewSetup& view,
+std::vector<double> CentralDifference(const Triangles& g, const std::vector<double>& delta,
+                                      double h, const Material& material, const ViewSetup& view,
                                       const RenderOptions& options) {
   Image image[2];
   for (int s = 0; s < 2; ++s) {
