@@ -208,7 +208,13 @@ Status RunRender(const RenderCommandOptions& opts) {
   if (!selection.ok()) return Status::Error("--" + selection.message());
   const std::vector<std::string> out_paths = ViewOutputPaths(dataset, ".exr");
   const RenderScene scene(mesh);
-  Progress progress("render", static_cast<int64_t>(selected.size()), !opts.quiet);
+  // Progress in tiles of camera samples, so that the line advances within a long view.
+  int64_t total_tiles = 0;
+  for (int v : selected) {
+    total_tiles += RenderTileCount(views.views[v].camera.width, views.views[v].camera.height);
+  }
+  Progress progress("render (tiles)", total_tiles, !opts.quiet);
+  render.on_tile_done = [&progress] { progress.Advance(); };
   nlohmann::json report;
   report["dataset"] = opts.dataset;
   report["mesh"] = opts.mesh;
@@ -261,7 +267,6 @@ Status RunRender(const RenderCommandOptions& opts) {
       rows.push_back(std::move(row));
     }
     per_view.push_back(std::move(entry));
-    progress.Advance();
   }
   progress.Finish();
   report["views"] = per_view;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <random>
 
@@ -142,13 +143,21 @@ Status WriteGradcheckImages(const std::string& dir, int view, int width, int hei
 }  // namespace
 
 std::vector<double> SmoothDisplacementField(const std::vector<Eigen::Vector3d>& positions,
-                                            uint64_t seed) {
+                                            uint64_t seed,
+                                            const std::vector<Eigen::Vector3i>* faces) {
   std::vector<double> delta(3 * positions.size(), 0.0);
   if (positions.empty()) return delta;
-  Eigen::Vector3d lo = positions[0], hi = positions[0];
-  for (const Eigen::Vector3d& p : positions) {
-    lo = lo.cwiseMin(p);
-    hi = hi.cwiseMax(p);
+  // The vertices the field is for (all without `faces`; unreferenced ones keep δ = 0).
+  std::vector<char> used(positions.size(), faces == nullptr ? 1 : 0);
+  if (faces != nullptr) {
+    for (const Eigen::Vector3i& f : *faces) used[f[0]] = used[f[1]] = used[f[2]] = 1;
+  }
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector3d hi = -lo;
+  for (size_t v = 0; v < positions.size(); ++v) {
+    if (!used[v]) continue;
+    lo = lo.cwiseMin(positions[v]);
+    hi = hi.cwiseMax(positions[v]);
   }
   const Eigen::Vector3d centre = 0.5 * (lo + hi);
   const double extent = (hi - lo).norm();
@@ -168,6 +177,7 @@ std::vector<double> SmoothDisplacementField(const std::vector<Eigen::Vector3d>& 
   }
   double max_norm = 0.0;
   for (size_t v = 0; v < positions.size(); ++v) {
+    if (!used[v]) continue;
     const Eigen::Vector3d q = (positions[v] - centre) / extent;
     Eigen::Vector3d d = Eigen::Vector3d::Zero();
     for (int m = 0; m < kModes; ++m)
@@ -227,7 +237,7 @@ Status RunGradcheck(const Dataset& dataset, const TriMesh& mesh, const Material&
   std::vector<double> delta(layout.size(), 0.0);
   if (vertices) {
     const std::vector<double> field =
-        SmoothDisplacementField(scene.positions(), options.direction_seed);
+        SmoothDisplacementField(scene.positions(), options.direction_seed, &scene.faces());
     std::copy(field.begin(), field.end(), delta.begin() + layout.VertexOffset());
   } else {
     for (int i = 0; i < layout.size(); ++i) {

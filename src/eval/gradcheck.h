@@ -117,9 +117,11 @@ Status RunGradcheck(const Dataset& dataset, const TriMesh& mesh, const Material&
 
 // The displacement field of a vertex gradcheck (see the file comment): 3·positions.size()
 // values, vertex v coordinate k at 3v + k, with max_v |δ(v)| = 1 (all zero when every position
-// is the same point). Deterministic in `seed`.
+// is the same point). Deterministic in `seed`. With `faces`, the field's frame (centre, size) is
+// that of the vertices the faces use, so unreferenced vertices do not stretch it.
 std::vector<double> SmoothDisplacementField(const std::vector<Eigen::Vector3d>& positions,
-                                            uint64_t seed);
+                                            uint64_t seed,
+                                            const std::vector<Eigen::Vector3i>* faces = nullptr);
 
 }  // namespace sft
 

@@ -206,13 +206,8 @@ double ThroughputReport::TwoBouncesRaysPerSecond() const {
 }
 
 ViewSetup ThroughputView(const RenderScene& scene, int resolution) {
-  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
-  Eigen::Vector3d hi = -lo;
-  for (const Eigen::Vector3d& p : scene.positions()) {
-    lo = lo.cwiseMin(p);
-    hi = hi.cwiseMax(p);
-  }
-  if (scene.positions().empty()) lo = hi = Eigen::Vector3d::Zero();
+  Eigen::Vector3d lo, hi;
+  scene.Bounds(&lo, &hi);  // of the referenced vertices.
   const Eigen::Vector3d target = 0.5 * (lo + hi);
   const double radius = 0.5 * scene.extent();  // bounding sphere of the box.
 
@@ -235,7 +230,9 @@ ViewSetup ThroughputView(const RenderScene& scene, int resolution) {
   auto span_at = [&](double distance) {
     Eigen::Vector2d min_xy = Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity());
     Eigen::Vector2d max_xy = -min_xy;
-    for (const Eigen::Vector3d& p : scene.positions()) {
+    for (size_t v = 0; v < scene.positions().size(); ++v) {
+      if (!scene.IsReferenced(static_cast<int>(v))) continue;
+      const Eigen::Vector3d& p = scene.positions()[v];
       const Eigen::Vector3d q =
           cam_from_world_rotation * (p - target) + Eigen::Vector3d(0, 0, distance);
       if (!(q.z() > 0.0)) return std::numeric_limits<double>::infinity();
@@ -243,7 +240,7 @@ ViewSetup ThroughputView(const RenderScene& scene, int resolution) {
       min_xy = min_xy.cwiseMin(xy);
       max_xy = max_xy.cwiseMax(xy);
     }
-    return scene.positions().empty() ? 0.0 : (max_xy - min_xy).maxCoeff();
+    return max_xy.x() >= min_xy.x() ? (max_xy - min_xy).maxCoeff() : 0.0;
   };
   double near = 1.001 * radius, far = 1e4 * radius;
   for (int i = 0; i < 60; ++i) {
@@ -296,7 +293,6 @@ std::vector<BenchRay> ShadowRays(const RenderScene& scene, const ViewSetup& view
   std::vector<BenchRay> slots(num_camera * num_lights);
   std::vector<char> used(slots.size(), 0);
   const CameraFrame frame(view);
-  const double min_dist = kMinRelativeLightDistance * scene.extent();
   tbb::task_arena arena(ArenaConcurrency(threads));
   arena.execute([&] {
     tbb::parallel_for(tbb::blocked_range<int>(0, height), [&](const tbb::blocked_range<int>& rows) {
@@ -315,7 +311,8 @@ std::vector<BenchRay> ShadowRays(const RenderScene& scene, const ViewSetup& view
             Eigen::Vector3d n = scene.FaceNormal(hit.face);
             if (n.isZero()) continue;
             if (n.dot(-dir) < 0.0) n = -n;
-            const double offset = SurfaceRayOffset(scene, p);
+            const double offset = SurfaceRayOffset(scene, hit.face, p);
+            const double min_dist = kMinRelativeLightDistance * SurfaceScale(scene, hit.face, p);
             const Eigen::Vector3d p_off = p + offset * n;
             for (size_t l = 0; l < num_lights; ++l) {
               const Eigen::Vector3d to_light = view.point_lights[l].position - p;

@@ -1113,13 +1113,16 @@ std::vector<Eigen::Vector2d> FaceCornerUvs(const TriMesh& mesh) {
 void MeshBounds(const TriMesh& mesh, Eigen::Vector3d* lo, Eigen::Vector3d* hi) {
   Eigen::Vector3d l = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
   Eigen::Vector3d h = -l;
-  for (size_t i = 0; i < mesh.n_vertices(); ++i) {
-    const TriMesh::Point& p = mesh.point(TriMesh::VertexHandle(static_cast<int>(i)));
+  bool any = false;
+  for (TriMesh::VertexHandle vh : mesh.vertices()) {
+    if (mesh.is_isolated(vh)) continue;
+    const TriMesh::Point& p = mesh.point(vh);
     const Eigen::Vector3d q(p[0], p[1], p[2]);
     l = l.cwiseMin(q);
     h = h.cwiseMax(q);
+    any = true;
   }
-  if (mesh.n_vertices() == 0) l = h = Eigen::Vector3d::Zero();
+  if (!any) l = h = Eigen::Vector3d::Zero();
   if (lo != nullptr) *lo = l;
   if (hi != nullptr) *hi = h;
 }

@@ -46,7 +46,9 @@ void MeshToArrays(const TriMesh& mesh, std::vector<Eigen::Vector3d>* positions,
 // Per-face corner UVs (3 per face, corner order = face vertex order); empty when the mesh has none.
 std::vector<Eigen::Vector2d> FaceCornerUvs(const TriMesh& mesh);
 
-// Axis-aligned bounds of the vertices.
+// Axis-aligned bounds of the vertices that some face uses (isolated vertices are not part of the
+// surface: a stray far-away `v` line must not move a normalization or a camera); both zero when
+// there are none.
 void MeshBounds(const TriMesh& mesh, Eigen::Vector3d* lo, Eigen::Vector3d* hi);
 
 }  // namespace sft

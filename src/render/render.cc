@@ -67,8 +67,8 @@ SurfaceMaterial LookUpMaterial(const Context& ctx, const Material& material, int
   return m;
 }
 
-double RayOffset(const Context& ctx, const Eigen::Vector3d& p) {
-  return SurfaceRayOffset(ctx.scene, p);
+double RayOffset(const Context& ctx, int face, const Eigen::Vector3d& p) {
+  return SurfaceRayOffset(ctx.scene, face, p);
 }
 
 // Direction, distance, cosine and BSDF value of a point light seen from the shading point p
@@ -82,12 +82,12 @@ struct PointLightSample {
 
 // False when the light is below the surface or closer than kMinRelativeLightDistance (the
 // contribution is then zero).
-bool SamplePointLight(const Context& ctx, const PointLight& light, const Eigen::Vector3d& p,
-                      const Eigen::Vector3d& n, const Eigen::Vector3d& wo, const BsdfParams& params,
-                      PointLightSample* sample) {
+bool SamplePointLight(const Context& ctx, const PointLight& light, int face,
+                      const Eigen::Vector3d& p, const Eigen::Vector3d& n, const Eigen::Vector3d& wo,
+                      const BsdfParams& params, PointLightSample* sample) {
   const Eigen::Vector3d to_light = light.position - p;
   const double dist2 = to_light.squaredNorm();
-  const double min_dist = kMinRelativeLightDistance * ctx.scene.extent();
+  const double min_dist = kMinRelativeLightDistance * SurfaceScale(ctx.scene, face, p);
   if (!(dist2 > min_dist * min_dist)) return false;
   sample->dist = std::sqrt(dist2);
   sample->wi = to_light / sample->dist;
@@ -409,7 +409,7 @@ Eigen::Vector3d TraceRadiance(const Context& ctx, Sampler* sampler, Eigen::Vecto
     const BsdfParams sampling =
         detached ? LookUpMaterial(ctx, ctx.sampling_material, hit.face, hit.u, hit.v).params
                  : params;
-    const double offset = RayOffset(ctx, p);
+    const double offset = RayOffset(ctx, hit.face, p);
     const Eigen::Vector3d p_off = p + offset * n;
     const bool lit_here = depth > 0 || effects.direct;
 
@@ -423,7 +423,7 @@ Eigen::Vector3d TraceRadiance(const Context& ctx, Sampler* sampler, Eigen::Vecto
     if (lit_here) {
       for (const PointLight& light : ctx.view.point_lights) {
         PointLightSample ls;
-        if (!SamplePointLight(ctx, light, p, n, wo, params, &ls)) continue;
+        if (!SamplePointLight(ctx, light, hit.face, p, n, wo, params, &ls)) continue;
         if (ls.f.isZero() && !path) continue;
         if (effects.shadows && !PointLightVisible(ctx, p, offset, ls, stats)) continue;
         LightTerm term;
@@ -671,6 +671,7 @@ struct EdgeCandidate {
 struct TexelCandidate {
   int face, other;
   Eigen::Vector3d b0, b1;
+  Eigen::Vector3d c0, c1;  // the same points as barycentrics of `other`.
   double s0, s1;
   double weight;
 };
@@ -785,13 +786,24 @@ bool ClipSegment(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Frust
          clip(f.v_max * a.z() - a.y(), f.v_max * b.z() - b.y()) && *s1 - *s0 > 0.0;
 }
 
+// The unit normals of a manifold edge's faces, f1's oriented consistently with f0's across the
+// edge (MeshEdge::flip1), so that the classification below does not depend on face winding: two
+// coplanar faces are coplanar whichever way each is wound.
+void ConsistentEdgeNormals(const RenderScene& scene, const MeshEdge& edge, Eigen::Vector3d* n0,
+                           Eigen::Vector3d* n1) {
+  *n0 = scene.FaceNormal(edge.f0);
+  *n1 = edge.flip1 * scene.FaceNormal(edge.f1);
+}
+
 // Whether flat-shaded radiance can jump across the edge as seen from `eye`: boundary,
-// non-manifold or degenerate-neighbour edges always; else silhouettes w.r.t. eye and (when
-// `creases`) edges between faces that are not coplanar.
+// non-manifold or degenerate-neighbour edges always; else silhouettes w.r.t. eye (the two faces,
+// consistently oriented, face opposite ways) and (when `creases`) edges between faces that are
+// not coplanar.
 bool IsDiscontinuityEdge(const RenderScene& scene, const MeshEdge& edge, const Eigen::Vector3d& eye,
                          bool creases) {
   if (edge.num_faces != 2) return true;
-  const Eigen::Vector3d n0 = scene.FaceNormal(edge.f0), n1 = scene.FaceNormal(edge.f1);
+  Eigen::Vector3d n0, n1;
+  ConsistentEdgeNormals(scene, edge, &n0, &n1);
   if (n0.isZero() || n1.isZero()) return true;
   const Eigen::Vector3d to_eye = eye - scene.positions()[edge.v0];
   if ((n0.dot(to_eye) > 0.0) != (n1.dot(to_eye) > 0.0)) return true;
@@ -818,7 +830,8 @@ void SideDirections(const Context& ctx, const Eigen::Matrix3d& world_from_cam_ro
 double PrimaryEdgeImportance(const RenderScene& scene, const MeshEdge& edge,
                              const Eigen::Vector3d& eye) {
   if (edge.num_faces != 2) return 1.0;
-  const Eigen::Vector3d n0 = scene.FaceNormal(edge.f0), n1 = scene.FaceNormal(edge.f1);
+  Eigen::Vector3d n0, n1;
+  ConsistentEdgeNormals(scene, edge, &n0, &n1);
   if (n0.isZero() || n1.isZero()) return 1.0;
   const Eigen::Vector3d to_eye = eye - scene.positions()[edge.v0];
   if ((n0.dot(to_eye) > 0.0) != (n1.dot(to_eye) > 0.0)) return 1.0;
@@ -871,7 +884,10 @@ bool EdgeFaceHit(const RenderScene& scene, const MeshEdge& edge, const Eigen::Ve
     if (face < 0) continue;
     const Eigen::Vector3i& corners = scene.faces()[face];
     int third = 0;
-    while (third < 2 && (corners[third] == edge.v0 || corners[third] == edge.v1)) ++third;
+    while (third < 2 && (scene.WeldedVertex(corners[third]) == edge.v0 ||
+                         scene.WeldedVertex(corners[third]) == edge.v1)) {
+      ++third;
+    }
     if (edge_plane.dot(positions[corners[third]] - center) * ray_side <= 0.0) continue;
     const Eigen::Vector3d n = scene.FaceNormal(face);
     const double t = n.dot(a - center) / n.dot(dir);
@@ -1002,12 +1018,69 @@ double MaterialJump(const Material& material, bool glossy, int face_a, const Eig
 // A texel boundary segment in 3D: the points Σ_k b_k(s)·p_k, b(s) = b0 + s·(b1 − b0), s ∈ [0, 1],
 // of face `face` (corners p_k), separating texels whose material differs by `size`
 // (MaterialJump); `other` is the face across it (`face` itself for a grid line inside the face,
-// the neighbour for mesh edge `edge` between coplanar faces; edge −1 for grid lines).
+// the neighbour for mesh edge `edge` between coplanar faces; edge −1 for grid lines), and c0, c1
+// the ends as barycentrics of `other` (= b0, b1 for grid lines).
 struct TexelSegment {
   int face, other, edge;
   Eigen::Vector3d b0, b1;
   double size;
+  Eigen::Vector3d c0, c1;
 };
+
+// The vertices that move a boundary point y, with rows_j = (∂y/∂p_j)ᵀ·row for a row vector `row`
+// (some linear functional of y's motion). A vertex may appear more than once (the sums are what
+// count).
+struct BoundaryRows {
+  static constexpr int kCapacity = 24;  // 2 × 8 edge-end copies (scene.cc) + 3 receiver corners.
+  int count = 0;
+  int vertices[kCapacity];
+  Eigen::Vector3d rows[kCapacity];
+  void Add(int vertex, const Eigen::Vector3d& row) {
+    CHECK_LT(count, kCapacity);
+    vertices[count] = vertex;
+    rows[count++] = row;
+  }
+};
+
+// Rows of the point a + s(b − a) of welded edge `edge`: each end moves with the copies of it that
+// the edge's faces use, shared as EdgeCopy describes (one copy with weight 1 on a welded mesh).
+void AddEdgePointRows(const RenderScene& scene, const MeshEdge& edge, double s,
+                      const Eigen::Vector3d& row, BoundaryRows* out) {
+  const EdgeCopy* copies = scene.edge_copies().data() + edge.first_copy;
+  for (int i = 0; i < edge.num_copies0; ++i) {
+    out->Add(copies[i].vertex, (copies[i].weight * (1.0 - s)) * row);
+  }
+  for (int i = edge.num_copies0; i < edge.num_copies0 + edge.num_copies1; ++i) {
+    out->Add(copies[i].vertex, (copies[i].weight * s) * row);
+  }
+}
+
+// Rows of the texel-boundary point with barycentrics b on `face` and c on `other` (∂y/∂p_k =
+// b_k·I). On an edge between two coplanar faces the motion is shared half and half between each
+// face's own corners, as for mesh edges (EdgeCopy); where the faces share a vertex the halves add
+// up to b_k.
+void AddTexelPointRows(const RenderScene& scene, int face, int other, const Eigen::Vector3d& b,
+                       const Eigen::Vector3d& c, const Eigen::Vector3d& row, BoundaryRows* out) {
+  const Eigen::Vector3i& corners = scene.faces()[face];
+  if (other == face) {
+    for (int k = 0; k < 3; ++k) out->Add(corners[k], b[k] * row);
+    return;
+  }
+  const Eigen::Vector3i& other_corners = scene.faces()[other];
+  Eigen::Vector3d own = 0.5 * b, across = 0.5 * c;
+  for (int k = 0; k < 3; ++k) {
+    for (int j = 0; j < 3; ++j) {
+      if (other_corners[j] == corners[k]) {
+        own[k] += across[j];
+        across[j] = 0.0;
+      }
+    }
+  }
+  for (int k = 0; k < 3; ++k) out->Add(corners[k], own[k] * row);
+  for (int j = 0; j < 3; ++j) {
+    if (across[j] != 0.0) out->Add(other_corners[j], across[j] * row);
+  }
+}
 
 // Every texel boundary of the material on the mesh: grid lines inside faces whose texels vary
 // and edges between coplanar, equally oriented faces, each cut where other grid lines cross so
@@ -1050,8 +1123,9 @@ std::vector<TexelSegment> TexelSegments(const RenderScene& scene, const Material
           const double size = MaterialJump(material, glossy, face, ab(a - kTexelSideOffset, mid),
                                            face, ab(a + kTexelSideOffset, mid));
           if (!(size > 0.0)) continue;
-          segments.push_back({face, face, -1, barycentrics(ab(a, cuts[k])),
-                              barycentrics(ab(a, cuts[k + 1])), size});
+          const Eigen::Vector3d b0 = barycentrics(ab(a, cuts[k]));
+          const Eigen::Vector3d b1 = barycentrics(ab(a, cuts[k + 1]));
+          segments.push_back({face, face, -1, b0, b1, size, b0, b1});
         }
       }
     }
@@ -1064,7 +1138,8 @@ std::vector<TexelSegment> TexelSegments(const RenderScene& scene, const Material
   for (size_t e = 0; e < scene.edges().size(); ++e) {
     const MeshEdge& edge = scene.edges()[e];
     if (edge.num_faces != 2 || positions[edge.v0] == positions[edge.v1]) continue;
-    const Eigen::Vector3d n0 = scene.FaceNormal(edge.f0), n1 = scene.FaceNormal(edge.f1);
+    Eigen::Vector3d n0, n1;
+    ConsistentEdgeNormals(scene, edge, &n0, &n1);
     if (n0.isZero() || n1.isZero() || !(n0.dot(n1) >= 1.0 - 1e-12)) continue;
     // Per face (0: f0, 1: f1): the barycentric unit vectors of the edge's ends and of the
     // opposite corner.
@@ -1073,9 +1148,10 @@ std::vector<TexelSegment> TexelSegments(const RenderScene& scene, const Material
     for (int i = 0; i < 2; ++i) {
       const Eigen::Vector3i& corners = faces[side_faces[i]];
       for (int k = 0; k < 3; ++k) {
-        end0[i][k] = corners[k] == edge.v0 ? 1.0 : 0.0;
-        end1[i][k] = corners[k] == edge.v1 ? 1.0 : 0.0;
-        opposite[i][k] = corners[k] != edge.v0 && corners[k] != edge.v1 ? 1.0 : 0.0;
+        const int welded = scene.WeldedVertex(corners[k]);
+        end0[i][k] = welded == edge.v0 ? 1.0 : 0.0;
+        end1[i][k] = welded == edge.v1 ? 1.0 : 0.0;
+        opposite[i][k] = welded != edge.v0 && welded != edge.v1 ? 1.0 : 0.0;
       }
     }
     for (size_t k = 0; k + 1 < cuts.size(); ++k) {
@@ -1092,7 +1168,9 @@ std::vector<TexelSegment> TexelSegments(const RenderScene& scene, const Material
       if (!(size > 0.0)) continue;
       segments.push_back({edge.f0, edge.f1, static_cast<int>(e),
                           (1.0 - cuts[k]) * end0[0] + cuts[k] * end1[0],
-                          (1.0 - cuts[k + 1]) * end0[0] + cuts[k + 1] * end1[0], size});
+                          (1.0 - cuts[k + 1]) * end0[0] + cuts[k + 1] * end1[0], size,
+                          (1.0 - cuts[k]) * end0[1] + cuts[k] * end1[1],
+                          (1.0 - cuts[k + 1]) * end0[1] + cuts[k + 1] * end1[1]});
     }
   }
   return segments;
@@ -1114,8 +1192,8 @@ bool DirectAtReceiver(const Context& ctx, const PointLight& light, const Eigen::
   if (n.dot(wo) < 0.0) n = -n;
   const BsdfParams params = LookUpMaterial(ctx, ctx.material, hit.face, hit.u, hit.v).params;
   PointLightSample ls;
-  if (!SamplePointLight(ctx, light, p, n, wo, params, &ls)) return true;
-  if (!PointLightVisible(ctx, p, RayOffset(ctx, p), ls, stats)) return true;
+  if (!SamplePointLight(ctx, light, hit.face, p, n, wo, params, &ls)) return true;
+  if (!PointLightVisible(ctx, p, RayOffset(ctx, hit.face, p), ls, stats)) return true;
   *radiance = ls.f.cwiseProduct(light.intensity) * (ls.cos_i / (ls.dist * ls.dist));
   return true;
 }
@@ -1163,12 +1241,18 @@ bool CastShadowPoint(const Context& ctx, const Eigen::Vector3d& light, const Mes
   const Eigen::Vector3d point = a + s * (b - a);
   const Eigen::Vector3d d = point - light;
   const double dist = d.norm();
-  if (!(dist > kMinRelativeLightDistance * scene.extent())) return false;
+  // The edge point lies on all of the edge's faces: the largest of their scales.
+  double scale = SurfaceScale(scene, edge.f0, point);
+  if (edge.f1 >= 0) scale = std::max(scale, SurfaceScale(scene, edge.f1, point));
+  if (!(dist > kMinRelativeLightDistance * scale)) return false;
   const Eigen::Vector3d dir = d / dist;
-  const double offset = SurfaceRayOffset(scene, point);
-  // The light must reach the edge, and the ray grazing it must land on a receiver.
+  const double offset = kRelativeRayOffset * scale;
+  // The light must reach the edge, and the ray grazing it must land on a receiver. A hit on the
+  // edge's own faces before the edge point is float noise of the grazing ray (a plane containing
+  // the point cannot be crossed on the way to it).
   ++stats->shadow_rays;
-  if (scene.Occluded(light, dir, 0.0, dist - offset)) return false;
+  const RayHit blocker = scene.Intersect(light, dir, 0.0, dist - offset);
+  if (blocker.hit && blocker.face != edge.f0 && blocker.face != edge.f1) return false;
   ++stats->shadow_rays;
   const RayHit hit = scene.Intersect(point, dir, offset, kInfinity);
   if (!hit.hit || hit.face == edge.f0 || hit.face == edge.f1) return false;
@@ -1185,22 +1269,15 @@ bool CastShadowPoint(const Context& ctx, const Eigen::Vector3d& light, const Mes
 }
 
 // The vertices that move a shadow point of `edge` at parameter s, and rows_j = (∂y/∂p_j)ᵀ·row for
-// a row vector `row` (= some linear functional of y's motion): the edge's two ends through the
-// edge point, the receiver's three corners through its plane.
+// a row vector `row` (= some linear functional of y's motion): the edge's two ends (their copies,
+// AddEdgePointRows) through the edge point, the receiver's three corners through its plane.
 void ShadowPointRows(const ShadowPoint& shadow, const RenderScene& scene, const MeshEdge& edge,
-                     double s, const Eigen::Vector3d& row, int vertices[5],
-                     Eigen::Vector3d rows[5]) {
+                     double s, const Eigen::Vector3d& row, BoundaryRows* out) {
   const Eigen::Vector3d point_row = shadow.d_y_d_point.transpose() * row;
   const Eigen::Vector3d receiver_row = shadow.along.transpose() * row;
   const Eigen::Vector3i& corners = scene.faces()[shadow.receiver];
-  vertices[0] = edge.v0;
-  vertices[1] = edge.v1;
-  rows[0] = (1.0 - s) * point_row;
-  rows[1] = s * point_row;
-  for (int j = 0; j < 3; ++j) {
-    vertices[2 + j] = corners[j];
-    rows[2 + j] = shadow.barycentrics[j] * receiver_row;
-  }
+  AddEdgePointRows(scene, edge, s, point_row, out);
+  for (int j = 0; j < 3; ++j) out->Add(corners[j], shadow.barycentrics[j] * receiver_row);
 }
 
 // Shadow-casting edges of a point light: every edge that can be a silhouette from it, weighted
@@ -1299,8 +1376,9 @@ SecondaryEdges BuildSecondaryEdges(const RenderScene& scene, const Material& mat
     const double length = (scene.positions()[edge.v1] - scene.positions()[edge.v0]).norm();
     if (!(length > 0.0) || !std::isfinite(length)) continue;
     if (edge.num_faces == 2) {
-      const Eigen::Vector3d n0 = scene.FaceNormal(edge.f0), n1 = scene.FaceNormal(edge.f1);
-      // Coplanar neighbours with the same orientation: never a silhouette nor a crease.
+      Eigen::Vector3d n0, n1;
+      ConsistentEdgeNormals(scene, edge, &n0, &n1);
+      // Coplanar neighbours (consistently oriented): never a silhouette nor a crease.
       if (!n0.isZero() && !n1.isZero() && n0.dot(n1) > 1.0 - 1e-12) continue;
     }
     out.edges.push_back(static_cast<int>(e));
@@ -1415,7 +1493,7 @@ void AddSecondaryEdgeSamples(const Context& ctx, const Sampler& path_sampler, in
       path_sampler.Fork(kSecondaryEdgeKey - 1).Next1D() < num_samples - count) {
     ++count;
   }
-  const double offset = RayOffset(ctx, x);
+  const double offset = RayOffset(ctx, face, x);
   const double extent = scene.extent();
   const auto& positions = scene.positions();
   // g(ω) = f·(n·ω)·L_in for the incoming radiance `l_in` along ω (0 below the horizon).
@@ -1498,9 +1576,10 @@ void AddSecondaryEdgeSamples(const Context& ctx, const Sampler& path_sampler, in
             if (!jump.isZero() && jump.allFinite()) {
               const double inv_pdf = kept.inv_pdf / num_samples;
               const Eigen::Vector3d m_row = m / r;  // m·∂ω/∂y.
-              const int vertices[2] = {edge.v0, edge.v1};
-              const Eigen::Vector3d rows[2] = {(1.0 - s_edge) * m_row, s_edge * m_row};
-              path->AddBoundary(throughput.cwiseProduct(jump) * inv_pdf, vertices, rows, 2, -m_row);
+              BoundaryRows rows;
+              AddEdgePointRows(scene, edge, s_edge, m_row, &rows);
+              path->AddBoundary(throughput.cwiseProduct(jump) * inv_pdf, rows.vertices, rows.rows,
+                                rows.count, -m_row);
             }
           }
         }
@@ -1568,10 +1647,11 @@ void AddSecondaryEdgeSamples(const Context& ctx, const Sampler& path_sampler, in
                   kept_texel.inv_pdf / (num_samples * kSecondaryTexelProbability);
               const Eigen::Vector3d m_row = m / r;  // m·∂ω/∂y; ∂y/∂p_k = b_k·I.
               const Eigen::Vector3d b = segment.b0 + t_s * (segment.b1 - segment.b0);
-              const Eigen::Vector3i& corners = scene.faces()[segment.face];
-              const int vertices[3] = {corners[0], corners[1], corners[2]};
-              const Eigen::Vector3d rows[3] = {b[0] * m_row, b[1] * m_row, b[2] * m_row};
-              path->AddBoundary(throughput.cwiseProduct(jump) * inv_pdf, vertices, rows, 3, -m_row);
+              const Eigen::Vector3d c = segment.c0 + t_s * (segment.c1 - segment.c0);
+              BoundaryRows rows;
+              AddTexelPointRows(scene, segment.face, segment.other, b, c, m_row, &rows);
+              path->AddBoundary(throughput.cwiseProduct(jump) * inv_pdf, rows.vertices, rows.rows,
+                                rows.count, -m_row);
             }
           }
         }
@@ -1618,23 +1698,22 @@ void AddSecondaryEdgeSamples(const Context& ctx, const Sampler& path_sampler, in
       if (jump.isZero() || !jump.allFinite()) continue;
       const double inv_pdf = num_lights * cumulative.back() / candidate.weight / num_samples;
       const Eigen::Vector3d m_row = m / r;
-      int vertices[5];
-      Eigen::Vector3d rows[5];
-      ShadowPointRows(shadow, scene, edge, u4, m_row, vertices, rows);
-      path->AddBoundary(throughput.cwiseProduct(jump) * (speed * inv_pdf), vertices, rows, 5,
-                        -m_row);
+      BoundaryRows rows;
+      ShadowPointRows(shadow, scene, edge, u4, m_row, &rows);
+      path->AddBoundary(throughput.cwiseProduct(jump) * (speed * inv_pdf), rows.vertices, rows.rows,
+                        rows.count, -m_row);
     }
   }
 }
 
 // Appends the entries jump·(row_j·∂q/∂vertex_j) for the moving vertices of one sample.
-void EmitBoundary(int pixel, const Eigen::Vector3d& jump, double scale, const int* vertices,
-                  const Eigen::Vector3d* rows, int count, std::vector<EdgeEntry>* out) {
-  for (int j = 0; j < count; ++j) {
+void EmitBoundary(int pixel, const Eigen::Vector3d& jump, double scale, const BoundaryRows& rows,
+                  std::vector<EdgeEntry>* out) {
+  for (int j = 0; j < rows.count; ++j) {
     for (int k = 0; k < 3; ++k) {
-      const double w = rows[j][k] * scale;
+      const double w = rows.rows[j][k] * scale;
       if (w == 0.0 || !std::isfinite(w)) continue;
-      out->push_back({pixel, 3 * vertices[j] + k, jump * w});
+      out->push_back({pixel, 3 * rows.vertices[j] + k, jump * w});
     }
   }
 }
@@ -1755,9 +1834,9 @@ void AddEdgeTerms(const Context& ctx, std::vector<DerivativeList>* pixel_lists,
           PrimaryJump(ctx, world_from_cam_rotation, center, edge, q, m, sampler, &local);
       if (jump.isZero()) return;
       const Eigen::Vector3d m_row = d_q.transpose() * m;  // m·∂q/∂y
-      const int vertices[2] = {edge.v0, edge.v1};
-      const Eigen::Vector3d rows[2] = {(1.0 - s) * m_row, s * m_row};
-      EmitBoundary(pixel, jump, speed * inv_pdf * options.spp, vertices, rows, 2, out);
+      BoundaryRows rows;
+      AddEdgePointRows(scene, edge, s, m_row, &rows);
+      EmitBoundary(pixel, jump, speed * inv_pdf * options.spp, rows, out);
     };
     const int64_t num_samples =
         static_cast<int64_t>(std::ceil(primary_ratio * options.spp * pixels));
@@ -1790,10 +1869,9 @@ void AddEdgeTerms(const Context& ctx, std::vector<DerivativeList>* pixel_lists,
                        q, m, &local);
         if (jump.isZero()) return;
         const Eigen::Vector3d m_row = d_q.transpose() * m;  // m·∂q/∂y
-        int vertices[5];
-        Eigen::Vector3d rows[5];
-        ShadowPointRows(shadow, scene, edge, s, m_row, vertices, rows);
-        EmitBoundary(pixel, jump, speed * inv_pdf * options.spp, vertices, rows, 5, out);
+        BoundaryRows rows;
+        ShadowPointRows(shadow, scene, edge, s, m_row, &rows);
+        EmitBoundary(pixel, jump, speed * inv_pdf * options.spp, rows, out);
       };
       const int64_t num_samples =
           static_cast<int64_t>(std::ceil(shadow_ratio * options.spp * pixels));
@@ -1807,10 +1885,11 @@ void AddEdgeTerms(const Context& ctx, std::vector<DerivativeList>* pixel_lists,
     const Material& material = ctx.material;
     const bool glossy = material.specular * ctx.specular_scale > 0.0;
     std::vector<TexelCandidate> candidates;
-    // Adds the segment of `face` from barycentrics b0 to b1 (over its corners), clipped to the
-    // view, weighted by projected length × material jump `size`.
-    auto add_segment = [&](int face, int other, const Eigen::Vector3d& b0,
-                           const Eigen::Vector3d& b1, double size) {
+    // Adds the segment (of its face, from barycentrics b0 to b1), clipped to the view, weighted
+    // by projected length × material jump.
+    auto add_segment = [&](const TexelSegment& segment) {
+      const int face = segment.face;
+      const Eigen::Vector3d &b0 = segment.b0, &b1 = segment.b1;
       const Eigen::Vector3i& corners = faces[face];
       Eigen::Vector3d y0 = Eigen::Vector3d::Zero(), y1 = Eigen::Vector3d::Zero();
       for (int k = 0; k < 3; ++k) {
@@ -1822,9 +1901,9 @@ void AddEdgeTerms(const Context& ctx, std::vector<DerivativeList>* pixel_lists,
       if (!ClipSegment(a_cam, b_cam, frustum, &s0, &s1)) return;
       const Eigen::Vector2d q0 = camera.ImageFromCam(a_cam + s0 * (b_cam - a_cam));
       const Eigen::Vector2d q1 = camera.ImageFromCam(a_cam + s1 * (b_cam - a_cam));
-      const double weight = (q1 - q0).norm() * size;
+      const double weight = (q1 - q0).norm() * segment.size;
       if (!(weight > 0.0) || !std::isfinite(weight)) return;
-      candidates.push_back({face, other, b0, b1, s0, s1, weight});
+      candidates.push_back({face, segment.other, b0, b1, segment.c0, segment.c1, s0, s1, weight});
     };
     for (const TexelSegment& segment : TexelSegments(scene, material, glossy)) {
       // A coplanar edge seen edge-on from the camera is a primary edge there.
@@ -1832,7 +1911,7 @@ void AddEdgeTerms(const Context& ctx, std::vector<DerivativeList>* pixel_lists,
           IsDiscontinuityEdge(scene, edges[segment.edge], center, /*creases=*/true)) {
         continue;
       }
-      add_segment(segment.face, segment.other, segment.b0, segment.b1, segment.size);
+      add_segment(segment);
     }
     const auto sample_texel = [&](const TexelCandidate& candidate, double s, double inv_pdf,
                                   const Sampler& sampler, std::vector<EdgeEntry>* out) {
@@ -1857,8 +1936,10 @@ void AddEdgeTerms(const Context& ctx, std::vector<DerivativeList>* pixel_lists,
                                              candidate.face, candidate.other, sampler, &local);
       if (jump.isZero()) return;
       const Eigen::Vector3d m_row = d_q.transpose() * m;  // m·∂q/∂y; ∂y/∂p_k = b_k·I.
-      const Eigen::Vector3d rows[3] = {b[0] * m_row, b[1] * m_row, b[2] * m_row};
-      EmitBoundary(pixel, jump, speed * inv_pdf * options.spp, corners.data(), rows, 3, out);
+      const Eigen::Vector3d c = candidate.c0 + s * (candidate.c1 - candidate.c0);
+      BoundaryRows rows;
+      AddTexelPointRows(scene, candidate.face, candidate.other, b, c, m_row, &rows);
+      EmitBoundary(pixel, jump, speed * inv_pdf * options.spp, rows, out);
     };
     const int64_t num_samples = static_cast<int64_t>(std::ceil(texel_ratio * options.spp * pixels));
     SampleCandidates(options, candidates, num_samples, kTexelEdgeKey, view.view_index, sample_texel,
@@ -1874,6 +1955,9 @@ void AddEdgeTerms(const Context& ctx, std::vector<DerivativeList>* pixel_lists,
     stats->bounce_rays += s.bounce_rays;
   }
 }
+
+// Camera samples are traced in fixed kTile × kTile pixel tiles (RenderImpl).
+constexpr int kTile = 8;
 
 void RenderImpl(const RenderScene& scene, const Material& material, const ViewSetup& view,
                 const RenderOptions& options, const DerivativeRequest* request,
@@ -1915,7 +1999,6 @@ void RenderImpl(const RenderScene& scene, const Material& material, const ViewSe
   // Fixed 8×8 tiles; each tile row is one packet of camera rays per sample. The packet
   // composition depends only on the image size, never on scheduling, so images (and
   // derivatives, reduced in tile order) stay bit-identical for any thread count.
-  constexpr int kTile = 8;
   const int tiles_x = (width + kTile - 1) / kTile;
   const int tiles_y = (height + kTile - 1) / kTile;
   const int num_tiles = tiles_x * tiles_y;
@@ -1990,6 +2073,7 @@ void RenderImpl(const RenderScene& scene, const Material& material, const ViewSe
         if (want_rows) pixel_rows[static_cast<size_t>(y) * width + x] = merged;
       }
     }
+    if (options.on_tile_done) options.on_tile_done();
   };
   tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
   arena.execute([&] { tbb::parallel_for(0, num_tiles, render_tile); });
@@ -2032,8 +2116,16 @@ void RenderImpl(const RenderScene& scene, const Material& material, const ViewSe
 
 }  // namespace
 
-double SurfaceRayOffset(const RenderScene& scene, const Eigen::Vector3d& p) {
-  return kRelativeRayOffset * std::max(scene.extent(), p.cwiseAbs().maxCoeff());
+int64_t RenderTileCount(int width, int height) {
+  return static_cast<int64_t>((width + kTile - 1) / kTile) * ((height + kTile - 1) / kTile);
+}
+
+double SurfaceScale(const RenderScene& scene, int face, const Eigen::Vector3d& p) {
+  return std::max(scene.FaceScale(face), p.cwiseAbs().maxCoeff());
+}
+
+double SurfaceRayOffset(const RenderScene& scene, int face, const Eigen::Vector3d& p) {
+  return kRelativeRayOffset * SurfaceScale(scene, face, p);
 }
 
 Eigen::Vector3d CameraSampleDirection(const ViewSetup& view,

@@ -8,6 +8,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -54,9 +55,17 @@ struct RenderOptions {
   // materials then follow identical paths, as finite differences and linearizations need. Must
   // have the rendered material's mesh-colors layout.
   const Material* sampling_material = nullptr;
+  // Called once per finished tile of camera samples (RenderTileCount per view), from the worker
+  // threads (so it must be thread-safe), e.g. to advance a progress line within a long view. It
+  // does not change the image.
+  std::function<void()> on_tile_done;
 
   bool Check(std::string* why) const;
 };
+
+// Number of tiles (fixed 8×8 pixel blocks) of a width × height render: the units of
+// RenderOptions::on_tile_done.
+int64_t RenderTileCount(int width, int height);
 
 struct PointLight {
   Eigen::Vector3d position;   // world frame.
@@ -92,15 +101,20 @@ struct RenderStats {
 // i.e. premultiplied by coverage, like Cycles' DiffCol pass); normal = world-space geometric
 // normal facing the camera; depth = camera-frame z.
 // Ray conventions of the renderer, shared with benchmarks that replay its rays.
-// Rays leave surfaces offset along the normal by this fraction of the scene scale (the larger of
-// the mesh's extent and the point's distance from the origin, so float rounding of the hit point
-// is covered at any scale).
+// Rays leave surfaces offset by this fraction of the local surface scale (SurfaceScale). The
+// scale is local so that a far-away part of the mesh (a stray vertex, a sliver reaching far out)
+// does not change the offsets, hence the image, of the rest.
 constexpr double kRelativeRayOffset = 2e-5;
-// Point lights closer than this (relative to the scene extent) to a shaded point are skipped:
-// I/d² would overflow, and a light inside the surface lights nothing physical.
+// Point lights closer than this (relative to the local surface scale) to a shaded point are
+// skipped: I/d² would overflow, and a light inside the surface lights nothing physical.
 constexpr double kMinRelativeLightDistance = 1e-9;
-// The offset for a ray leaving the surface at p.
-double SurfaceRayOffset(const RenderScene& scene, const Eigen::Vector3d& p);
+// The scale of float rounding at point p of face `face`: max(FaceScale(face), |p|∞), the
+// magnitude of the coordinates Embree computes with there (its float copy of the face's corners,
+// and ray origins at p). Like pbrt's error bounds, but one conservative factor for all
+// (kRelativeRayOffset = 2e-5 is ~170 float ulps).
+double SurfaceScale(const RenderScene& scene, int face, const Eigen::Vector3d& p);
+// The offset for a ray leaving face `face` at p: kRelativeRayOffset · SurfaceScale.
+double SurfaceRayOffset(const RenderScene& scene, int face, const Eigen::Vector3d& p);
 
 // Sample s of pixel (x, y): resets *sampler to that sample's stream, draws the sub-pixel position
 // (its first Next2D) and returns the unit world direction of the camera ray.

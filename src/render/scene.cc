@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 #include <mutex>
+#include <tuple>
 
 namespace sft {
 
@@ -40,6 +41,27 @@ RenderScene::~RenderScene() {
   if (scene_ != nullptr) rtcReleaseScene(scene_);
 }
 
+namespace {
+
+// Embree's limit on ray origin and direction coordinates (its FLT_LARGE): larger ones make the ray
+// invalid, which Embree asserts on.
+constexpr double kMaxEmbreeCoordinate = 1.8e18;
+
+// Whether Embree accepts a ray with these (float-converted) values.
+bool ValidRay(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, float t_near,
+              float t_far) {
+  for (int k = 0; k < 3; ++k) {
+    if (!(std::abs(origin[k]) <= kMaxEmbreeCoordinate) ||
+        !(std::abs(dir[k]) <= kMaxEmbreeCoordinate)) {
+      return false;
+    }
+  }
+  if (dir.isZero()) return false;
+  return t_near >= 0.0f && std::isfinite(t_near) && t_far >= t_near;
+}
+
+}  // namespace
+
 void RenderScene::Build() {
   RTCDevice device = EmbreeDevice();
   scene_ = rtcNewScene(device);
@@ -56,12 +78,15 @@ void RenderScene::Build() {
   // An empty mesh still gets one (degenerate, never hit) primitive: Embree wants non-empty buffers.
   index_buffer[0] = index_buffer[1] = index_buffer[2] = 0;
   vertex_buffer_[0] = vertex_buffer_[1] = vertex_buffer_[2] = 0.0f;
+  referenced_.assign(positions_.size(), 0);
   for (size_t f = 0; f < faces_.size(); ++f) {
     for (int k = 0; k < 3; ++k) {
       CHECK(faces_[f][k] >= 0 && faces_[f][k] < static_cast<int>(positions_.size()));
       index_buffer[3 * f + k] = static_cast<unsigned>(faces_[f][k]);
+      referenced_[faces_[f][k]] = 1;
     }
   }
+  Weld();
   BuildEdges();
   UpdateDerived();
   rtcCommitGeometry(geometry_);
@@ -70,31 +95,107 @@ void RenderScene::Build() {
   rtcCommitScene(scene_);
 }
 
+void RenderScene::Weld() {
+  welded_.resize(positions_.size());
+  std::vector<int> order;
+  for (size_t v = 0; v < positions_.size(); ++v) {
+    welded_[v] = static_cast<int>(v);
+    if (referenced_[v] && positions_[v].allFinite()) order.push_back(static_cast<int>(v));
+  }
+  // Sorted by coordinates, then index: runs of equal coordinates start at their smallest index.
+  auto less = [this](int a, int b) {
+    const Eigen::Vector3d &p = positions_[a], &q = positions_[b];
+    if (p.x() != q.x()) return p.x() < q.x();
+    if (p.y() != q.y()) return p.y() < q.y();
+    if (p.z() != q.z()) return p.z() < q.z();
+    return a < b;
+  };
+  std::sort(order.begin(), order.end(), less);
+  for (size_t i = 1; i < order.size(); ++i) {
+    if (positions_[order[i]] == positions_[order[i - 1]]) welded_[order[i]] = welded_[order[i - 1]];
+  }
+}
+
+namespace {
+
+// A face's traversal of a welded edge: welded ends (v0 < v1), the face, the direction (+1: from
+// v0 to v1 in the face's winding) and the face's own vertices at v0 and v1.
+struct HalfEdge {
+  int v0, v1, face, direction, copy0, copy1;
+  bool operator<(const HalfEdge& o) const {
+    return std::tie(v0, v1, face) < std::tie(o.v0, o.v1, o.face);
+  }
+};
+
+// Copies of the faces' own vertices with weight `share` each, merged per vertex. At most
+// kMaxEdgeCopies distinct copies per end are kept (renormalized): only edges shared by that many
+// faces that all use different copies — pathological non-manifold input — lose exactness.
+constexpr int kMaxEdgeCopies = 8;
+int AddCopies(const std::vector<int>& vertices, std::vector<EdgeCopy>* out) {
+  const size_t first = out->size();
+  for (const int v : vertices) {
+    bool merged = false;
+    for (size_t i = first; i < out->size() && !merged; ++i) {
+      if ((*out)[i].vertex == v) {
+        (*out)[i].weight += 1.0;
+        merged = true;
+      }
+    }
+    if (!merged && out->size() - first < kMaxEdgeCopies) out->push_back({v, 1.0});
+  }
+  double total = 0.0;
+  for (size_t i = first; i < out->size(); ++i) total += (*out)[i].weight;
+  for (size_t i = first; i < out->size(); ++i) (*out)[i].weight /= total;
+  return static_cast<int>(out->size() - first);
+}
+
+}  // namespace
+
 void RenderScene::BuildEdges() {
-  // (v0, v1, face) triples sorted by edge, then grouped.
-  std::vector<std::array<int, 3>> half_edges;
+  std::vector<HalfEdge> half_edges;
   half_edges.reserve(3 * faces_.size());
   for (size_t f = 0; f < faces_.size(); ++f) {
     for (int k = 0; k < 3; ++k) {
       const int a = faces_[f][k], b = faces_[f][(k + 1) % 3];
-      if (a == b) continue;
-      half_edges.push_back({std::min(a, b), std::max(a, b), static_cast<int>(f)});
+      const int wa = welded_[a], wb = welded_[b];
+      if (wa == wb) continue;
+      if (wa < wb) {
+        half_edges.push_back({wa, wb, static_cast<int>(f), 1, a, b});
+      } else {
+        half_edges.push_back({wb, wa, static_cast<int>(f), -1, b, a});
+      }
     }
   }
   std::sort(half_edges.begin(), half_edges.end());
   edges_.clear();
+  edge_copies_.clear();
+  std::vector<int> copies0, copies1;
   for (size_t i = 0; i < half_edges.size();) {
     MeshEdge edge;
-    edge.v0 = half_edges[i][0];
-    edge.v1 = half_edges[i][1];
-    for (; i < half_edges.size() && half_edges[i][0] == edge.v0 && half_edges[i][1] == edge.v1;
+    edge.v0 = half_edges[i].v0;
+    edge.v1 = half_edges[i].v1;
+    int direction0 = 0;
+    copies0.clear();
+    copies1.clear();
+    for (; i < half_edges.size() && half_edges[i].v0 == edge.v0 && half_edges[i].v1 == edge.v1;
          ++i) {
-      const int face = half_edges[i][2];
-      if (edge.num_faces > 0 && face == edge.f0) continue;  // a face listing the edge twice.
-      if (edge.num_faces == 0) edge.f0 = face;
-      if (edge.num_faces == 1) edge.f1 = face;
+      const HalfEdge& h = half_edges[i];
+      if (edge.num_faces > 0 && h.face == half_edges[i - 1].face) continue;  // listed twice.
+      if (edge.num_faces == 0) {
+        edge.f0 = h.face;
+        direction0 = h.direction;
+      }
+      if (edge.num_faces == 1) {
+        edge.f1 = h.face;
+        edge.flip1 = h.direction != direction0 ? 1 : -1;
+      }
       ++edge.num_faces;
+      copies0.push_back(h.copy0);
+      copies1.push_back(h.copy1);
     }
+    edge.first_copy = static_cast<int>(edge_copies_.size());
+    edge.num_copies0 = AddCopies(copies0, &edge_copies_);
+    edge.num_copies1 = AddCopies(copies1, &edge_copies_);
     edges_.push_back(edge);
   }
 }
@@ -102,21 +203,38 @@ void RenderScene::BuildEdges() {
 void RenderScene::UpdateDerived() {
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
   Eigen::Vector3d hi = -lo;
+  bool any = false;
   for (size_t i = 0; i < positions_.size(); ++i) {
     for (int k = 0; k < 3; ++k) vertex_buffer_[3 * i + k] = static_cast<float>(positions_[i][k]);
+    if (!referenced_[i]) continue;
     lo = lo.cwiseMin(positions_[i]);
     hi = hi.cwiseMax(positions_[i]);
+    any = true;
   }
-  extent_ = positions_.empty() ? 1.0 : (hi - lo).norm();
+  if (!any) lo = hi = Eigen::Vector3d::Zero();
+  lo_ = lo;
+  hi_ = hi;
+  extent_ = (hi - lo).norm();
   if (!(extent_ > 0) || !std::isfinite(extent_)) extent_ = 1.0;
   face_normals_.resize(faces_.size());
+  face_scales_.resize(faces_.size());
   for (size_t f = 0; f < faces_.size(); ++f) {
     const Eigen::Vector3d& p0 = positions_[faces_[f][0]];
     const Eigen::Vector3d n = (positions_[faces_[f][1]] - p0).cross(positions_[faces_[f][2]] - p0);
     const double len = n.norm();
     face_normals_[f] =
         len > 0 && std::isfinite(len) ? Eigen::Vector3d(n / len) : Eigen::Vector3d::Zero();
+    double scale = 0.0;
+    for (int k = 0; k < 3; ++k) {
+      scale = std::max(scale, positions_[faces_[f][k]].cwiseAbs().maxCoeff());
+    }
+    face_scales_[f] = scale;
   }
+}
+
+void RenderScene::Bounds(Eigen::Vector3d* lo, Eigen::Vector3d* hi) const {
+  *lo = lo_;
+  *hi = hi_;
 }
 
 void RenderScene::SetVertices(const std::vector<Eigen::Vector3d>& positions) {
@@ -130,6 +248,10 @@ void RenderScene::SetVertices(const std::vector<Eigen::Vector3d>& positions) {
 
 RayHit RenderScene::Intersect(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir,
                               double t_near, double t_far) const {
+  RayHit hit;
+  const float t_near_f = static_cast<float>(t_near);
+  const float t_far_f = static_cast<float>(std::min(t_far, 3.0e38));
+  if (!ValidRay(origin, dir, t_near_f, t_far_f)) return hit;
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
   RTCRayHit rh;
@@ -139,8 +261,8 @@ RayHit RenderScene::Intersect(const Eigen::Vector3d& origin, const Eigen::Vector
   rh.ray.dir_x = static_cast<float>(dir.x());
   rh.ray.dir_y = static_cast<float>(dir.y());
   rh.ray.dir_z = static_cast<float>(dir.z());
-  rh.ray.tnear = static_cast<float>(t_near);
-  rh.ray.tfar = static_cast<float>(std::min(t_far, 3.0e38));
+  rh.ray.tnear = t_near_f;
+  rh.ray.tfar = t_far_f;
   rh.ray.time = 0.0f;
   rh.ray.mask = 0xFFFFFFFFu;
   rh.ray.id = 0;
@@ -148,7 +270,6 @@ RayHit RenderScene::Intersect(const Eigen::Vector3d& origin, const Eigen::Vector
   rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
   rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
   rtcIntersect1(scene_, &context, &rh);
-  RayHit hit;
   if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return hit;
   hit.hit = true;
   hit.t = rh.ray.tfar;
@@ -167,7 +288,7 @@ void RenderScene::Intersect8(const Eigen::Vector3d& origin, const Eigen::Vector3
   alignas(32) int valid[8];
   alignas(32) RTCRayHit8 rh;
   for (int i = 0; i < 8; ++i) {
-    valid[i] = i < count ? -1 : 0;
+    valid[i] = i < count && ValidRay(origin, dirs[i], 0.0f, 3.0e38f) ? -1 : 0;
     const Eigen::Vector3d& dir = dirs[i < count ? i : 0];
     rh.ray.org_x[i] = static_cast<float>(origin.x());
     rh.ray.org_y[i] = static_cast<float>(origin.y());
@@ -188,6 +309,7 @@ void RenderScene::Intersect8(const Eigen::Vector3d& origin, const Eigen::Vector3
   for (int i = 0; i < count; ++i) {
     RayHit& hit = hits[i];
     hit = RayHit();
+    if (!valid[i]) continue;
     if (rh.hit.geomID[i] == RTC_INVALID_GEOMETRY_ID) continue;
     hit.hit = true;
     hit.t = rh.ray.tfar[i];
@@ -199,6 +321,9 @@ void RenderScene::Intersect8(const Eigen::Vector3d& origin, const Eigen::Vector3
 
 bool RenderScene::Occluded(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, double t_near,
                            double t_far) const {
+  const float t_near_f = static_cast<float>(t_near);
+  const float t_far_f = static_cast<float>(std::min(t_far, 3.0e38));
+  if (!ValidRay(origin, dir, t_near_f, t_far_f)) return false;
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
   RTCRay ray;
@@ -208,8 +333,8 @@ bool RenderScene::Occluded(const Eigen::Vector3d& origin, const Eigen::Vector3d&
   ray.dir_x = static_cast<float>(dir.x());
   ray.dir_y = static_cast<float>(dir.y());
   ray.dir_z = static_cast<float>(dir.z());
-  ray.tnear = static_cast<float>(t_near);
-  ray.tfar = static_cast<float>(std::min(t_far, 3.0e38));
+  ray.tnear = t_near_f;
+  ray.tfar = t_far_f;
   ray.time = 0.0f;
   ray.mask = 0xFFFFFFFFu;
   ray.id = 0;

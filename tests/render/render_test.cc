@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <cmath>
 
 #include "src/geometry/material.h"
@@ -252,6 +253,28 @@ TEST(RenderTest, OptionsCheckAndEffectsParse) {
   EXPECT_TRUE(effects.direct && effects.shadows && !effects.bounces && !effects.environment);
   EXPECT_FALSE(Effects::Parse("direct,glitter", &effects, &why));
   EXPECT_NE(why.find("glitter"), std::string::npos);
+}
+
+// RenderOptions::on_tile_done is called once per 8×8 tile (partial tiles at the borders count),
+// from any thread, and does not change the image.
+TEST(RenderTest, TileCallbackCountsTilesWithoutChangingTheImage) {
+  const RenderScene scene(QuadPositions(1.0), QuadFaces());
+  const Material material = ConstantMaterial(2, Eigen::Vector3d(0.5, 0.5, 0.5), 0.5, 0.0);
+  ViewSetup view = TopDownView(2.0, 20, 12.0);
+  view.camera.height = 12;
+  view.camera.params = {12.0, 12.0, 10.0, 6.0};
+  view.point_lights.push_back({Eigen::Vector3d(0.2, 0.1, 1.0), Eigen::Vector3d(1, 1, 1)});
+  RenderOptions options;
+  options.spp = 4;
+  options.threads = 2;
+  Image plain, counted;
+  RenderView(scene, material, view, options, &plain);
+  std::atomic<int> tiles{0};
+  options.on_tile_done = [&tiles] { ++tiles; };
+  RenderView(scene, material, view, options, &counted);
+  EXPECT_EQ(RenderTileCount(20, 12), 6);
+  EXPECT_EQ(tiles.load(), 6);
+  EXPECT_EQ(plain.data, counted.data);
 }
 
 }  // namespace

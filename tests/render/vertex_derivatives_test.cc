@@ -34,6 +34,8 @@
 #include "src/render/environment.h"
 #include "src/render/render.h"
 #include "src/render/scene.h"
+#include "tests/testing/finite_differences.h"
+#include "tests/testing/meshes.h"
 #include "tests/testing/temp_dir.h"
 #include "tests/testing/views.h"
 
@@ -42,36 +44,13 @@ namespace {
 
 using testing::LookAtView;
 
-struct Geometry {
-  std::vector<Eigen::Vector3d> positions;
-  std::vector<Eigen::Vector3i> faces;
+using Geometry = testing::Triangles;
+using testing::CentralDifference;
+using testing::CompareWithFiniteDifferences;
+using testing::Comparison;
+using testing::Sum;
 
-  // Appends `other` (its indices shifted); returns the index of its first vertex.
-  int Append(const Geometry& other) {
-    const int base = static_cast<int>(positions.size());
-    positions.insert(positions.end(), other.positions.begin(), other.positions.end());
-    for (const Eigen::Vector3i& f : other.faces)
-      faces.push_back(f + Eigen::Vector3i::Constant(base));
-    return base;
-  }
-};
-
-Geometry FromMesh(const std::string& file) {
-  TriMesh mesh;
-  EXPECT_TRUE(ReadMesh(testing::DataDir() + "/meshes/" + file, &mesh).ok()) << file;
-  Geometry g;
-  for (auto vh : mesh.vertices()) {
-    const auto& p = mesh.point(vh);
-    g.positions.emplace_back(p[0], p[1], p[2]);
-  }
-  for (auto fh : mesh.faces()) {
-    Eigen::Vector3i f;
-    int k = 0;
-    for (auto vh : mesh.fv_range(fh)) f[k++] = vh.idx();
-    g.faces.push_back(f);
-  }
-  return g;
-}
+Geometry FromMesh(const std::string& file) { return testing::ReadTestMesh(file); }
 
 // An n × n grid of squares (2 triangles each, counter-clockwise seen from +z) over
 // [−half, half]² in the plane z = 0.
@@ -119,147 +98,6 @@ double Directional(const std::vector<double>& gradient, const std::vector<double
 Material Lambert(const Geometry& g, double albedo) {
   return ConstantMaterial(static_cast<int>(g.faces.size()), Eigen::Vector3d::Constant(albedo), 0.5,
                           0.0);
-}
-
-// δ·(p) → the directional derivative image Σ_θ J_θ·δ_θ (RGB per pixel) from the rows.
-std::vector<double> RowsTimes(const DerivativeOutput& out, const std::vector<double>& delta) {
-  const size_t pixels = static_cast<size_t>(out.rows.width) * out.rows.height;
-  std::vector<double> image(3 * pixels, 0.0);
-  for (size_t p = 0; p < pixels; ++p) {
-    for (uint64_t e = out.rows.offsets[p]; e < out.rows.offsets[p + 1]; ++e) {
-      const JacobianEntry& entry = out.rows.entries[e];
-      EXPECT_EQ(out.layout.KindOf(entry.param), ParameterKind::kVertex);
-      for (int c = 0; c < 3; ++c) image[3 * p + c] += entry.d[c] * delta[entry.param];
-    }
-  }
-  return image;
-}
-
-// (I(p + hδ) − I(p − hδ))/(2h), RGB per pixel, same seeds, detached sampling.
-std::vector<double> CentralDifference(const Geometry& g, const std::vector<double>& delta, double h,
-                                      const Material& material, const ViewSetup& view,
-                                      const RenderOptions& options) {
-  Image image[2];
-  for (int s = 0; s < 2; ++s) {
-    std::vector<Eigen::Vector3d> positions = g.positions;
-    const double t = s == 0 ? h : -h;
-    for (size_t v = 0; v < positions.size(); ++v) {
-      for (int k = 0; k < 3; ++k) positions[v][k] += t * delta[3 * v + k];
-    }
-    const RenderScene scene(positions, g.faces);
-    RenderView(scene, material, view, options, &image[s]);
-  }
-  std::vector<double> fd(3 * static_cast<size_t>(image[0].width) * image[0].height);
-  for (size_t p = 0; p < fd.size() / 3; ++p) {
-    for (int c = 0; c < 3; ++c) {
-      fd[3 * p + c] =
-          (static_cast<double>(image[0].data[4 * p + c]) - image[1].data[4 * p + c]) / (2 * h);
-    }
-  }
-  return fd;
-}
-
-std::vector<double> BlockSums(const std::vector<double>& image, int res, int block) {
-  const int nb = (res + block - 1) / block;
-  std::vector<double> sums(3 * nb * nb, 0.0);
-  for (int y = 0; y < res; ++y) {
-    for (int x = 0; x < res; ++x) {
-      for (int c = 0; c < 3; ++c) {
-        sums[3 * ((y / block) * nb + x / block) + c] += image[3 * (y * res + x) + c];
-      }
-    }
-  }
-  return sums;
-}
-
-double RelativeError(const std::vector<double>& a, const std::vector<double>& ref) {
-  double err2 = 0.0, ref2 = 0.0;
-  for (size_t i = 0; i < a.size(); ++i) {
-    err2 += (a[i] - ref[i]) * (a[i] - ref[i]);
-    ref2 += ref[i] * ref[i];
-  }
-  return ref2 > 0.0 ? std::sqrt(err2 / ref2) : (err2 > 0.0 ? 1.0 : 0.0);
-}
-
-double Sum(const std::vector<double>& v) {
-  double s = 0.0;
-  for (double x : v) s += x;
-  return s;
-}
-
-struct Comparison {
-  double block_error = 0.0;  // 8×8 block sums, RGB.
-  double sum_error = 0.0;    // |Σ analytic − Σ fd| / |Σ fd| over the image and RGB.
-  double adjoint_mismatch = 0.0;
-  bool finite = true;
-};
-
-// Renders the derivative rows (and the adjoint for random weights) at p and the central difference
-// along δ with step h; compares them on 8×8 block sums.
-//
-// `nodes` > 1: the analytic side is instead the mean of the derivative images at the midpoints
-// t_j = −h + (j + ½)·2h/nodes of the meshes p + t_j·δ, each rendered with spp/nodes samples and
-// its own seed. In expectation the central difference is exactly the mean of the derivative over
-// [−h, h] (I(h) − I(−h) = ∫ I′), and this midpoint rule estimates that mean, also where I′ is
-// not smooth: the expected image of a polyhedron has a kink whenever one of its faces turns edge
-// on to the camera (the set of silhouette edges changes), so a central difference over a step
-// containing such events is not the derivative at p (see SphereUnderEnvironmentLong).
-Comparison CompareWithFiniteDifferences(const Geometry& g, const std::vector<double>& delta,
-                                        double h, const Material& material, const ViewSetup& view,
-                                        RenderOptions options, const char* name, int nodes = 1) {
-  options.sampling_material = &material;
-  const int res = view.camera.width;
-  Image weights(res, res, 3);
-  std::mt19937 rng(17);
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  for (float& w : weights.data) w = static_cast<float>(u(rng));
-  DerivativeRequest request;
-  request.params = ParameterSelection::Only(ParameterKind::kVertex);
-  request.jacobian_rows = true;
-  request.adjoint_weights = &weights;
-  Comparison result;
-  std::vector<double> analytic(3 * static_cast<size_t>(res) * res, 0.0);
-  for (int j = 0; j < nodes; ++j) {
-    RenderOptions node_options = options;
-    std::vector<Eigen::Vector3d> positions = g.positions;
-    if (nodes > 1) {
-      node_options.spp = std::max(1, options.spp / nodes);
-      node_options.seed = options.seed + 1 + j;
-      const double t = -h + (j + 0.5) * 2.0 * h / nodes;
-      for (size_t v = 0; v < positions.size(); ++v) {
-        for (int k = 0; k < 3; ++k) positions[v][k] += t * delta[3 * v + k];
-      }
-    }
-    const RenderScene scene(positions, g.faces);
-    Image image;
-    DerivativeOutput out;
-    RenderViewWithDerivatives(scene, material, view, node_options, request, 1, &image, &out);
-    const std::vector<double> node = RowsTimes(out, delta);
-    double adjoint = 0.0, weighted = 0.0, weighted_abs = 0.0;
-    for (size_t i = 0; i < out.gradient.size(); ++i) {
-      result.finite &= std::isfinite(out.gradient[i]);
-      if (i < delta.size()) adjoint += out.gradient[i] * delta[i];
-    }
-    for (size_t i = 0; i < node.size(); ++i) {
-      result.finite &= std::isfinite(node[i]);
-      weighted += weights.data[i] * node[i];
-      weighted_abs += std::abs(weights.data[i] * node[i]);
-      analytic[i] += node[i] / nodes;
-    }
-    result.adjoint_mismatch =
-        std::max(result.adjoint_mismatch,
-                 weighted_abs > 0.0 ? std::abs(adjoint - weighted) / weighted_abs : 0.0);
-  }
-  const std::vector<double> fd = CentralDifference(g, delta, h, material, view, options);
-  result.block_error = RelativeError(BlockSums(analytic, res, 8), BlockSums(fd, res, 8));
-  const double fd_sum = Sum(fd);
-  result.sum_error = std::abs(Sum(analytic) - fd_sum) / std::max(std::abs(fd_sum), 1e-300);
-  std::printf(
-      "%s: block error %.4f, pixel error %.4f, sum error %.4f (fd sum %.5g), adjoint "
-      "mismatch %.1e\n",
-      name, result.block_error, RelativeError(analytic, fd), result.sum_error, fd_sum,
-      result.adjoint_mismatch);
-  return result;
 }
 
 // ---------------------------------------------------------------------------------------------
