@@ -3,6 +3,8 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
+#include <cstring>
 #include <atomic>
 #include <filesystem>
 #include <fstream>
@@ -54,20 +56,34 @@ Status WriteAtomically(const std::string& path,
   }
   fs::rename(tmp, target, ec);
   if (ec) {
-    fs::remove(tmp, ec);
-    return Status::Error(path + ": cannot write (" + ec.message() + ")");
+    // The reason is taken before the clean-up, whose own error code would overwrite it (the
+    // message used to read "cannot write (Success)").
+    const std::string reason = ec.message();
+    std::error_code ignored;
+    fs::remove(tmp, ignored);
+    return Status::Error(path + ": cannot write (" + reason + ")");
   }
   return Status::Ok();
 }
 
 Status WriteTextFile(const std::string& path, const std::string& contents) {
   return WriteAtomically(path, [&](const std::string& tmp) {
+    errno = 0;
     std::ofstream out(tmp, std::ios::binary);
+    if (!out) return Status::Error(path + ": cannot write (" + ErrnoText(errno) + ")");
     out << contents;
     out.close();
-    if (!out) return Status::Error(path + ": cannot write");
+    if (!out) return Status::Error(path + ": cannot write (" + ErrnoText(errno) + ")");
     return Status::Ok();
   });
+}
+
+std::string ErrnoText(int error_number) {
+  return error_number == 0 ? "unknown error" : std::strerror(error_number);
+}
+
+void StripUtf8Bom(std::string* text) {
+  if (text->compare(0, 3, "\xEF\xBB\xBF") == 0) text->erase(0, 3);
 }
 
 Status ReadTextFile(const std::string& path, std::string* contents) {
