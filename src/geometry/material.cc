@@ -628,6 +628,7 @@ Status LoadMaterial(const std::string& spec, const TriMesh& mesh, Material* mate
     where = "material (inline JSON)";
   } else {
     SFT_RETURN_IF_ERROR(ReadTextFile(spec, &text));
+    StripUtf8Bom(&text);  // nlohmann::json skips it too; explicit for every reader.
     base_dir = std::filesystem::path(spec).parent_path().string();
     where = spec;
   }
