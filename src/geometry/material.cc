@@ -102,20 +102,10 @@ void FillConstant(int num_faces, int resolution, const double* value, int channe
 // the integer point (px, py) and the bilinear interpolant is bilinear on each unit cell.
 class Texture {
  public:
-  // `image` holds linear values (see PrepareTexture).
-  explicit Texture(const Image& image) : width_(image.width), height_(image.height) {
-    rgb_.resize(static_cast<size_t>(width_) * height_);
-    for (int y = 0; y < height_; ++y) {
-      for (int x = 0; x < width_; ++x) {
-        Eigen::Vector3d c;
-        for (int k = 0; k < 3; ++k) {
-          // Grey images replicate their channel; alpha (4th channel) is ignored.
-          c[k] = image.at(x, y, image.channels >= 3 ? k : 0);
-        }
-        rgb_[static_cast<size_t>(y) * width_ + x] = c;
-      }
-    }
-  }
+  // `image` holds linear values (see PrepareTexture); it is kept as is (floats, no per-pixel
+  // copy: an 8192² texture is 0.8–1 GB already).
+  explicit Texture(Image image)
+      : width_(image.width), height_(image.height), image_(std::move(image)) {}
 
   Eigen::Vector2d ToPixel(const Eigen::Vector2d& uv) const {
     return Eigen::Vector2d(uv.x() * width_ - 0.5, (1.0 - uv.y()) * height_ - 0.5);
@@ -145,12 +135,14 @@ class Texture {
     const int k = static_cast<int>(m < 0 ? m + n : m);
     return k >= n ? 0 : k;
   }
-  const Eigen::Vector3d& At(int x, int y) const {
-    return rgb_[static_cast<size_t>(y) * width_ + x];
+  // Grey images replicate their channel; alpha (4th channel) is ignored.
+  Eigen::Vector3d At(int x, int y) const {
+    const float* p = &image_.data[image_.Index(x, y)];
+    return image_.channels >= 3 ? Eigen::Vector3d(p[0], p[1], p[2]) : Eigen::Vector3d::Constant(p[0]);
   }
 
   int width_, height_;
-  std::vector<Eigen::Vector3d> rgb_;
+  Image image_;
 };
 
 using Polygon = std::vector<Eigen::Vector2d>;
@@ -283,10 +275,11 @@ void SampleTexture(const Texture& texture, const std::vector<Eigen::Vector2d>& c
   });
 }
 
-// Texture pixels across the narrowest texel regions that sampling needs (see TextureReduction):
-// with 8 the area average over a region differs from the full-resolution one only through the
-// box filter's blur at the region's border, a fraction ~1/8 of a mip pixel's variation.
-constexpr double kTexturePixelsAcrossTexel = 8.0;
+// Texture pixels kept across the texel regions (see TextureReduction): the area average over a
+// region of the mip level differs from the full-resolution one only by the box filter's blur
+// along the region's border, ~2/16 of the region's area (measured: at most 2.6% of a unit jump in
+// the texture, mean 0.3%; 5.6% with 8 pixels, docs/design-notes.md 2026-11-24).
+constexpr double kTexturePixelsAcrossTexel = 16.0;
 // The percentile of faces (by UV size) whose texel regions must keep kTexturePixelsAcrossTexel:
 // smaller faces' regions see a coarser mip level, as with trilinear filtering.
 constexpr double kTextureReductionPercentile = 0.1;
@@ -587,7 +580,7 @@ Status BuildMaterial(const Context& ctx, const Json& json, const std::string& ba
     const int reduction =
         TextureReduction(corner_uvs, num_faces, resolution, image.width, image.height);
     if (reduction > 1) image = ShrinkImage(image, reduction);
-    SampleTexture(Texture(image), corner_uvs, num_faces, resolution, &result.albedo);
+    SampleTexture(Texture(std::move(image)), corner_uvs, num_faces, resolution, &result.albedo);
   } else if (source == "mesh_colors") {
     std::string file;
     SFT_RETURN_IF_ERROR(ReadString(ctx, json, "mesh_colors", &file));

@@ -444,7 +444,7 @@ TEST(MaterialTest, ProceduralDeterministicAndInRange) {
 
 // A texture much finer than the texel regions is box-filtered to a mip level before sampling
 // (memory: docs/design-notes.md 2026-11-24). A 1024² linear gradient on UVs [0.25, 0.75]² at
-// resolution 2 is reduced 32× (texel regions 256 pixels across, kept at >= 8); box filtering
+// resolution 2 is reduced 16× (texel regions 256 pixels across, kept at >= 16); box filtering
 // keeps a linear function linear with its samples at the block centres, so each texel must still
 // be the value at its region's centroid, which a half-pixel misalignment of the mip would break.
 TEST(MaterialTest, ReducedTextureKeepsLinearGradientExact) {
