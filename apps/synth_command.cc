@@ -41,10 +41,10 @@ struct SynthOptions {
   std::string up_axis = "z";  // the mesh's up axis: "z" (as is) or "y" (rotated).
   bool normalize = true;      // centre the mesh and scale its bbox diagonal to 1.
   std::vector<double> light_offset = {0.15, 0.0, 0.0};  // point light in the camera frame.
-  double light_intensity = 0.0;         // W/sr, in (0, 1e30]; used when given.
+  double light_intensity = 0.0;                         // W/sr, in (0, 1e30]; used when given.
   bool light_intensity_given = false;   // --light-intensity was given (else automatic).
   std::string envmap;                   // equirectangular EXR probe replacing the point light.
-  double envmap_scale = 1.0;            // probe radiance scale, >= 0.
+  double envmap_scale = 1.0;            // probe radiance scale, [0, 1e30].
   bool environment_background = false;  // camera rays that miss see the probe.
   RenderOptions render;                 // spp, bounces, seed, threads of the target renders.
   std::string effects = "all";          // enabled effects (Effects::Parse).
@@ -59,7 +59,9 @@ struct SynthOptions {
     }
     if (zooms.empty()) return Fail(why, "--zooms: needs at least one value");
     for (double z : zooms) {
-      if (!(z > 0 && z <= 1000)) return Fail(why, "--zooms: values must be in (0, 1000], got " + Text(z));
+      if (!(z > 0 && z <= 1000)) {
+        return Fail(why, "--zooms: values must be in (0, 1000], got " + Text(z));
+      }
     }
     if (res < 1 || res > 16384) {
       return Fail(why, "--res: must be in [1, 16384], got " + std::to_string(res));
@@ -67,7 +69,9 @@ struct SynthOptions {
     if (!(fov_deg > 0 && fov_deg < 179)) {
       return Fail(why, "--fov: must be in (0, 179) degrees, got " + Text(fov_deg));
     }
-    if (!(fill > 0 && fill <= 10)) return Fail(why, "--fill: must be in (0, 10], got " + Text(fill));
+    if (!(fill > 0 && fill <= 10)) {
+      return Fail(why, "--fill: must be in (0, 10], got " + Text(fill));
+    }
     if (up_axis != "y" && up_axis != "z") return Fail(why, "--up-axis: must be y or z");
     if (light_offset.size() != 3) return Fail(why, "--light-offset: needs 3 numbers x,y,z");
     for (double x : light_offset) {
@@ -76,7 +80,8 @@ struct SynthOptions {
       }
     }
     if (light_intensity_given && !(light_intensity > 0 && light_intensity <= 1e30)) {
-      return Fail(why, "--light-intensity: must be in (0, 1e30] W/sr, got " + Text(light_intensity));
+      return Fail(why,
+                  "--light-intensity: must be in (0, 1e30] W/sr, got " + Text(light_intensity));
     }
     if (!(envmap_scale >= 0 && envmap_scale <= 1e30)) {
       return Fail(why, "--envmap-scale: must be in [0, 1e30], got " + Text(envmap_scale));

@@ -138,7 +138,8 @@ class Texture {
   // Grey images replicate their channel; alpha (4th channel) is ignored.
   Eigen::Vector3d At(int x, int y) const {
     const float* p = &image_.data[image_.Index(x, y)];
-    return image_.channels >= 3 ? Eigen::Vector3d(p[0], p[1], p[2]) : Eigen::Vector3d::Constant(p[0]);
+    return image_.channels >= 3 ? Eigen::Vector3d(p[0], p[1], p[2])
+                                : Eigen::Vector3d::Constant(p[0]);
   }
 
   int width_, height_;
@@ -320,9 +321,9 @@ Status PrepareTexture(const Context& ctx, const std::string& file, bool srgb, Im
     float& v = image->data[i];
     if (!std::isfinite(v)) {
       const size_t pixel = i / image->channels;
-      return ctx.Error("albedo_texture",
-                       file + ": pixel (" + std::to_string(pixel % image->width) + ", " +
-                           std::to_string(pixel / image->width) + ") has a non-finite value");
+      return ctx.Error("albedo_texture", file + ": pixel (" + std::to_string(pixel % image->width) +
+                                             ", " + std::to_string(pixel / image->width) +
+                                             ") has a non-finite value");
     }
     if (v < 0.0f || v > 1.0f) {
       ++clamped;
@@ -333,8 +334,8 @@ Status PrepareTexture(const Context& ctx, const std::string& file, bool srgb, Im
     if (srgb) v = SrgbToLinear(v);
   }
   if (clamped > 0) {
-    LOG(WARNING) << file << ": " << clamped << " texture values outside [0, 1] (from "
-                 << lowest << " to " << highest << ") clamped to [0, 1] for albedo";
+    LOG(WARNING) << file << ": " << clamped << " texture values outside [0, 1] (from " << lowest
+                 << " to " << highest << ") clamped to [0, 1] for albedo";
   }
   return Status::Ok();
 }

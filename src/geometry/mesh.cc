@@ -802,7 +802,9 @@ Status BuildMesh(const std::string& path, const ParsedMesh& parsed, TriMesh* mes
       // Polygons: ear clipping in their plane (a fan when strictly convex); refused when not
       // planar or self-intersecting.
       polygon.clear();
-      for (int c = begin; c < end; ++c) polygon.push_back(parsed.positions[parsed.corner_vertices[c]]);
+      for (int c = begin; c < end; ++c) {
+        polygon.push_back(parsed.positions[parsed.corner_vertices[c]]);
+      }
       const Status triangulated = TriangulatePolygon(polygon, &triangles);
       if (!triangulated.ok()) {
         std::string where = path + ": face " + std::to_string(f);

@@ -163,7 +163,7 @@ Status TriangulatePolygon(const std::vector<Eigen::Vector3d>& corners,
     newell += d.cross(corners[(i + 1) % n] - centroid);
   }
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(covariance);
-  Eigen::Vector3d normal = eigen.eigenvectors().col(0);  // Smallest eigenvalue.
+  Eigen::Vector3d normal = eigen.eigenvectors().col(0);      // Smallest eigenvalue.
   const Eigen::Vector3d axis = eigen.eigenvectors().col(2);  // Largest: the main direction.
 
   int worst = 0;
@@ -199,10 +199,9 @@ Status TriangulatePolygon(const std::vector<Eigen::Vector3d>& corners,
   const double eps = kOrientRelativeTolerance * size * size;
   int edge_a = 0, edge_b = 0;
   if (FindSelfIntersection(q, eps, &edge_a, &edge_b)) {
-    return Status::Error("polygon is self-intersecting: its edges " + std::to_string(edge_a) +
-                         "-" + std::to_string((edge_a + 1) % n) + " and " +
-                         std::to_string(edge_b) + "-" + std::to_string((edge_b + 1) % n) +
-                         " (corners) cross or touch");
+    return Status::Error("polygon is self-intersecting: its edges " + std::to_string(edge_a) + "-" +
+                         std::to_string((edge_a + 1) % n) + " and " + std::to_string(edge_b) + "-" +
+                         std::to_string((edge_b + 1) % n) + " (corners) cross or touch");
   }
   bool convex = true;
   for (int i = 0; i < n && convex; ++i) {

@@ -26,7 +26,8 @@ Status CheckViewsFitInMemory(const Dataset& dataset) {
                          "rendering one view of " + std::to_string(camera.width) + "x" +
                              std::to_string(camera.height) + " pixels",
                          &why)) {
-    return Status::Error("cameras[" + std::to_string(largest) + "] (\"" + camera.id + "\"): " + why);
+    return Status::Error("cameras[" + std::to_string(largest) + "] (\"" + camera.id +
+                         "\"): " + why);
   }
   return Status::Ok();
 }

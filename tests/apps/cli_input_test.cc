@@ -45,20 +45,20 @@ TEST(CliInputTest, HugeCameraIsOneErrorNotBadAlloc) {
   const std::string mesh = testing::DataDir() + "/meshes/icosphere_r1_320f.obj";
   std::string out;
   std::string dataset = HugeCameraDataset(tmp, 100000, 100000);
-  EXPECT_EQ(Sft("render --quiet --dataset " + dataset + " --mesh " + mesh + " --out " +
-                    tmp.Join("o"),
-                &out),
-            1)
+  EXPECT_EQ(
+      Sft("render --quiet --dataset " + dataset + " --mesh " + mesh + " --out " + tmp.Join("o"),
+          &out),
+      1)
       << out;
   EXPECT_EQ(CountLines(out), 1) << out;
   EXPECT_THAT(out, HasSubstr("cameras[0].width: 100000 is larger than the maximum 65536"));
 
   dataset = HugeCameraDataset(tmp, 32768, 32768);  // Within the read limits: 48 GiB to render.
   if (AvailableMemoryBytes() >= 48 * (uint64_t{1} << 30)) GTEST_SKIP() << "48 GiB available";
-  EXPECT_EQ(Sft("render --quiet --dataset " + dataset + " --mesh " + mesh + " --out " +
-                    tmp.Join("o"),
-                &out),
-            1)
+  EXPECT_EQ(
+      Sft("render --quiet --dataset " + dataset + " --mesh " + mesh + " --out " + tmp.Join("o"),
+          &out),
+      1)
       << out;
   EXPECT_EQ(CountLines(out), 1) << out;
   EXPECT_THAT(out, HasSubstr("needs an estimated 48 GB, more than the "));
@@ -99,8 +99,11 @@ TEST(CliInputTest, SynthFlagsOutOfRangeNameTheFlag) {
   // The flags given explicitly at valid values are used (the intensity is not replaced by the
   // automatic value): the dataset's light has intensity 2.
   std::string out;
-  ASSERT_EQ(Sft(base + "--cameras 1 --zooms 1 --res 8 --spp 1 --light-intensity 2 --light-offset 0.1,0,0",
-                &out), 0) << out;
+  ASSERT_EQ(
+      Sft(base + "--cameras 1 --zooms 1 --res 8 --spp 1 --light-intensity 2 --light-offset 0.1,0,0",
+          &out),
+      0)
+      << out;
   const nlohmann::json scene = nlohmann::json::parse(std::ifstream(tmp.Join("ds/scene.json")));
   EXPECT_EQ(scene["lights"][0]["intensity"], nlohmann::json::parse("[2.0, 2.0, 2.0]"));
 }

@@ -462,8 +462,8 @@ TEST(MaterialTest, ReducedTextureKeepsLinearGradientExact) {
   ASSERT_TRUE(WriteExr(tmp.Join("tex.exr"), texture).ok());
   Material m;
   ASSERT_TRUE(
-      LoadMaterial(R"({"albedo_texture": ")" + tmp.Join("tex.exr") + R"(", "resolution": 2})",
-                   mesh, &m)
+      LoadMaterial(R"({"albedo_texture": ")" + tmp.Join("tex.exr") + R"(", "resolution": 2})", mesh,
+                   &m)
           .ok());
   const std::vector<Eigen::Vector2d> uvs = FaceCornerUvs(mesh);
   const int r = 2;

@@ -62,9 +62,8 @@ TEST(MeshPolygonTest, ConcavePentagonInObjOffPly) {
   EXPECT_TRUE(report.has_texcoords);
   EXPECT_EQ(report.num_degenerate_faces, 0);
   ExpectPentagon(mesh);
-  ASSERT_TRUE(ReadString(tmp, "p.off", "OFF\n5 1 0\n" + std::string(kPentagonVertices) +
-                                           "5 0 1 2 3 4\n",
-                         &mesh)
+  ASSERT_TRUE(ReadString(tmp, "p.off",
+                         "OFF\n5 1 0\n" + std::string(kPentagonVertices) + "5 0 1 2 3 4\n", &mesh)
                   .ok());
   ExpectPentagon(mesh);
   // PLY with MeshLab-style per-corner texcoords.
@@ -84,8 +83,8 @@ TEST(MeshPolygonTest, ConcavePentagonInObjOffPly) {
 TEST(MeshPolygonTest, ConvexQuadIsStillTheFan) {
   testing::TempDir tmp;
   TriMesh mesh;
-  ASSERT_TRUE(ReadString(tmp, "q.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 2 3 4 1\n", &mesh)
-                  .ok());
+  ASSERT_TRUE(
+      ReadString(tmp, "q.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 2 3 4 1\n", &mesh).ok());
   std::vector<Eigen::Vector3i> faces;
   MeshToArrays(mesh, nullptr, &faces);
   ASSERT_EQ(faces.size(), 2u);
@@ -121,11 +120,12 @@ TEST(MeshPolygonTest, SelfIntersectingPolygonRefusedNamingTheFace) {
   testing::TempDir tmp;
   TriMesh mesh;
   // A bow-tie quad and a pentagon whose corner 3 touches its first edge.
-  Status s = ReadString(tmp, "bowtie.obj", "v 0 0 0\nv 1 1 0\nv 1 0 0\nv 0 1 0\nf 1 2 3 4\n", &mesh);
+  Status s =
+      ReadString(tmp, "bowtie.obj", "v 0 0 0\nv 1 1 0\nv 1 0 0\nv 0 1 0\nf 1 2 3 4\n", &mesh);
   ASSERT_FALSE(s.ok());
   EXPECT_THAT(s.message(), HasSubstr("bowtie.obj: face 0 (line 5): polygon is self-intersecting"));
-  s = ReadString(tmp, "touch.off",
-                 "OFF\n5 1 0\n0 0 0\n4 0 0\n4 4 0\n2 0 0\n0 4 0\n5 0 1 2 3 4\n", &mesh);
+  s = ReadString(tmp, "touch.off", "OFF\n5 1 0\n0 0 0\n4 0 0\n4 4 0\n2 0 0\n0 4 0\n5 0 1 2 3 4\n",
+                 &mesh);
   EXPECT_THAT(s.message(), HasSubstr("touch.off: face 0 (line 8): polygon is self-intersecting"));
   s = ReadString(tmp, "bowtie.ply",
                  "ply\nformat ascii 1.0\nelement vertex 4\n"

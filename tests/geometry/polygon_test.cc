@@ -21,9 +21,7 @@ std::vector<Eigen::Vector3d> InPlaneZ0(const std::vector<Eigen::Vector2d>& point
 }
 
 // The concave pentagon of issue 9: a square with a notch cut to (2, 1) from the top edge.
-std::vector<Eigen::Vector2d> NotchedPentagon() {
-  return {{0, 0}, {4, 0}, {4, 4}, {2, 1}, {0, 4}};
-}
+std::vector<Eigen::Vector2d> NotchedPentagon() { return {{0, 0}, {4, 0}, {4, 4}, {2, 1}, {0, 4}}; }
 
 double Cross2(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
   return a.x() * b.y() - a.y() * b.x();
@@ -165,7 +163,8 @@ TEST(PolygonTest, NonPlanarRefusedWithTolerance) {
   pentagon[3].z() = 0.5;
   EXPECT_THAT(TriangulatePolygon(pentagon, &triangles).message(), HasSubstr("not planar"));
   // Lifted by 0.002 (well under 1% of the size): accepted.
-  EXPECT_TRUE(TriangulatePolygon({{0, 0, 0}, {1, 0, 0}, {1, 1, 0.002}, {0, 1, 0}}, &triangles).ok());
+  EXPECT_TRUE(
+      TriangulatePolygon({{0, 0, 0}, {1, 0, 0}, {1, 1, 0.002}, {0, 1, 0}}, &triangles).ok());
 }
 
 TEST(PolygonTest, SelfIntersectingRefused) {
@@ -177,7 +176,8 @@ TEST(PolygonTest, SelfIntersectingRefused) {
   EXPECT_THAT(s.message(), HasSubstr("edges 0-1 and 2-3"));
   // Pentagram: every corner joined to the next-but-one point of a regular pentagon.
   std::vector<Eigen::Vector2d> star;
-  for (int k = 0; k < 5; ++k) star.emplace_back(std::cos(k * 4 * M_PI / 5), std::sin(k * 4 * M_PI / 5));
+  for (int k = 0; k < 5; ++k)
+    star.emplace_back(std::cos(k * 4 * M_PI / 5), std::sin(k * 4 * M_PI / 5));
   EXPECT_THAT(TriangulatePolygon(InPlaneZ0(star), &triangles).message(),
               HasSubstr("self-intersecting"));
   // A pentagon folding back along its first edge (a spike) and one touching itself.

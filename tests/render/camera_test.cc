@@ -84,8 +84,8 @@ TEST(CameraTest, PixelsPastTheFoldHaveNoRay) {
       EXPECT_EQ(camera.CamFromImage(pixel), ray);
     }
     // Past it: no ray, and CamFromImage says so with a zero direction.
-    for (const Eigen::Vector2d& pixel : {Eigen::Vector2d(32 + 0.56 * 32, 32), Eigen::Vector2d(0.5, 0.5),
-                                         Eigen::Vector2d(63.5, 20)}) {
+    for (const Eigen::Vector2d& pixel : {Eigen::Vector2d(32 + 0.56 * 32, 32),
+                                         Eigen::Vector2d(0.5, 0.5), Eigen::Vector2d(63.5, 20)}) {
       EXPECT_FALSE(camera.RayFromImage(pixel, &ray)) << pixel.transpose();
       EXPECT_EQ(camera.CamFromImage(pixel), Eigen::Vector3d::Zero()) << pixel.transpose();
     }
@@ -103,8 +103,8 @@ TEST(CameraTest, PixelsPastTheFoldHaveNoRay) {
 // pixels well inside the fold see the wall (alpha 1).
 TEST(CameraTest, PixelsPastTheFoldRenderEmpty) {
   // A 40 × 40 quad at z = 0 seen from z = −1 (normalized coordinates up to ±20 land on it).
-  const std::vector<Eigen::Vector3d> positions = {{-20, -20, 0}, {20, -20, 0}, {20, 20, 0},
-                                                  {-20, 20, 0}};
+  const std::vector<Eigen::Vector3d> positions = {
+      {-20, -20, 0}, {20, -20, 0}, {20, 20, 0}, {-20, 20, 0}};
   const std::vector<Eigen::Vector3i> faces = {{0, 1, 2}, {0, 2, 3}};
   const RenderScene scene(positions, faces);
   const Material material = ConstantMaterial(2, Eigen::Vector3d::Constant(0.5), 0.5, 0.0);
