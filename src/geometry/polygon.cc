@@ -140,6 +140,10 @@ Status TriangulatePolygon(const std::vector<Eigen::Vector3d>& corners,
   const int n = static_cast<int>(corners.size());
   triangles->clear();
   if (n < 3) return Status::Error("polygon with " + std::to_string(n) + " corners");
+  if (n > kMaxPolygonCorners) {
+    return Status::Error("polygon has " + std::to_string(n) + " corners, more than the " +
+                         std::to_string(kMaxPolygonCorners) + " supported");
+  }
   auto fan = [&]() {
     for (int k = 1; k + 1 < n; ++k) triangles->push_back({0, k, k + 1});
     return Status::Ok();

@@ -16,6 +16,10 @@ namespace sft {
 // polygon does not define one surface: its triangulations differ by more than 1% of its size.
 constexpr double kPolygonPlanarTolerance = 1e-2;
 
+// Polygons with more corners are refused: the checks and ear clipping take O(n²) time (a concave
+// 10000-corner star takes 0.4 s), so a hostile face of a million corners would take hours.
+constexpr int kMaxPolygonCorners = 16384;
+
 // Triangulates the polygon whose corners are `corners` (in order; at least 3). Each triangle
 // (indices into `corners`) has the polygon's winding and starts at its lowest corner index.
 //   - Strictly convex polygons give the fan (0, k, k+1), unchanged from a plain fan.
@@ -24,8 +28,8 @@ constexpr double kPolygonPlanarTolerance = 1e-2;
 //   - Polygons whose corners all lie on a line (zero area) give the fan's zero-area triangles, as
 //     a degenerate triangle would be kept.
 // Errors (one line, without the file or face, which the caller adds): a polygon that is not
-// planar (tolerance above) or is self-intersecting (two edges cross or touch, projected into the
-// plane).
+// planar (tolerance above), is self-intersecting (two edges cross or touch, projected into the
+// plane), or has more than kMaxPolygonCorners corners.
 Status TriangulatePolygon(const std::vector<Eigen::Vector3d>& corners,
                           std::vector<std::array<int, 3>>* triangles);
 

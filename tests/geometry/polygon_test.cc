@@ -189,5 +189,29 @@ TEST(PolygonTest, SelfIntersectingRefused) {
       HasSubstr("self-intersecting"));
 }
 
+// A concave star with the maximum number of corners is triangulated exactly (and quickly: the
+// work is O(n²)); one more corner is refused.
+TEST(PolygonTest, LargeConcavePolygonAndCornerLimit) {
+  std::vector<Eigen::Vector2d> star;
+  const int n = kMaxPolygonCorners;
+  for (int k = 0; k < n; ++k) {
+    const double r = k % 2 == 0 ? 1.0 : 0.6, a = 2 * M_PI * k / n;
+    star.emplace_back(r * std::cos(a), r * std::sin(a));
+  }
+  Triangles triangles;
+  ASSERT_TRUE(TriangulatePolygon(InPlaneZ0(star), &triangles).ok());
+  ASSERT_EQ(triangles.size(), static_cast<size_t>(n - 2));
+  double area = 0.0, shoelace = 0.0;
+  for (const auto& t : triangles) {
+    EXPECT_GT(SignedArea(star, t), 0.0);
+    area += SignedArea(star, t);
+  }
+  for (int k = 0; k < n; ++k) shoelace += 0.5 * Cross2(star[k], star[(k + 1) % n]);
+  EXPECT_NEAR(area, shoelace, 1e-12);
+  star.emplace_back(1.0, -1e-9);
+  const Status s = TriangulatePolygon(InPlaneZ0(star), &triangles);
+  EXPECT_THAT(s.message(), HasSubstr("polygon has 16385 corners, more than the 16384 supported"));
+}
+
 }  // namespace
 }  // namespace sft
