@@ -159,6 +159,36 @@ Status TriangulatePolygon(const std::vector<Eigen::Vector3d>& corners,
   centroid /= n;
   const double size = (hi - lo).norm();
   if (!(size > 0)) return fan();  // All corners at one point: zero-area triangles.
+  // Corners that repeat the previous corner's position (a collapsed edge, common in quad meshes)
+  // would make the polygon touch itself: triangulate without them, then give each a zero-area
+  // triangle with its neighbours so that it stays connected (as the fan's degenerate triangle
+  // did).
+  std::vector<int> kept;
+  for (int i = 0; i < n; ++i) {
+    const int previous = kept.empty() ? n - 1 : kept.back();
+    const bool repeats = (corners[i] - corners[previous]).norm() <= kCollinearRelativeWidth * size;
+    if (!repeats || (kept.empty() && i == n - 1)) kept.push_back(i);
+  }
+  if (static_cast<int>(kept.size()) < n) {
+    if (kept.size() < 3) return fan();
+    std::vector<Eigen::Vector3d> reduced;
+    for (int i : kept) reduced.push_back(corners[i]);
+    std::vector<std::array<int, 3>> reduced_triangles;
+    SFT_RETURN_IF_ERROR(TriangulatePolygon(reduced, &reduced_triangles));
+    for (const std::array<int, 3>& t : reduced_triangles) {
+      triangles->push_back(Rotated(kept[t[0]], kept[t[1]], kept[t[2]]));
+    }
+    for (int i = 0, k = 0; i < n; ++i) {  // k: position in `kept` of the next kept corner.
+      if (k < static_cast<int>(kept.size()) && kept[k] == i) {
+        ++k;
+        continue;
+      }
+      const int before = (i + n - 1) % n;
+      const int after = kept[k % kept.size()];
+      triangles->push_back(Rotated(before, i, after));
+    }
+    return Status::Ok();
+  }
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
   Eigen::Vector3d newell = Eigen::Vector3d::Zero();  // Twice the vector area: winding's normal.
   for (int i = 0; i < n; ++i) {

@@ -151,6 +151,34 @@ TEST(PolygonTest, CollinearCornersGiveTheDegenerateFan) {
   EXPECT_EQ(triangles, (Triangles{{0, 1, 2}, {0, 2, 3}}));
 }
 
+// A quad with a collapsed edge (corners 1 and 2 at one position, common in quad meshes) is not
+// "self-touching": it gives the triangle of its distinct corners plus a zero-area triangle that
+// keeps the repeated corner connected, as the fan did.
+TEST(PolygonTest, RepeatedCornerPositionsGiveADegenerateTriangle) {
+  Triangles triangles;
+  ASSERT_TRUE(TriangulatePolygon(InPlaneZ0({{0, 0}, {1, 0}, {1, 0}, {0, 1}}), &triangles).ok());
+  EXPECT_EQ(triangles, (Triangles{{0, 1, 3}, {1, 2, 3}}));
+  // The concave pentagon with its notch corner doubled, and with the first corner doubled at
+  // the end (the wrap-around).
+  ASSERT_TRUE(
+      TriangulatePolygon(InPlaneZ0({{0, 0}, {4, 0}, {4, 4}, {2, 1}, {2, 1}, {0, 4}}), &triangles)
+          .ok());
+  ASSERT_EQ(triangles.size(), 4u);
+  const std::vector<Eigen::Vector2d> notched = {{0, 0}, {4, 0}, {4, 4}, {2, 1}, {2, 1}, {0, 4}};
+  double area = 0.0;
+  for (const auto& t : triangles) area += SignedArea(notched, t);
+  EXPECT_EQ(area, 10.0);
+  ASSERT_TRUE(
+      TriangulatePolygon(InPlaneZ0({{0, 0}, {4, 0}, {4, 4}, {2, 1}, {0, 4}, {0, 0}}), &triangles)
+          .ok());
+  EXPECT_EQ(triangles.size(), 4u);
+  // Corners that meet without being neighbours still make the polygon touch itself.
+  EXPECT_THAT(
+      TriangulatePolygon(InPlaneZ0({{0, 0}, {1, 0}, {1, 1}, {0, 0}, {-1, 1}, {-1, 0}}), &triangles)
+          .message(),
+      HasSubstr("self-intersecting"));
+}
+
 TEST(PolygonTest, NonPlanarRefusedWithTolerance) {
   Triangles triangles;
   // A unit quad with one corner lifted by 0.2 (the diagonal is 1.43): refused.
