@@ -10,6 +10,7 @@
 // The default light intensity gives a white Lambertian patch facing the camera at the object's
 // centre a radiance of 0.5. The dataset is written to OUT.partial and renamed to OUT at the end.
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
@@ -40,28 +41,51 @@ struct SynthOptions {
   std::string up_axis = "z";  // the mesh's up axis: "z" (as is) or "y" (rotated).
   bool normalize = true;      // centre the mesh and scale its bbox diagonal to 1.
   std::vector<double> light_offset = {0.15, 0.0, 0.0};  // point light in the camera frame.
-  double light_intensity = -1.0;        // W/sr; < 0 = automatic (see the file comment).
+  double light_intensity = 0.0;                         // W/sr, in (0, 1e30]; used when given.
+  bool light_intensity_given = false;   // --light-intensity was given (else automatic).
   std::string envmap;                   // equirectangular EXR probe replacing the point light.
-  double envmap_scale = 1.0;            // probe radiance scale, >= 0.
+  double envmap_scale = 1.0;            // probe radiance scale, [0, 1e30].
   bool environment_background = false;  // camera rays that miss see the probe.
   RenderOptions render;                 // spp, bounces, seed, threads of the target renders.
   std::string effects = "all";          // enabled effects (Effects::Parse).
   bool overwrite = false;               // replace an existing, non-empty output directory.
   bool quiet = false;                   // no progress line.
 
-  // Errors name the command-line flag.
+  // Errors name the command-line flag and the value; NaN fails every range test. --spp,
+  // --bounces and --threads are checked by RenderOptions::Check.
   bool Check(std::string* why) const {
-    if (cameras < 1 || cameras > 10000) return Fail(why, "--cameras: must be in [1, 10000]");
+    if (cameras < 1 || cameras > 10000) {
+      return Fail(why, "--cameras: must be in [1, 10000], got " + std::to_string(cameras));
+    }
     if (zooms.empty()) return Fail(why, "--zooms: needs at least one value");
     for (double z : zooms) {
-      if (!(z > 0) || !std::isfinite(z)) return Fail(why, "--zooms: values must be > 0");
+      if (!(z > 0 && z <= 1000)) {
+        return Fail(why, "--zooms: values must be in (0, 1000], got " + Text(z));
+      }
     }
-    if (res < 1 || res > 16384) return Fail(why, "--res: must be in [1, 16384]");
-    if (!(fov_deg > 0 && fov_deg < 179)) return Fail(why, "--fov: must be in (0, 179)");
-    if (!(fill > 0 && fill <= 10)) return Fail(why, "--fill: must be in (0, 10]");
+    if (res < 1 || res > 16384) {
+      return Fail(why, "--res: must be in [1, 16384], got " + std::to_string(res));
+    }
+    if (!(fov_deg > 0 && fov_deg < 179)) {
+      return Fail(why, "--fov: must be in (0, 179) degrees, got " + Text(fov_deg));
+    }
+    if (!(fill > 0 && fill <= 10)) {
+      return Fail(why, "--fill: must be in (0, 10], got " + Text(fill));
+    }
     if (up_axis != "y" && up_axis != "z") return Fail(why, "--up-axis: must be y or z");
     if (light_offset.size() != 3) return Fail(why, "--light-offset: needs 3 numbers x,y,z");
-    if (!(envmap_scale >= 0)) return Fail(why, "--envmap-scale: must be >= 0");
+    for (double x : light_offset) {
+      if (!std::isfinite(x)) {
+        return Fail(why, "--light-offset: must be 3 finite numbers, got " + Text(x));
+      }
+    }
+    if (light_intensity_given && !(light_intensity > 0 && light_intensity <= 1e30)) {
+      return Fail(why,
+                  "--light-intensity: must be in (0, 1e30] W/sr, got " + Text(light_intensity));
+    }
+    if (!(envmap_scale >= 0 && envmap_scale <= 1e30)) {
+      return Fail(why, "--envmap-scale: must be in [0, 1e30], got " + Text(envmap_scale));
+    }
     if (environment_background && envmap.empty()) {
       return Fail(why, "--background-environment: needs --envmap");
     }
@@ -69,9 +93,14 @@ struct SynthOptions {
   }
 
  private:
-  static bool Fail(std::string* why, const char* message) {
+  static bool Fail(std::string* why, const std::string& message) {
     *why = message;
     return false;
+  }
+  static std::string Text(double value) {
+    char buffer[32];
+    std::snprintf(buffer, sizeof(buffer), "%g", value);
+    return buffer;
   }
 };
 
@@ -144,7 +173,7 @@ Status RunSynth(const SynthOptions& opts) {
     light.position =
         Eigen::Vector3d(opts.light_offset[0], opts.light_offset[1], opts.light_offset[2]);
     const double intensity =
-        opts.light_intensity >= 0 ? opts.light_intensity : 0.5 * M_PI * distance * distance;
+        opts.light_intensity_given ? opts.light_intensity : 0.5 * M_PI * distance * distance;
     light.intensity = Eigen::Vector3d::Constant(intensity);
     dataset.lights.push_back(light);
   } else {
@@ -240,8 +269,9 @@ CommandRunner SetupSynthCommand(CLI::App* app) {
       ->delimiter(',')
       ->expected(3)
       ->capture_default_str();
-  app->add_option("--light-intensity", opts->light_intensity,
-                  "Radiant intensity, W/sr (default: white facing patch at the centre = 0.5)");
+  CLI::Option* light_intensity =
+      app->add_option("--light-intensity", opts->light_intensity,
+                      "Radiant intensity, W/sr (default: white facing patch at the centre = 0.5)");
   app->add_option("--envmap", opts->envmap,
                   "Equirectangular EXR probe to light the object instead of the point light");
   app->add_option("--envmap-scale", opts->envmap_scale, "Probe radiance scale")
@@ -259,7 +289,8 @@ CommandRunner SetupSynthCommand(CLI::App* app) {
       ->capture_default_str();
   app->add_flag("--overwrite", opts->overwrite, "Replace an existing output directory");
   app->add_flag("--quiet", opts->quiet, "No progress line");
-  return [opts]() {
+  return [opts, light_intensity]() {
+    opts->light_intensity_given = light_intensity->count() > 0;
     const Status status = RunSynth(*opts);
     return status.ok() ? 0 : PrintError("synth", status);
   };

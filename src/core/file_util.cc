@@ -6,6 +6,8 @@
 #include <cerrno>
 #include <cstring>
 #include <atomic>
+#include <cerrno>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -56,8 +58,11 @@ Status WriteAtomically(const std::string& path,
   }
   fs::rename(tmp, target, ec);
   if (ec) {
-    const std::string reason = ec.message();  // before remove() overwrites ec.
-    fs::remove(tmp, ec);
+    // The reason is taken before the clean-up, whose own error code would overwrite it (the
+    // message used to read "cannot write (Success)").
+    const std::string reason = ec.message();
+    std::error_code ignored;
+    fs::remove(tmp, ignored);
     return Status::Error(path + ": cannot write (" + reason + ")");
   }
   return Status::Ok();
@@ -65,12 +70,22 @@ Status WriteAtomically(const std::string& path,
 
 Status WriteTextFile(const std::string& path, const std::string& contents) {
   return WriteAtomically(path, [&](const std::string& tmp) {
+    errno = 0;
     std::ofstream out(tmp, std::ios::binary);
+    if (!out) return Status::Error(path + ": cannot write (" + ErrnoText(errno) + ")");
     out << contents;
     out.close();
-    if (!out) return Status::Error(path + ": cannot write (" + std::strerror(errno) + ")");
+    if (!out) return Status::Error(path + ": cannot write (" + ErrnoText(errno) + ")");
     return Status::Ok();
   });
+}
+
+std::string ErrnoText(int error_number) {
+  return error_number == 0 ? "unknown error" : std::strerror(error_number);
+}
+
+void StripUtf8Bom(std::string* text) {
+  if (text->compare(0, 3, "\xEF\xBB\xBF") == 0) text->erase(0, 3);
 }
 
 Status ReadTextFile(const std::string& path, std::string* contents) {

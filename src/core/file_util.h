@@ -26,6 +26,14 @@ Status WriteAtomically(const std::string& path,
 // Writes `contents` to `path` atomically.
 Status WriteTextFile(const std::string& path, const std::string& contents);
 
+// strerror(error_number), or "unknown error" for 0 (never "Success" in an error message). Callers
+// capture errno right after the failing call, before anything else can change it.
+std::string ErrnoText(int error_number);
+
+// Removes a leading UTF-8 byte-order mark (EF BB BF), which some editors write at the start of
+// text files (OBJ, OFF, PLY headers, JSON); left in place it would garble the first line.
+void StripUtf8Bom(std::string* text);
+
 // Reads a whole file; error names the path.
 Status ReadTextFile(const std::string& path, std::string* contents);
 

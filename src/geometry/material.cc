@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <opencv2/imgproc.hpp>
 #include <set>
 
 #include "src/core/file_util.h"
@@ -101,21 +102,10 @@ void FillConstant(int num_faces, int resolution, const double* value, int channe
 // the integer point (px, py) and the bilinear interpolant is bilinear on each unit cell.
 class Texture {
  public:
-  Texture(const Image& image, bool srgb) : width_(image.width), height_(image.height) {
-    rgb_.resize(static_cast<size_t>(width_) * height_);
-    for (int y = 0; y < height_; ++y) {
-      for (int x = 0; x < width_; ++x) {
-        Eigen::Vector3d c;
-        for (int k = 0; k < 3; ++k) {
-          // Grey images replicate their channel; alpha (4th channel) is ignored.
-          float v = image.at(x, y, image.channels >= 3 ? k : 0);
-          if (srgb) v = SrgbToLinear(std::min(std::max(v, 0.0f), 1.0f));
-          c[k] = v;
-        }
-        rgb_[static_cast<size_t>(y) * width_ + x] = c;
-      }
-    }
-  }
+  // `image` holds linear values (see PrepareTexture); it is kept as is (floats, no per-pixel
+  // copy: an 8192² texture is 0.8–1 GB already).
+  explicit Texture(Image image)
+      : width_(image.width), height_(image.height), image_(std::move(image)) {}
 
   Eigen::Vector2d ToPixel(const Eigen::Vector2d& uv) const {
     return Eigen::Vector2d(uv.x() * width_ - 0.5, (1.0 - uv.y()) * height_ - 0.5);
@@ -145,12 +135,15 @@ class Texture {
     const int k = static_cast<int>(m < 0 ? m + n : m);
     return k >= n ? 0 : k;
   }
-  const Eigen::Vector3d& At(int x, int y) const {
-    return rgb_[static_cast<size_t>(y) * width_ + x];
+  // Grey images replicate their channel; alpha (4th channel) is ignored.
+  Eigen::Vector3d At(int x, int y) const {
+    const float* p = &image_.data[image_.Index(x, y)];
+    return image_.channels >= 3 ? Eigen::Vector3d(p[0], p[1], p[2])
+                                : Eigen::Vector3d::Constant(p[0]);
   }
 
   int width_, height_;
-  std::vector<Eigen::Vector3d> rgb_;
+  Image image_;
 };
 
 using Polygon = std::vector<Eigen::Vector2d>;
@@ -281,6 +274,83 @@ void SampleTexture(const Texture& texture, const std::vector<Eigen::Vector2d>& c
       }
     }
   });
+}
+
+// Texture pixels kept across the texel regions (see TextureReduction): the area average over a
+// region of the mip level differs from the full-resolution one only by the box filter's blur
+// along the region's border, ~2/16 of the region's area (measured: at most 2.6% of a unit jump in
+// the texture, mean 0.3%; 5.6% with 8 pixels, docs/design-notes.md 2026-11-24).
+constexpr double kTexturePixelsAcrossTexel = 16.0;
+// The percentile of faces (by UV size) whose texel regions must keep kTexturePixelsAcrossTexel:
+// smaller faces' regions see a coarser mip level, as with trilinear filtering.
+constexpr double kTextureReductionPercentile = 0.1;
+
+// The power-of-two factor by which a width × height texture can be box-filtered (a mip level)
+// before sampling into mesh colors of resolution r: the texel regions of the faces at the 10th
+// percentile of UV size then still span kTexturePixelsAcrossTexel pixels. A texel region of a
+// face whose UV triangle covers A pixels² is a square of 2A/r² pixels². 1 = no reduction.
+int TextureReduction(const std::vector<Eigen::Vector2d>& corner_uvs, int num_faces, int r,
+                     int width, int height) {
+  std::vector<double> across;  // Pixels across a texel region, per face with UV area.
+  across.reserve(num_faces);
+  for (int f = 0; f < num_faces; ++f) {
+    const Eigen::Vector2d e1 = corner_uvs[3 * f + 1] - corner_uvs[3 * f];
+    const Eigen::Vector2d e2 = corner_uvs[3 * f + 2] - corner_uvs[3 * f];
+    const double area = 0.5 * std::abs(e1.x() * e2.y() - e1.y() * e2.x()) * width * height;
+    if (area > 0) across.push_back(std::sqrt(2.0 * area) / r);
+  }
+  if (across.empty()) return 1;
+  const size_t k = static_cast<size_t>(kTextureReductionPercentile * (across.size() - 1));
+  std::nth_element(across.begin(), across.begin() + k, across.end());
+  int reduction = 1;
+  while (across[k] / (2 * reduction) >= kTexturePixelsAcrossTexel && width / (2 * reduction) >= 1 &&
+         height / (2 * reduction) >= 1) {
+    reduction *= 2;
+  }
+  return reduction;
+}
+
+// Checks the texture's values and turns them into linear albedo in place: non-finite values are
+// an error naming the pixel; values outside [0, 1] are clamped and reported in one warning (a
+// texture is data from another tool, often an HDR EXR: one bright texel should not stop a run,
+// unlike a constant typed by the user, which is refused). "srgb" decodes after clamping.
+Status PrepareTexture(const Context& ctx, const std::string& file, bool srgb, Image* image) {
+  int64_t clamped = 0;
+  float lowest = 0.0f, highest = 1.0f;
+  for (size_t i = 0; i < image->data.size(); ++i) {
+    float& v = image->data[i];
+    if (!std::isfinite(v)) {
+      const size_t pixel = i / image->channels;
+      return ctx.Error("albedo_texture", file + ": pixel (" + std::to_string(pixel % image->width) +
+                                             ", " + std::to_string(pixel / image->width) +
+                                             ") has a non-finite value");
+    }
+    if (v < 0.0f || v > 1.0f) {
+      ++clamped;
+      lowest = std::min(lowest, v);
+      highest = std::max(highest, v);
+      v = std::min(std::max(v, 0.0f), 1.0f);
+    }
+    if (srgb) v = SrgbToLinear(v);
+  }
+  if (clamped > 0) {
+    LOG(WARNING) << file << ": " << clamped << " texture values outside [0, 1] (from " << lowest
+                 << " to " << highest << ") clamped to [0, 1] for albedo";
+  }
+  return Status::Ok();
+}
+
+// Box-filters `image` down by `reduction` (OpenCV INTER_AREA: exact block means for a power of
+// two that divides the size).
+Image ShrinkImage(const Image& image, int reduction) {
+  const cv::Mat full(image.height, image.width, CV_32FC(image.channels),
+                     const_cast<float*>(image.data.data()));
+  Image small(std::max(1, image.width / reduction), std::max(1, image.height / reduction),
+              image.channels);
+  cv::Mat out(small.height, small.width, CV_32FC(small.channels), small.data.data());
+  cv::resize(full, out, out.size(), 0, 0, cv::INTER_AREA);
+  CHECK(out.data == reinterpret_cast<uchar*>(small.data.data())) << "resize reallocated";
+  return small;
 }
 
 // ---- Procedural patterns ------------------------------------------------------------------------
@@ -460,10 +530,9 @@ Status BuildMaterial(const Context& ctx, const Json& json, const std::string& ba
     }
   }
   if (has("specular")) {
-    // With Schlick's approximation `specular` is F0, a reflectance.
-    const double hi =
-        result.fresnel == FresnelMode::kSchlick ? 1.0 : std::numeric_limits<double>::infinity();
-    SFT_RETURN_IF_ERROR(ReadNumber(ctx, json, "specular", 0.0, hi, &result.specular));
+    // The constant Fresnel weight (or Schlick's F0) is a reflectance: above 1 the glossy lobe
+    // reflects more than arrives (1e20 gave inf pixels).
+    SFT_RETURN_IF_ERROR(ReadNumber(ctx, json, "specular", 0.0, 1.0, &result.specular));
   }
   int resolution = source == "albedo" ? 1 : kDefaultSampledResolution;
   if (has("resolution")) {
@@ -506,7 +575,13 @@ Status BuildMaterial(const Context& ctx, const Json& json, const std::string& ba
     if (image.width < 1 || image.height < 1 || image.channels < 1) {
       return ctx.Error("albedo_texture", file + ": empty image");
     }
-    SampleTexture(Texture(image, srgb), corner_uvs, num_faces, resolution, &result.albedo);
+    SFT_RETURN_IF_ERROR(PrepareTexture(ctx, file, srgb, &image));
+    // Only the detail that texel regions can hold is kept: an 8192² texture at resolution 64 held
+    // 2.4 GB while sampled (docs/design-notes.md, 2026-11-24).
+    const int reduction =
+        TextureReduction(corner_uvs, num_faces, resolution, image.width, image.height);
+    if (reduction > 1) image = ShrinkImage(image, reduction);
+    SampleTexture(Texture(std::move(image)), corner_uvs, num_faces, resolution, &result.albedo);
   } else if (source == "mesh_colors") {
     std::string file;
     SFT_RETURN_IF_ERROR(ReadString(ctx, json, "mesh_colors", &file));
@@ -628,6 +703,7 @@ Status LoadMaterial(const std::string& spec, const TriMesh& mesh, Material* mate
     where = "material (inline JSON)";
   } else {
     SFT_RETURN_IF_ERROR(ReadTextFile(spec, &text));
+    StripUtf8Bom(&text);  // nlohmann::json skips it too; explicit for every reader.
     base_dir = std::filesystem::path(spec).parent_path().string();
     where = spec;
   }

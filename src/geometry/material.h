@@ -17,7 +17,7 @@ enum class FresnelMode { kConstant, kSchlick };
 struct Material {
   MeshColors albedo;      // 3 channels, linear, in [0, 1].
   MeshColors roughness;   // 1 channel, in [0, 1]; GGX α = roughness².
-  double specular = 0.0;  // glossy lobe weight (constant Fresnel), or F0 with Schlick.
+  double specular = 0.0;  // glossy lobe weight (constant Fresnel), or F0 with Schlick; [0, 1].
   FresnelMode fresnel = FresnelMode::kConstant;
 };
 
@@ -34,7 +34,10 @@ Material ConstantMaterial(int num_faces, const Eigen::Vector3d& albedo, double r
 //   {"procedural": "wood"|"noise", "colors": [[r,g,b],[r,g,b]], "scale": s,
 //    "roughness": x | "roughness_range": [lo, hi], "specular": s, "resolution": r, "seed": n}
 // Optional everywhere: "fresnel": "constant"|"schlick". Relative paths are relative to the JSON
-// file's directory, or to the working directory for inline JSON. Errors name the field.
+// file's directory, or to the working directory for inline JSON. Ranges (README "Materials"):
+// colours, roughness and specular in [0, 1], resolution in [1, 64], scale in (0, 1e6]; a value
+// outside is an error naming the file, the field and the value. Texture texels: non-finite is an
+// error, outside [0, 1] is clamped with a warning. Errors name the field.
 // An empty `spec` gives the default material (albedo 0.7, roughness 0.5, specular 0).
 Status LoadMaterial(const std::string& spec, const TriMesh& mesh, Material* material);
 

@@ -18,6 +18,7 @@
 
 #include <OpenMesh/Core/IO/MeshIO.hh>
 #include <OpenMesh/Core/System/omstream.hh>
+#include <array>
 #include <cerrno>
 #include <charconv>
 #include <cmath>
@@ -33,6 +34,7 @@
 #include <unordered_map>
 
 #include "src/core/file_util.h"
+#include "src/geometry/polygon.h"
 
 namespace sft {
 namespace {
@@ -49,6 +51,7 @@ struct ParsedMesh {
   std::vector<int> face_offsets{0};  // face f's corners are [face_offsets[f], face_offsets[f+1]).
   std::vector<int> corner_vertices;  // 0-based vertex index per corner.
   std::vector<int> corner_uvs;       // index into `uvs` per corner, or -1.
+  std::vector<int> face_lines;       // 1-based line of each face in the file; empty for PLY.
 
   int num_faces() const { return static_cast<int>(face_offsets.size()) - 1; }
   void EndFace() { face_offsets.push_back(static_cast<int>(corner_vertices.size())); }
@@ -168,8 +171,9 @@ Status ParseObj(const std::string& path, const std::string& text, ParsedMesh* ou
   std::vector<std::string_view> tokens;
   int num_normals = 0;
   // Positive indices may refer to vertices defined later in the file (OpenMesh's reader allows
-  // it too), so they are range-checked at the end; remember where each face came from.
-  std::vector<int> face_lines;
+  // it too), so they are range-checked at the end; out->face_lines remembers where each face
+  // came from.
+  std::vector<int>& face_lines = out->face_lines;
   struct PendingNormal {
     long long index;
     int line;
@@ -403,6 +407,7 @@ Status ParseOff(const std::string& path, const std::string& text, ParsedMesh* ou
       out->corner_uvs.push_back(-1);
     }
     out->EndFace();  // Tokens after the indices (face colours) are ignored.
+    out->face_lines.push_back(ln);
   }
   return Status::Ok();
 }
@@ -773,6 +778,8 @@ Status BuildMesh(const std::string& path, const ParsedMesh& parsed, TriMesh* mes
   }
 
   int repeated_vertex_faces = 0, non_manifold_faces = 0;
+  std::vector<Eigen::Vector3d> polygon;
+  std::vector<std::array<int, 3>> triangles;
   {
     ScopedOpenMeshQuiet quiet;
     for (int f = 0; f < parsed.num_faces(); ++f) {
@@ -792,9 +799,22 @@ Status BuildMesh(const std::string& path, const ParsedMesh& parsed, TriMesh* mes
         ++repeated_vertex_faces;
         continue;
       }
-      // Polygons: fan triangulation (c0, ck, ck+1), as OpenMesh's TriMesh::add_face does.
-      for (int k = begin + 1; k + 1 < end; ++k) {
-        const int corners[3] = {begin, k, k + 1};
+      // Polygons: ear clipping in their plane (a fan when strictly convex); refused when not
+      // planar or self-intersecting.
+      polygon.clear();
+      for (int c = begin; c < end; ++c) {
+        polygon.push_back(parsed.positions[parsed.corner_vertices[c]]);
+      }
+      const Status triangulated = TriangulatePolygon(polygon, &triangles);
+      if (!triangulated.ok()) {
+        std::string where = path + ": face " + std::to_string(f);
+        if (f < static_cast<int>(parsed.face_lines.size())) {
+          where += " (line " + std::to_string(parsed.face_lines[f]) + ")";
+        }
+        return triangulated.Prefixed(where);
+      }
+      for (const std::array<int, 3>& triangle : triangles) {
+        const int corners[3] = {begin + triangle[0], begin + triangle[1], begin + triangle[2]};
         TriMesh::VertexHandle vh[3];
         for (int c = 0; c < 3; ++c) vh[c] = handles[parsed.corner_vertices[corners[c]]];
         TriMesh::FaceHandle fh = mesh->add_face(vh[0], vh[1], vh[2]);
@@ -873,7 +893,11 @@ Status BuildMesh(const std::string& path, const ParsedMesh& parsed, TriMesh* mes
 // Text output through a buffer flushed in 1 MB chunks.
 class TextFileWriter {
  public:
-  explicit TextFileWriter(const std::string& path) : file_(std::fopen(path.c_str(), "wb")) {}
+  explicit TextFileWriter(const std::string& path) {
+    errno = 0;
+    file_ = std::fopen(path.c_str(), "wb");
+    if (file_ == nullptr) error_ = errno;
+  }
   ~TextFileWriter() {
     if (file_ != nullptr) std::fclose(file_);
   }
@@ -886,18 +910,28 @@ class TextFileWriter {
   bool Close() {
     Flush();
     const bool ok = std::ferror(file_) == 0;
+    errno = 0;
     const bool closed = std::fclose(file_) == 0;
+    if (!closed && error_ == 0) error_ = errno;
     file_ = nullptr;
     return ok && closed;
   }
+  // The reason of the first failure (strerror of the errno captured right after the failing call).
+  std::string error() const { return ErrnoText(error_); }
 
  private:
   void Flush() {
-    if (!buffer_.empty()) std::fwrite(buffer_.data(), 1, buffer_.size(), file_);
+    if (!buffer_.empty()) {
+      errno = 0;
+      if (std::fwrite(buffer_.data(), 1, buffer_.size(), file_) != buffer_.size() && error_ == 0) {
+        error_ = errno;
+      }
+    }
     buffer_.clear();
   }
-  std::FILE* file_;
+  std::FILE* file_ = nullptr;
   std::string buffer_;
+  int error_ = 0;  // errno of the first failed call, 0 if none (or none given).
 };
 
 // 1-based (OBJ) or 0-based (OFF) indices of the mesh's non-deleted vertices, in order.
@@ -912,7 +946,9 @@ std::vector<int> CompactVertexIndices(const TriMesh& mesh, int first, int* count
 Status WriteObj(const std::string& path, const TriMesh& mesh) {
   return WriteAtomically(path, [&](const std::string& tmp) -> Status {
     TextFileWriter out(tmp);
-    if (!out.is_open()) return Status::Error(path + ": cannot open for writing");
+    if (!out.is_open()) {
+      return Status::Error(path + ": cannot open for writing (" + out.error() + ")");
+    }
     std::string& text = out.buffer();
     int num_vertices = 0;
     const std::vector<int> compact = CompactVertexIndices(mesh, 1, &num_vertices);
@@ -970,7 +1006,7 @@ Status WriteObj(const std::string& path, const TriMesh& mesh) {
       text += '\n';
       out.MaybeFlush();
     }
-    if (!out.Close()) return Status::Error(path + ": write failed");
+    if (!out.Close()) return Status::Error(path + ": write failed (" + out.error() + ")");
     return Status::Ok();
   });
 }
@@ -979,7 +1015,9 @@ Status WriteObj(const std::string& path, const TriMesh& mesh) {
 Status WriteOff(const std::string& path, const TriMesh& mesh) {
   return WriteAtomically(path, [&](const std::string& tmp) -> Status {
     TextFileWriter out(tmp);
-    if (!out.is_open()) return Status::Error(path + ": cannot open for writing");
+    if (!out.is_open()) {
+      return Status::Error(path + ": cannot open for writing (" + out.error() + ")");
+    }
     std::string& text = out.buffer();
     int num_vertices = 0;
     const std::vector<int> compact = CompactVertexIndices(mesh, 0, &num_vertices);
@@ -1004,7 +1042,7 @@ Status WriteOff(const std::string& path, const TriMesh& mesh) {
       text += '\n';
       out.MaybeFlush();
     }
-    if (!out.Close()) return Status::Error(path + ": write failed");
+    if (!out.Close()) return Status::Error(path + ": write failed (" + out.error() + ")");
     return Status::Ok();
   });
 }
@@ -1045,6 +1083,7 @@ Status ReadMesh(const std::string& path, TriMesh* mesh, MeshReport* report) {
   }
   std::string text;
   SFT_RETURN_IF_ERROR(ReadTextFile(path, &text));
+  StripUtf8Bom(&text);
   if (text.find_first_not_of(" \t\r\n") == std::string::npos) {
     return Status::Error(path + ": empty file (no faces)");
   }

@@ -28,7 +28,10 @@ struct MeshReport {
   bool has_texcoords = false;  // per-corner UVs were read (OBJ vt / PLY texcoord).
 };
 
-// Reads OBJ, PLY (ascii/binary) or OFF by extension. Polygons are triangulated. Per-corner UVs are
+// Reads OBJ, PLY (ascii/binary) or OFF by extension. Polygons are triangulated by
+// TriangulatePolygon (polygon.h: ear clipping in their plane); a non-planar, self-intersecting or
+// over-large polygon is an error naming the file, the face index and (OBJ, OFF) its line. A
+// leading UTF-8 byte-order mark is skipped. Per-corner UVs are
 // read into halfedge texcoords when the file has them (report->has_texcoords). Errors (one line,
 // naming the file): missing/unreadable file, unknown extension, no faces, non-finite coordinates,
 // a face index out of range (detected before OpenMesh sees the file, since OpenMesh skips such

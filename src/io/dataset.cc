@@ -159,6 +159,24 @@ class SceneParser {
     return Status::Ok();
   }
 
+  // Width and height within kMaxCameraSide and their product within kMaxCameraPixels.
+  Status CheckCameraSize(const Camera& camera, const std::string& path) const {
+    for (const auto& [key, size] : {std::pair<const char*, int>{"width", camera.width},
+                                    std::pair<const char*, int>{"height", camera.height}}) {
+      if (size > kMaxCameraSide) {
+        return Error(Field(path, key), std::to_string(size) + " is larger than the maximum " +
+                                           std::to_string(kMaxCameraSide) + " pixels");
+      }
+    }
+    const int64_t pixels = static_cast<int64_t>(camera.width) * camera.height;
+    if (pixels > kMaxCameraPixels) {
+      return Error(path, SizeText(camera.width, camera.height) + " has " + std::to_string(pixels) +
+                             " pixels, more than the maximum " + std::to_string(kMaxCameraPixels) +
+                             " (2^30)");
+    }
+    return Status::Ok();
+  }
+
   // An array of exactly `n` finite numbers (any length when n < 0).
   Status Numbers(const json& value, const std::string& path, int n,
                  std::vector<double>* out) const {
@@ -231,6 +249,7 @@ class SceneParser {
       SFT_RETURN_IF_ERROR(PositiveInt(*value, Field(path, "width"), &camera.width));
       SFT_RETURN_IF_ERROR(Require(entry, path, "height", &value));
       SFT_RETURN_IF_ERROR(PositiveInt(*value, Field(path, "height"), &camera.height));
+      SFT_RETURN_IF_ERROR(CheckCameraSize(camera, path));
       SFT_RETURN_IF_ERROR(Require(entry, path, "params", &value));
       SFT_RETURN_IF_ERROR(Numbers(*value, Field(path, "params"), -1, &camera.params));
       std::string why;
@@ -521,6 +540,7 @@ Status ReadDataset(const std::string& dir, Dataset* dataset) {
   }
   std::string text;
   SFT_RETURN_IF_ERROR(ReadTextFile(file, &text));
+  StripUtf8Bom(&text);  // nlohmann::json skips it too; explicit for every reader.
   try {
     json root;
     try {

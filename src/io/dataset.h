@@ -20,6 +20,7 @@
 #define SFT_IO_DATASET_H_
 
 #include <Eigen/Core>
+#include <cstdint>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -33,6 +34,13 @@ namespace sft {
 enum class LightType { kPoint, kEnvironment };
 enum class LightFrame { kWorld, kCamera };  // a point light's `position` frame.
 enum class Background { kBlack, kEnvironment };
+
+// Largest camera accepted on read: at most 65536 pixels per side and 2^30 pixels (a 32768²
+// image) in all. Far above any camera (the largest sensors have ~150 megapixels), and pixel
+// indices stay within 32-bit integers. Whether a view that size fits into memory is checked
+// where it is rendered (MakeDatasetViews).
+constexpr int kMaxCameraSide = 65536;
+constexpr int64_t kMaxCameraPixels = int64_t{1} << 30;
 
 struct LightSpec {
   std::string id;

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cerrno>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -385,7 +386,13 @@ Status WritePng(const std::string& path, const Image& image, bool srgb) {
   }
   return WriteAtomically(path, [&](const std::string& tmp) {
     try {
-      if (!cv::imwrite(tmp, mat)) return PathError(path, "cannot write PNG");
+      errno = 0;
+      if (!cv::imwrite(tmp, mat)) {
+        // errno right after the failing call (OpenCV's fopen/fwrite set it; 0 means no reason).
+        const int error = errno;
+        return PathError(path, error != 0 ? "cannot write PNG (" + ErrnoText(error) + ")"
+                                          : std::string("cannot write PNG"));
+      }
     } catch (const cv::Exception& e) {
       return PathError(path, "cannot write PNG (" + std::string(e.what()) + ")");
     }

@@ -1,8 +1,39 @@
 #include "src/io/scene_setup.h"
 
+#include "src/core/memory.h"
+
 namespace sft {
 
+uint64_t EstimateViewRenderBytes(const Camera& camera) {
+  return kViewImageCopies * EstimateImageBytes(camera.width, camera.height, 4);
+}
+
+Status CheckViewsFitInMemory(const Dataset& dataset) {
+  int largest = -1;
+  uint64_t bytes = 0;
+  for (const ViewSpec& view : dataset.views) {
+    if (view.camera < 0 || view.camera >= static_cast<int>(dataset.cameras.size())) continue;
+    const uint64_t b = EstimateViewRenderBytes(dataset.cameras[view.camera]);
+    if (b > bytes) {
+      bytes = b;
+      largest = view.camera;
+    }
+  }
+  if (largest < 0) return Status::Ok();
+  const Camera& camera = dataset.cameras[largest];
+  std::string why;
+  if (!CheckMemoryBudget(bytes,
+                         "rendering one view of " + std::to_string(camera.width) + "x" +
+                             std::to_string(camera.height) + " pixels",
+                         &why)) {
+    return Status::Error("cameras[" + std::to_string(largest) + "] (\"" + camera.id +
+                         "\"): " + why);
+  }
+  return Status::Ok();
+}
+
 Status MakeDatasetViews(const Dataset& dataset, DatasetViews* out) {
+  SFT_RETURN_IF_ERROR(CheckViewsFitInMemory(dataset));
   out->environments.clear();
   out->environments.resize(dataset.lights.size());
   out->views.clear();

@@ -4,6 +4,7 @@
 #ifndef SFT_IO_SCENE_SETUP_H_
 #define SFT_IO_SCENE_SETUP_H_
 
+#include <cstdint>
 #include <memory>
 #include <vector>
 
@@ -19,8 +20,21 @@ struct DatasetViews {
   std::vector<ViewSetup> views;                               // point into `environments`.
 };
 
-// A view may use at most one environment light (more would need summed maps). Errors name the
-// view and light.
+// What rendering one view holds at once, in RGBA float images of the camera's size: the render,
+// the target read back for comparison, and the report's difference and thumbnails (about one
+// more). Derivative rows come on top of this.
+constexpr uint64_t kViewImageCopies = 3;
+
+// Bytes that rendering one view of `camera` needs (kViewImageCopies RGBA float images).
+uint64_t EstimateViewRenderBytes(const Camera& camera);
+
+// Refuses datasets whose largest view cannot be rendered in the memory available
+// (CheckMemoryBudget): the error names the camera, the estimate and the memory available.
+Status CheckViewsFitInMemory(const Dataset& dataset);
+
+// Checks that the views fit in memory (CheckViewsFitInMemory) before allocating anything. A view
+// may use at most one environment light (more would need summed maps). Errors name the view and
+// light, or the camera.
 Status MakeDatasetViews(const Dataset& dataset, DatasetViews* out);
 
 // The view indices to work on: `requested` when non-empty (each checked against [0, num_views);

@@ -1,6 +1,8 @@
 #include "src/render/camera.h"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace sft {
 namespace {
@@ -76,6 +78,59 @@ Eigen::Matrix2d DistortionJacobian(const Camera& camera, const Eigen::Vector2d& 
   j(1, 0) = v * d_radial * u + 2.0 * p2 * v + 2.0 * p1 * u;
   j(1, 1) = radial + v * d_radial * v + 2.0 * p2 * u + 6.0 * p1 * v;
   return j;
+}
+
+// The undistorted radius r (of normalized coordinates) up to which the radial distortion
+// r·(1 + k1 r² + k2 r⁴) increases: the smallest r > 0 with 1 + 3 k1 r² + 5 k2 r⁴ = 0, or +inf
+// when it increases everywhere. Beyond it the distortion folds back: image points past its image
+// d(r_max) have no preimage, and closer ones have a second, spurious preimage beyond r_max.
+double RadialMonotonicLimit(double k1, double k2) {
+  // Roots s = r² of 5 k2 s² + 3 k1 s + 1.
+  double s = std::numeric_limits<double>::infinity();
+  if (k2 == 0.0) {
+    if (k1 < 0.0) s = -1.0 / (3.0 * k1);
+  } else {
+    const double disc = 9.0 * k1 * k1 - 20.0 * k2;
+    if (disc >= 0.0) {
+      for (const double sign : {-1.0, 1.0}) {
+        const double root = (-3.0 * k1 + sign * std::sqrt(disc)) / (10.0 * k2);
+        if (root > 0.0) s = std::min(s, root);
+      }
+    }
+  }
+  return std::sqrt(s);
+}
+
+double RadialDistorted(double r, double k1, double k2) {
+  const double r2 = r * r;
+  return r * (1.0 + k1 * r2 + k2 * r2 * r2);
+}
+
+// Inverts the radial distortion on [0, r_max]: the r with RadialDistorted(r) = rd, by Newton's
+// method kept inside a shrinking bracket (the function increases there, so the root is unique).
+// False when rd lies past the fold (no preimage).
+bool InvertRadial(double rd, double k1, double k2, double r_max, double* r) {
+  double lo = 0.0, hi = r_max;
+  if (std::isinf(r_max)) {  // Increasing everywhere: find an upper bracket.
+    hi = std::max(1.0, rd);
+    while (RadialDistorted(hi, k1, k2) < rd) hi *= 2.0;
+  } else if (RadialDistorted(r_max, k1, k2) < rd) {
+    return false;
+  }
+  double x = std::min(rd, hi);
+  for (int iter = 0; iter < 200; ++iter) {
+    const double f = RadialDistorted(x, k1, k2) - rd;
+    if (std::abs(f) <= 1e-15 * std::max(1.0, rd)) break;
+    (f < 0.0 ? lo : hi) = x;
+    const double x2 = x * x;
+    const double slope = 1.0 + 3.0 * k1 * x2 + 5.0 * k2 * x2 * x2;
+    double next = slope > 0.0 ? x - f / slope : 0.5 * (lo + hi);
+    if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
+    if (next == x) break;
+    x = next;
+  }
+  *r = x;
+  return true;
 }
 
 }  // namespace
@@ -154,15 +209,37 @@ Eigen::Matrix<double, 2, 3> Camera::ImageFromCamJacobian(const Eigen::Vector3d& 
   return Focal().asDiagonal() * d_distorted * d_uv;
 }
 
-Eigen::Vector3d Camera::CamFromImage(const Eigen::Vector2d& pixel) const {
+double Camera::MaxUndistortedRadius() const {
+  double k1, k2, p1, p2;
+  if (!DistortionCoefficients(*this, &k1, &k2, &p1, &p2)) {
+    return std::numeric_limits<double>::infinity();
+  }
+  return RadialMonotonicLimit(k1, k2);
+}
+
+bool Camera::RayFromImage(const Eigen::Vector2d& pixel, Eigen::Vector3d* ray) const {
   const Eigen::Vector2d distorted = (pixel - Principal()).cwiseQuotient(Focal());
-  Eigen::Vector2d uv = distorted;
-  if (model != CameraModel::kPinhole && model != CameraModel::kSimplePinhole) {
-    // Newton's method on g(uv) = uv + D(uv) - distorted with a central-difference Jacobian,
-    // as COLMAP's IterativeUndistortion; converges in a few steps for realistic distortion.
+  double k1, k2, p1, p2;
+  if (!DistortionCoefficients(*this, &k1, &k2, &p1, &p2)) {
+    *ray = Eigen::Vector3d(distorted.x(), distorted.y(), 1.0);
+    return true;
+  }
+  // The radial part alone, inverted on the increasing branch [0, r_max].
+  const double r_max = RadialMonotonicLimit(k1, k2);
+  const double rd = distorted.norm();
+  double r = 0.0;
+  if (!InvertRadial(rd, k1, k2, r_max, &r)) return false;
+  Eigen::Vector2d uv = rd > 0.0 ? Eigen::Vector2d(distorted * (r / rd)) : distorted;
+  if (p1 != 0.0 || p2 != 0.0) {
+    // Tangential terms: Newton's method on g(uv) = uv + D(uv) − distorted with a central-
+    // difference Jacobian, as COLMAP's IterativeUndistortion, from the radial solution.
+    bool converged = false;
     for (int iter = 0; iter < 100; ++iter) {
       const Eigen::Vector2d residual = uv + Distortion(*this, uv) - distorted;
-      if (residual.squaredNorm() < 1e-28) break;
+      if (residual.squaredNorm() < 1e-28) {
+        converged = true;
+        break;
+      }
       Eigen::Matrix2d jacobian;
       for (int d = 0; d < 2; ++d) {
         const double step = 1e-7 * std::max(1.0, std::abs(uv[d]));
@@ -175,8 +252,20 @@ Eigen::Vector3d Camera::CamFromImage(const Eigen::Vector2d& pixel) const {
       if (!delta.allFinite()) break;
       uv -= delta;
     }
+    // A solution past the radial fold belongs to the spurious branch; one that was not reached
+    // (residual above 1e-7 of the normalized image) is no solution.
+    const double error = (uv + Distortion(*this, uv) - distorted).norm();
+    if (!converged && !(error < 1e-7)) return false;
+    if (!(uv.norm() <= r_max) || !uv.allFinite()) return false;
   }
-  return {uv.x(), uv.y(), 1.0};
+  *ray = Eigen::Vector3d(uv.x(), uv.y(), 1.0);
+  return true;
+}
+
+Eigen::Vector3d Camera::CamFromImage(const Eigen::Vector2d& pixel) const {
+  Eigen::Vector3d ray;
+  if (!RayFromImage(pixel, &ray)) return Eigen::Vector3d::Zero();
+  return ray;
 }
 
 }  // namespace sft

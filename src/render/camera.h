@@ -53,8 +53,19 @@ struct Camera {
   // ∂ImageFromCam/∂p_in_cam (2×3), analytic, distortion included (z > 0).
   Eigen::Matrix<double, 2, 3> ImageFromCamJacobian(const Eigen::Vector3d& p_in_cam) const;
   // Inverse of ImageFromCam up to scale: a direction (x, y, 1) in the camera frame whose
-  // projection is `pixel`. Distortion is inverted by Newton iterations (as COLMAP does).
+  // projection is `pixel`. False when no ray projects there: past the fold of a distortion whose
+  // radial part r·(1 + k1 r² + k2 r⁴) stops increasing at r = MaxUndistortedRadius() (e.g. a
+  // strongly negative k1), or where the tangential terms' Newton iteration does not converge.
+  // The radial part is inverted on its increasing branch only, so no pixel gets the spurious
+  // preimage beyond the fold.
+  bool RayFromImage(const Eigen::Vector2d& pixel, Eigen::Vector3d* ray) const;
+  // RayFromImage's ray, or the zero vector for pixels without one. A zero direction is the
+  // renderer's "no ray": Embree finds no hit along it (it asserts on NaN directions, so NaN is not
+  // an option) and the environment gives it no radiance, so the sample is empty (black, alpha 0).
   Eigen::Vector3d CamFromImage(const Eigen::Vector2d& pixel) const;
+  // The undistorted radius (normalized coordinates) up to which the radial distortion increases;
+  // +inf for the pinhole models and distortions that increase everywhere.
+  double MaxUndistortedRadius() const;
 
   // Focal lengths in pixels (fx, fy).
   Eigen::Vector2d Focal() const;

@@ -67,6 +67,8 @@ void EnvironmentMap::TexelOf(const Eigen::Vector3d& dir, int* x, int* y) const {
 }
 
 Eigen::Vector3d EnvironmentMap::Radiance(const Eigen::Vector3d& dir) const {
+  // A zero or non-finite direction is no ray (Camera::CamFromImage past a distortion's fold).
+  if (!(dir.squaredNorm() > 0.0) || !dir.allFinite()) return Eigen::Vector3d::Zero();
   int x, y;
   TexelOf(dir, &x, &y);
   return texels_[static_cast<size_t>(y) * width_ + x].cast<double>();

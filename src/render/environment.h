@@ -19,7 +19,8 @@ class EnvironmentMap {
   // `rgb` must have 3 or 4 channels (alpha ignored).
   EnvironmentMap(const Image& rgb, const Eigen::Matrix3d& world_from_env, double scale);
 
-  // Radiance arriving from world direction `dir` (unit), i.e. seen looking along `dir`.
+  // Radiance arriving from world direction `dir` (unit), i.e. seen looking along `dir`; zero for
+  // a zero or non-finite `dir` (no ray, see Camera::CamFromImage).
   Eigen::Vector3d Radiance(const Eigen::Vector3d& dir) const;
 
   // Samples a world direction with two uniforms; returns false when the map is black.

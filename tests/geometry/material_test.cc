@@ -442,6 +442,66 @@ TEST(MaterialTest, ProceduralDeterministicAndInRange) {
   }
 }
 
+// A texture much finer than the texel regions is box-filtered to a mip level before sampling
+// (memory: docs/design-notes.md 2026-11-24). A 1024² linear gradient on UVs [0.25, 0.75]² at
+// resolution 2 is reduced 16× (texel regions 256 pixels across, kept at >= 16); box filtering
+// keeps a linear function linear with its samples at the block centres, so each texel must still
+// be the value at its region's centroid, which a half-pixel misalignment of the mip would break.
+TEST(MaterialTest, ReducedTextureKeepsLinearGradientExact) {
+  testing::TempDir tmp;
+  const TriMesh mesh = UvQuad(tmp, 0.25, 0.75);
+  const int n = 1024;
+  Image texture(n, n, 3);
+  for (int y = 0; y < n; ++y) {
+    for (int x = 0; x < n; ++x) {
+      texture.at(x, y, 0) = (x + 0.5f) / n;
+      texture.at(x, y, 1) = (y + 0.5f) / n;
+      texture.at(x, y, 2) = 0.5f;
+    }
+  }
+  ASSERT_TRUE(WriteExr(tmp.Join("tex.exr"), texture).ok());
+  Material m;
+  ASSERT_TRUE(
+      LoadMaterial(R"({"albedo_texture": ")" + tmp.Join("tex.exr") + R"(", "resolution": 2})", mesh,
+                   &m)
+          .ok());
+  const std::vector<Eigen::Vector2d> uvs = FaceCornerUvs(mesh);
+  const int r = 2;
+  for (int f = 0; f < 2; ++f) {
+    for (int i = 0; i <= r; ++i) {
+      for (int j = 0; i + j <= r; ++j) {
+        const Eigen::Vector2d ab = MeshColors::TexelCenter(r, i, j);
+        const Eigen::Vector2d uv =
+            (1 - ab.x() - ab.y()) * uvs[3 * f] + ab.x() * uvs[3 * f + 1] + ab.y() * uvs[3 * f + 2];
+        const double* texel =
+            m.albedo.texel(f * MeshColors::TexelsPerFace(r) + MeshColors::LocalIndex(r, i, j));
+        EXPECT_NEAR(texel[0], uv.x(), 1e-5) << f << " " << i << " " << j;
+        EXPECT_NEAR(texel[1], 1 - uv.y(), 1e-5) << f << " " << i << " " << j;
+        EXPECT_NEAR(texel[2], 0.5, 1e-6);
+      }
+    }
+  }
+}
+
+// Texture values: non-finite ones are an error naming the pixel; values outside [0, 1] (HDR
+// textures) are clamped (and reported in a warning), unlike constants, which are refused.
+TEST(MaterialTest, TextureValuesCheckedAndClamped) {
+  testing::TempDir tmp;
+  const TriMesh mesh = UvQuad(tmp, 0.0, 1.0);
+  Image texture(2, 2, 3, 0.5f);
+  texture.at(1, 0, 2) = std::nanf("");
+  ASSERT_TRUE(WriteExr(tmp.Join("nan.exr"), texture).ok());
+  Material m;
+  Status status = LoadMaterial(R"({"albedo_texture": ")" + tmp.Join("nan.exr") + R"("})", mesh, &m);
+  ASSERT_FALSE(status.ok());
+  EXPECT_THAT(status.message(), HasSubstr("\"albedo_texture\": " + tmp.Join("nan.exr") +
+                                          ": pixel (1, 0) has a non-finite value"));
+  ASSERT_TRUE(WriteExr(tmp.Join("hdr.exr"), Image(2, 2, 3, 7.0f)).ok());
+  status = LoadMaterial(R"({"albedo_texture": ")" + tmp.Join("hdr.exr") + R"("})", mesh, &m);
+  ASSERT_TRUE(status.ok()) << status.message();
+  for (double v : m.albedo.values()) EXPECT_EQ(v, 1.0);
+}
+
 TEST(MaterialTest, ErrorsNameTheField) {
   testing::TempDir tmp;
   const TriMesh quad = ReadFixture("quad_z0_2x2_2f.obj");  // No UVs.
@@ -466,6 +526,8 @@ TEST(MaterialTest, ErrorsNameTheField) {
       {R"({"roughness": "x"})", {"\"roughness\""}},
       {R"({"specular": -0.1})", {"\"specular\""}},
       {R"({"specular": 1.5, "fresnel": "schlick"})", {"\"specular\"", "[0, 1]"}},
+      {R"({"specular": 1e20})", {"\"specular\"", "[0, 1]", "1e+20"}},  // Gave inf pixels.
+      {R"({"specular": 1.5})", {"\"specular\"", "[0, 1]", "1.5"}},
       {R"({"fresnel": "fresnel"})", {"\"fresnel\""}},
       {R"({"resolution": 0})", {"\"resolution\"", "[1, 64]"}},
       {R"({"resolution": 65})", {"\"resolution\""}},

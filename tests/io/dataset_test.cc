@@ -9,7 +9,9 @@
 #include <string>
 #include <vector>
 
+#include "src/core/memory.h"
 #include "src/io/image_io.h"
+#include "src/io/scene_setup.h"
 #include "tests/testing/temp_dir.h"
 
 namespace sft {
@@ -261,6 +263,55 @@ TEST(DatasetErrors, BadCameraSize) {
   EXPECT_THAT(ReadError(scene), HasSubstr("cameras[0].height"));
   scene["cameras"][0].erase("height");
   EXPECT_THAT(ReadError(scene), HasSubstr("cameras[0].height: missing"));
+}
+
+// Sizes beyond kMaxCameraSide per side or kMaxCameraPixels in all are refused on read (a
+// 100000² camera used to end in std::bad_alloc when rendered).
+TEST(DatasetErrors, CameraTooLarge) {
+  json scene = MinimalScene();
+  scene["cameras"][0]["width"] = 100000;
+  EXPECT_THAT(ReadError(scene),
+              HasSubstr("cameras[0].width: 100000 is larger than the maximum 65536 pixels"));
+  scene["cameras"][0]["width"] = 65536;
+  scene["cameras"][0]["height"] = 65536;
+  EXPECT_THAT(ReadError(scene), HasSubstr("cameras[0]: 65536x65536 has 4294967296 pixels, more "
+                                          "than the maximum 1073741824"));
+  scene["cameras"][0]["height"] = 16384;  // Exactly 2^30 pixels: accepted.
+  TempDir dir;
+  WriteJson(dir.path(), scene);
+  Dataset dataset;
+  EXPECT_TRUE(ReadDataset(dir.path(), &dataset).ok());
+}
+
+// A camera that passes the read limits but whose views cannot be rendered in the memory this
+// machine has is refused before anything is allocated, naming the camera and both sizes.
+TEST(DatasetErrors, ViewsThatDoNotFitInMemory) {
+  json scene = MinimalScene();
+  scene["cameras"][0]["width"] = 32768;
+  scene["cameras"][0]["height"] = 32768;
+  TempDir dir;
+  WriteJson(dir.path(), scene);
+  Dataset dataset;
+  ASSERT_TRUE(ReadDataset(dir.path(), &dataset).ok());
+  const uint64_t needed = EstimateViewRenderBytes(dataset.cameras[0]);
+  EXPECT_EQ(needed, 3 * 16 * (uint64_t{1} << 30));  // 48 GiB.
+  if (AvailableMemoryBytes() >= needed) GTEST_SKIP() << "this machine has 48 GiB available";
+  DatasetViews views;
+  const Status status = MakeDatasetViews(dataset, &views);
+  ASSERT_FALSE(status.ok());
+  EXPECT_THAT(status.message(), HasSubstr("cameras[0] (\"c0\"): rendering one view of "
+                                          "32768x32768 pixels needs an estimated 48 GB, more "
+                                          "than the "));
+  EXPECT_TRUE(views.views.empty());
+}
+
+// A UTF-8 byte-order mark before the JSON is skipped.
+TEST(DatasetRead, ByteOrderMarkIsSkipped) {
+  TempDir dir;
+  std::ofstream(dir.Join("scene.json")) << "\xEF\xBB\xBF" << MinimalScene().dump(1);
+  Dataset dataset;
+  const Status status = ReadDataset(dir.path(), &dataset);
+  EXPECT_TRUE(status.ok()) << status.message();
 }
 
 TEST(DatasetErrors, DuplicateCameraId) {
