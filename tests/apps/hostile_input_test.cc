@@ -217,6 +217,12 @@ TEST_F(HostileInputTest, Datasets) {
       {"zero quaternion", EditScene("\"rotation\": [", "\"rotation\": [0, 0, 0, 0], \"x\": ["),
        render, false, {}, "rotation"},
       {"camera width 0", EditScene("\"width\": 16", "\"width\": 0"), render, false, {}, "width"},
+      {"camera of 100000 x 100000",
+       [](const fs::path& d) {
+         EditScene("\"width\": 16", "\"width\": 100000")(d);
+         EditScene("\"height\": 16", "\"height\": 100000")(d);
+       },
+       render, false, {}, "scene.json"},
       {"two views of one image: two outputs",
        EditScene("\"images/001.exr\"", "\"images/000.exr\""), render, true,
        {"out/images/000.exr", "out/images/000_view001.exr"}, ""},
@@ -265,6 +271,20 @@ TEST_F(HostileInputTest, Meshes) {
        [](const fs::path& d) { Write(d / "m.off", "OFF\n-3 -1 0\n"); },
        "render --quiet --dataset {ds} --mesh {dir}/m.off --spp 2 --out {out}", false, {},
        "m.off"},
+      {"unreferenced vertex at 1e23 (renders as without it)",
+       [](const fs::path& d) {
+         std::string obj = Read(d / "mesh.obj");
+         Write(d / "mesh.obj", "v 1e23 0 0\n" + obj);
+       },
+       render, true, {"out/images/000.exr"}, ""},
+      {"concave polygon that is not planar",
+       mesh("v 0 0 0\nv 2 0 0\nv 2 2 1\nv 1 0.5 0\nv 0 2 0\nf 1 2 3 4 5\n"), render, false, {},
+       "not planar"},
+      {"self-intersecting quad", mesh("v 0 0 0\nv 1 1 0\nv 1 0 0\nv 0 1 0\nf 1 2 3 4\n"),
+       render, false, {}, "mesh.obj"},
+      {"byte-order mark", [](const fs::path& d) {
+         Write(d / "mesh.obj", "\xEF\xBB\xBF" + Read(d / "mesh.obj"));
+       }, render, true, {"out/images/000.exr"}, ""},
       {"unknown extension", [](const fs::path& d) { Write(d / "m.stl", "solid x\n"); },
        "render --quiet --dataset {ds} --mesh {dir}/m.stl --spp 2 --out {out}", false, {}, "m.stl"},
   });
@@ -284,6 +304,9 @@ TEST_F(HostileInputTest, Materials) {
       {"texture on a mesh without UVs", material("{\"albedo_texture\": \"nope.png\"}"), render,
        false, {}, "albedo_texture"},
       {"not an object", material("[1, 2, 3]"), render, false, {}, "material.json"},
+      {"specular 1e20", material("{\"specular\": 1e20}"), render, false, {}, "specular"},
+      {"specular NaN-like string", material("{\"specular\": \"nan\"}"), render, false, {},
+       "specular"},
   });
 }
 
@@ -346,6 +369,19 @@ TEST_F(HostileInputTest, Options) {
        "res"},
       {"synth --cameras 0", nullptr, "synth --quiet --mesh {mesh} --out {out} --cameras 0", false,
        {}, "cameras"},
+      {"synth --light-offset nan", nullptr,
+       "synth --quiet --mesh {mesh} --out {out} --light-offset nan,0,0", false, {},
+       "light-offset"},
+      {"synth --light-intensity -1", nullptr,
+       "synth --quiet --mesh {mesh} --out {out} --light-intensity -1", false, {},
+       "light-intensity"},
+      {"reconstruct --steps 0", nullptr,
+       "reconstruct --quiet --dataset {ds} --init {mesh} --out {out} --steps 0", false, {},
+       "--steps"},
+      {"reconstruct --out is the dataset", nullptr,
+       "reconstruct --quiet --dataset {ds} --init {mesh} --out {ds}", false, {}, "--out"},
+      {"eval --json onto the mesh", nullptr,
+       "eval --reference {mesh} --mesh {mesh} --samples 100 --json {mesh}", false, {}, "--json"},
       {"synth --fov 200", nullptr, "synth --quiet --mesh {mesh} --out {out} --fov 200", false,
        {}, "fov"},
       {"gradcheck --param bogus", nullptr,
