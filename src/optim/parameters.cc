@@ -31,6 +31,10 @@ ParameterSelection ActiveParameters::ToSelection() const {
   return selection;
 }
 
+bool ActiveParameters::Includes(ParameterKind kind) const {
+  return ToSelection().Selected(kind);
+}
+
 SceneParameters::SceneParameters(const std::vector<Eigen::Vector3d>& positions,
                                  const Material& material, int num_lights) {
   layout_.num_vertices = static_cast<int>(positions.size());

@@ -39,6 +39,7 @@ struct ActiveParameters {
   bool lights = false;
 
   ParameterSelection ToSelection() const;
+  bool Includes(ParameterKind kind) const;
   bool Any() const { return vertices || albedo || roughness || specular || lights; }
 };
 

@@ -198,22 +198,35 @@ void RenderCache::StoreRender(int v, const Image& image, const JacobianRows* row
   pyramid_seconds_ += Seconds(start);
 }
 
+namespace {
+
+// Σ over the active pixels and RGB of (render − target)², and the count of terms.
+void SquaredError(const LevelCache& level, const std::vector<uint8_t>& active, double* sum,
+                  int64_t* count) {
+  *sum = 0.0;
+  *count = 0;
+  for (int y = 0; y < level.render.height; ++y) {
+    for (int x = 0; x < level.render.width; ++x) {
+      if (!active[static_cast<size_t>(y) * level.render.width + x]) continue;
+      for (int c = 0; c < 3; ++c) {
+        const double r = level.render.at(x, y, c) - level.target.at(x, y, c);
+        *sum += r * r;
+      }
+      *count += 3;
+    }
+  }
+}
+
+}  // namespace
+
 double RenderCache::ImageCost() const {
   double cost = 0.0;
   for (int v = 0; v < num_views(); ++v) {
     for (int l = 0; l < num_levels(v); ++l) {
       const LevelCache& level = *levels_[v][l];
-      const std::vector<uint8_t>& active = targets_[v].active[l];
       double sum = 0.0;
-      for (int y = 0; y < level.render.height; ++y) {
-        for (int x = 0; x < level.render.width; ++x) {
-          if (!active[static_cast<size_t>(y) * level.render.width + x]) continue;
-          for (int c = 0; c < 3; ++c) {
-            const double r = level.render.at(x, y, c) - level.target.at(x, y, c);
-            sum += r * r;
-          }
-        }
-      }
+      int64_t count = 0;
+      SquaredError(level, targets_[v].active[l], &sum, &count);
       cost += 0.5 * level.sqrt_weight * level.sqrt_weight * sum;
     }
   }
@@ -223,21 +236,10 @@ double RenderCache::ImageCost() const {
 std::vector<double> RenderCache::ViewMse() const {
   std::vector<double> mse(num_views(), 0.0);
   for (int v = 0; v < num_views(); ++v) {
-    const LevelCache& level = *levels_[v][0];
-    const std::vector<uint8_t>& active = targets_[v].active[0];
     double sum = 0.0;
-    int64_t n = 0;
-    for (int y = 0; y < level.render.height; ++y) {
-      for (int x = 0; x < level.render.width; ++x) {
-        if (!active[static_cast<size_t>(y) * level.render.width + x]) continue;
-        for (int c = 0; c < 3; ++c) {
-          const double r = level.render.at(x, y, c) - level.target.at(x, y, c);
-          sum += r * r;
-          ++n;
-        }
-      }
-    }
-    mse[v] = n > 0 ? sum / n : 0.0;
+    int64_t count = 0;
+    SquaredError(*levels_[v][0], targets_[v].active[0], &sum, &count);
+    mse[v] = count > 0 ? sum / count : 0.0;
   }
   return mse;
 }

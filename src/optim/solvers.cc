@@ -109,15 +109,8 @@ AdjointObjective::AdjointObjective(RenderCache* cache, SceneParameters* params,
                                    const ParameterBounds& bounds, ceres::Problem* regularizers)
     : cache_(cache), params_(params), bounds_(bounds), regularizers_(regularizers) {
   const ParameterLayout& layout = params->layout();
-  const ActiveParameters& a = cache->active();
   for (int i = 0; i < layout.size(); ++i) {
-    const ParameterKind kind = layout.KindOf(i);
-    const bool on = (kind == ParameterKind::kVertex && a.vertices) ||
-                    (kind == ParameterKind::kAlbedo && a.albedo) ||
-                    (kind == ParameterKind::kRoughness && a.roughness) ||
-                    (kind == ParameterKind::kSpecular && a.specular) ||
-                    (kind == ParameterKind::kLight && a.lights);
-    if (on) active_.push_back(i);
+    if (cache->active().Includes(layout.KindOf(i))) active_.push_back(i);
   }
 }
 

@@ -13,17 +13,10 @@
 namespace sft {
 namespace {
 
+using testing::CountLines;
+using testing::RunSft;
+
 using ::testing::HasSubstr;
-
-int Sft(const std::string& args, std::string* output) {
-  return testing::RunCommand(testing::SftBinary() + " " + args, output);
-}
-
-int CountLines(const std::string& text) {
-  int lines = 0;
-  for (char c : text) lines += c == '\n';
-  return lines;
-}
 
 // A copy of the bunny point-light dataset's scene.json whose camera is width × height (the
 // images are not needed: the commands stop before reading them).
@@ -46,7 +39,7 @@ TEST(CliInputTest, HugeCameraIsOneErrorNotBadAlloc) {
   std::string out;
   std::string dataset = HugeCameraDataset(tmp, 100000, 100000);
   EXPECT_EQ(
-      Sft("render --quiet --dataset " + dataset + " --mesh " + mesh + " --out " + tmp.Join("o"),
+      RunSft("render --quiet --dataset " + dataset + " --mesh " + mesh + " --out " + tmp.Join("o"),
           &out),
       1)
       << out;
@@ -56,7 +49,7 @@ TEST(CliInputTest, HugeCameraIsOneErrorNotBadAlloc) {
   dataset = HugeCameraDataset(tmp, 32768, 32768);  // Within the read limits: 48 GiB to render.
   if (AvailableMemoryBytes() >= 48 * (uint64_t{1} << 30)) GTEST_SKIP() << "48 GiB available";
   EXPECT_EQ(
-      Sft("render --quiet --dataset " + dataset + " --mesh " + mesh + " --out " + tmp.Join("o"),
+      RunSft("render --quiet --dataset " + dataset + " --mesh " + mesh + " --out " + tmp.Join("o"),
           &out),
       1)
       << out;
@@ -91,7 +84,7 @@ TEST(CliInputTest, SynthFlagsOutOfRangeNameTheFlag) {
   for (const auto& [flags, message] : cases) {
     SCOPED_TRACE(flags);
     std::string out;
-    EXPECT_EQ(Sft(base + flags, &out), 1) << out;
+    EXPECT_EQ(RunSft(base + flags, &out), 1) << out;
     EXPECT_EQ(CountLines(out), 1) << out;
     EXPECT_THAT(out, HasSubstr(message));
     EXPECT_FALSE(std::filesystem::exists(tmp.Join("ds")));
@@ -100,7 +93,7 @@ TEST(CliInputTest, SynthFlagsOutOfRangeNameTheFlag) {
   // automatic value): the dataset's light has intensity 2.
   std::string out;
   ASSERT_EQ(
-      Sft(base + "--cameras 1 --zooms 1 --res 8 --spp 1 --light-intensity 2 --light-offset 0.1,0,0",
+      RunSft(base + "--cameras 1 --zooms 1 --res 8 --spp 1 --light-intensity 2 --light-offset 0.1,0,0",
           &out),
       0)
       << out;

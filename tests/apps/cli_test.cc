@@ -13,24 +13,17 @@
 namespace sft {
 namespace {
 
+using testing::CountLines;
+using testing::RunSft;
+
 using ::testing::HasSubstr;
-
-int Sft(const std::string& args, std::string* output) {
-  return testing::RunCommand(testing::SftBinary() + " " + args, output);
-}
-
-int CountLines(const std::string& text) {
-  int lines = 0;
-  for (char c : text) lines += c == '\n';
-  return lines;
-}
 
 TEST(CliTest, HelpListsCommands) {
   std::string out;
-  EXPECT_EQ(Sft("--help", &out), 0);
+  EXPECT_EQ(RunSft("--help", &out), 0);
   EXPECT_THAT(out, HasSubstr("synth"));
   EXPECT_THAT(out, HasSubstr("render"));
-  EXPECT_EQ(Sft("render --help", &out), 0);
+  EXPECT_EQ(RunSft("render --help", &out), 0);
   EXPECT_THAT(out, HasSubstr("--bounces"));
   EXPECT_THAT(out, HasSubstr("--pass"));
 }
@@ -41,7 +34,7 @@ TEST(CliTest, SynthThenRenderRoundTrip) {
   testing::TempDir tmp;
   const std::string mesh = testing::DataDir() + "/meshes/icosphere_r1_320f.obj";
   std::string out;
-  ASSERT_EQ(Sft("synth --quiet --mesh " + mesh + " --out " + tmp.Join("ds") +
+  ASSERT_EQ(RunSft("synth --quiet --mesh " + mesh + " --out " + tmp.Join("ds") +
                     " --cameras 3 --zooms 1,2 --res 24 --spp 64 --bounces 2 "
                     "--material '{\"albedo\": [0.5, 0.4, 0.3], \"roughness\": 0.3, "
                     "\"specular\": 0.2}'",
@@ -57,7 +50,7 @@ TEST(CliTest, SynthThenRenderRoundTrip) {
   EXPECT_TRUE(std::filesystem::exists(tmp.Join("ds/gt/mesh.ply")));
   EXPECT_FALSE(std::filesystem::exists(tmp.Join("ds.partial")));
 
-  ASSERT_EQ(Sft("render --quiet --dataset " + tmp.Join("ds") + " --mesh " +
+  ASSERT_EQ(RunSft("render --quiet --dataset " + tmp.Join("ds") + " --mesh " +
                     tmp.Join("ds/gt/mesh.ply") + " --material " + tmp.Join("ds/gt/material.json") +
                     " --spp 64 --bounces 2 --seed 7 --out " + tmp.Join("r"),
                 &out),
@@ -93,7 +86,7 @@ TEST(CliTest, SynthWithEnvironmentAndProceduralMaterial) {
   const std::string mesh = testing::DataDir() + "/meshes/icosphere_r1_320f.obj";
   const std::string probe = testing::DataDir() + "/cycles/sphere_env_studio/probes/studio.exr";
   std::string out;
-  ASSERT_EQ(Sft("synth --quiet --mesh " + mesh + " --out " + tmp.Join("ds") + " --envmap " + probe +
+  ASSERT_EQ(RunSft("synth --quiet --mesh " + mesh + " --out " + tmp.Join("ds") + " --envmap " + probe +
                     " --background-environment --cameras 2 --zooms 1 --res 16 --spp 8 "
                     "--bounces 1 --material '{\"procedural\": \"wood\", \"colors\": "
                     "[[0.8, 0.6, 0.3], [0.3, 0.2, 0.1]], \"roughness\": 0.4, \"resolution\": 4}'",
@@ -111,7 +104,7 @@ TEST(CliTest, SynthWithEnvironmentAndProceduralMaterial) {
   // The background shows the probe: the corner pixel is not black.
   EXPECT_GT(image.at(0, 0, 0) + image.at(0, 0, 1) + image.at(0, 0, 2), 0.0f);
 
-  ASSERT_EQ(Sft("render --quiet --dataset " + tmp.Join("ds") + " --mesh " +
+  ASSERT_EQ(RunSft("render --quiet --dataset " + tmp.Join("ds") + " --mesh " +
                     tmp.Join("ds/gt/mesh.ply") + " --material " + tmp.Join("ds/gt/material.json") +
                     " --pass albedo --spp 4 --out " + tmp.Join("r"),
                 &out),
@@ -136,38 +129,38 @@ TEST(CliTest, SynthWithEnvironmentAndProceduralMaterial) {
 TEST(CliTest, BadInputGivesOneLineAndNonZeroExit) {
   testing::TempDir tmp;
   std::string out;
-  EXPECT_NE(Sft("synth --mesh " + tmp.Join("missing.obj") + " --out " + tmp.Join("ds"), &out), 0);
+  EXPECT_NE(RunSft("synth --mesh " + tmp.Join("missing.obj") + " --out " + tmp.Join("ds"), &out), 0);
   EXPECT_EQ(CountLines(out), 1) << out;
   EXPECT_THAT(out, HasSubstr("missing.obj"));
 
   EXPECT_NE(
-      Sft("render --dataset " + tmp.Join("nope") + " --mesh x.obj --out " + tmp.Join("o"), &out),
+      RunSft("render --dataset " + tmp.Join("nope") + " --mesh x.obj --out " + tmp.Join("o"), &out),
       0);
   EXPECT_EQ(CountLines(out), 1) << out;
   EXPECT_THAT(out, HasSubstr("nope"));
 
   const std::string ds = testing::DataDir() + "/cycles/bunny_point_diffuse";
-  EXPECT_NE(Sft("render --dataset " + ds + " --mesh " + ds + "/gt/mesh.ply --bounces 0 --out " +
+  EXPECT_NE(RunSft("render --dataset " + ds + " --mesh " + ds + "/gt/mesh.ply --bounces 0 --out " +
                     tmp.Join("o"),
                 &out),
             0);
   EXPECT_EQ(CountLines(out), 1) << out;
   EXPECT_THAT(out, HasSubstr("bounces"));
 
-  EXPECT_NE(Sft("render --dataset " + ds + " --mesh " + ds + "/gt/mesh.ply --pass glow --out " +
+  EXPECT_NE(RunSft("render --dataset " + ds + " --mesh " + ds + "/gt/mesh.ply --pass glow --out " +
                     tmp.Join("o"),
                 &out),
             0);
   EXPECT_THAT(out, HasSubstr("--pass"));
 
-  EXPECT_NE(Sft("render --dataset " + ds + " --mesh " + ds +
+  EXPECT_NE(RunSft("render --dataset " + ds + " --mesh " + ds +
                     "/gt/mesh.ply --material '{\"albedo\": [2, 0, 0]}' --out " + tmp.Join("o"),
                 &out),
             0);
   EXPECT_EQ(CountLines(out), 1) << out;
   EXPECT_THAT(out, HasSubstr("albedo"));
 
-  EXPECT_NE(Sft("synth --mesh x.obj", &out), 0);  // --out missing: usage error.
+  EXPECT_NE(RunSft("synth --mesh x.obj", &out), 0);  // --out missing: usage error.
   EXPECT_THAT(out, HasSubstr("--out"));
   EXPECT_FALSE(std::filesystem::exists(tmp.Join("o/images")));
 }

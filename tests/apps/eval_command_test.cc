@@ -12,25 +12,18 @@
 namespace sft {
 namespace {
 
+using testing::CountLines;
+using testing::RunSft;
+
 using ::testing::HasSubstr;
 using ::testing::StartsWith;
-
-int Sft(const std::string& args, std::string* output) {
-  return testing::RunCommand(testing::SftBinary() + " " + args, output);
-}
-
-int CountLines(const std::string& text) {
-  int lines = 0;
-  for (char c : text) lines += c == '\n';
-  return lines;
-}
 
 std::string Sphere() { return testing::DataDir() + "/meshes/icosphere_r1_1280f.obj"; }
 
 TEST(EvalCommandTest, PrintsJsonAndWritesIt) {
   testing::TempDir tmp;
   std::string out;
-  ASSERT_EQ(Sft("eval --reference " + Sphere() + " --mesh " + Sphere() +
+  ASSERT_EQ(RunSft("eval --reference " + Sphere() + " --mesh " + Sphere() +
                     " --samples 20000 --seed 3 --json " + tmp.Join("sub/eval.json"),
                 &out),
             0)
@@ -71,7 +64,7 @@ TEST(EvalCommandTest, DifferentMeshes) {
   testing::WriteTestFile(tmp.Join("moved.obj"), moved.str());
   std::string out;
   ASSERT_EQ(
-      Sft("eval --reference " + Sphere() + " --mesh " + tmp.Join("moved.obj") + " --samples 50000",
+      RunSft("eval --reference " + Sphere() + " --mesh " + tmp.Join("moved.obj") + " --samples 50000",
           &out),
       0)
       << out;
@@ -104,7 +97,7 @@ TEST(EvalCommandTest, ErrorsAreOneLineNamingTheFileOrFlag) {
   for (const auto& c : cases) {
     SCOPED_TRACE(c.args);
     std::string out;
-    EXPECT_NE(Sft(c.args, &out), 0);
+    EXPECT_NE(RunSft(c.args, &out), 0);
     EXPECT_EQ(CountLines(out), 1) << out;
     EXPECT_THAT(out, StartsWith("sft eval: error: "));
     EXPECT_THAT(out, HasSubstr(c.expected));

@@ -24,6 +24,9 @@
 namespace sft {
 namespace {
 
+using testing::CountLines;
+using testing::RunSft;
+
 namespace fs = std::filesystem;
 
 // Every regular file and symlink below `root` (relative path -> contents, or "-> target"),
@@ -54,12 +57,6 @@ std::map<std::string, std::string> Snapshot(const fs::path& root,
     }
   }
   return files;
-}
-
-int CountLines(const std::string& text) {
-  int lines = 0;
-  for (char c : text) lines += c == '\n';
-  return lines + (!text.empty() && text.back() != '\n');
 }
 
 // A case: `prepare` edits the case folder; `args` is the command line after `sft`, in which

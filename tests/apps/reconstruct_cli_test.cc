@@ -14,24 +14,17 @@
 namespace sft {
 namespace {
 
+using testing::CountLines;
+using testing::RunSft;
+
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
-
-int Sft(const std::string& args, std::string* output) {
-  return testing::RunCommand(testing::SftBinary() + " " + args, output);
-}
 
 std::string ReadAll(const std::string& path) {
   std::ifstream in(path);
   std::stringstream ss;
   ss << in.rdbuf();
   return ss.str();
-}
-
-int CountLines(const std::string& text) {
-  int n = 0;
-  for (char c : text) n += c == '\n';
-  return n;
 }
 
 // Geometry and texture from a perturbed sphere: the run writes every output, the cost drops,
@@ -43,14 +36,14 @@ TEST(ReconstructCliTest, ReconstructEvalResume) {
                                     "--material '{\"albedo\": [0.6, 0.5, 0.4], \"roughness\": 0.5}'"),
             "");
   std::string out;
-  ASSERT_EQ(Sft("perturb --mesh " + tmp.Join("ds/gt/mesh.ply") + " --out " + tmp.Join("init.ply") +
+  ASSERT_EQ(RunSft("perturb --mesh " + tmp.Join("ds/gt/mesh.ply") + " --out " + tmp.Join("init.ply") +
                     " --amplitude 0.02 --seed 2",
                 &out),
             0)
       << out;
   const std::string common = "reconstruct --quiet --dataset " + tmp.Join("ds") +
                              " --spp 8 --bounces 1 --steps 2 --phases alternate";
-  ASSERT_EQ(Sft(common + " --init " + tmp.Join("init.ply") + " --out " + tmp.Join("r") +
+  ASSERT_EQ(RunSft(common + " --init " + tmp.Join("init.ply") + " --out " + tmp.Join("r") +
                     " --outer 1",
                 &out),
             0)
@@ -68,7 +61,7 @@ TEST(ReconstructCliTest, ReconstructEvalResume) {
   EXPECT_EQ(CountLines(ReadAll(tmp.Join("r/metrics.csv"))), 1 + static_cast<int>(iterations.size()));
 
   // Resume to two outer iterations: the earlier records are kept, new ones follow.
-  ASSERT_EQ(Sft("reconstruct --quiet --resume " + tmp.Join("r") + " --outer 2", &out), 0) << out;
+  ASSERT_EQ(RunSft("reconstruct --quiet --resume " + tmp.Join("r") + " --outer 2", &out), 0) << out;
   const nlohmann::json resumed = nlohmann::json::parse(ReadAll(tmp.Join("r/metrics.json")));
   EXPECT_GT(resumed["iterations"].size(), iterations.size());
   EXPECT_EQ(resumed["iterations"].back()["outer"], 1);
@@ -77,7 +70,7 @@ TEST(ReconstructCliTest, ReconstructEvalResume) {
   EXPECT_TRUE(state["finished"].get<bool>());
 
   // eval, both modes.
-  ASSERT_EQ(Sft("eval --dataset " + tmp.Join("ds") + " --reconstruction " + tmp.Join("r") +
+  ASSERT_EQ(RunSft("eval --dataset " + tmp.Join("ds") + " --reconstruction " + tmp.Join("r") +
                     " --spp 16 --bounces 1",
                 &out),
             0)
@@ -85,7 +78,7 @@ TEST(ReconstructCliTest, ReconstructEvalResume) {
   const nlohmann::json images = nlohmann::json::parse(out);
   EXPECT_GT(images["full"]["psnr"].get<double>(), 20.0);
   EXPECT_GT(images["albedo"]["psnr"].get<double>(), 15.0);
-  ASSERT_EQ(Sft("eval --reference " + tmp.Join("ds/gt/mesh.ply") + " --mesh " +
+  ASSERT_EQ(RunSft("eval --reference " + tmp.Join("ds/gt/mesh.ply") + " --mesh " +
                     tmp.Join("r/mesh.ply") + " --samples 20000",
                 &out),
             0)
@@ -93,7 +86,7 @@ TEST(ReconstructCliTest, ReconstructEvalResume) {
   EXPECT_GT(nlohmann::json::parse(out)["f1"].get<double>(), 0.0);
 
   // The fitted lights re-render through sft render.
-  ASSERT_EQ(Sft("render --quiet --no-report --dataset " + tmp.Join("ds") + " --mesh " +
+  ASSERT_EQ(RunSft("render --quiet --no-report --dataset " + tmp.Join("ds") + " --mesh " +
                     tmp.Join("r/mesh.ply") + " --material " + tmp.Join("r/material.json") +
                     " --lights " + tmp.Join("r/lights.json") + " --spp 2 --out " +
                     tmp.Join("rr"),
@@ -109,18 +102,18 @@ TEST(ReconstructCliTest, BadInputIsOneLine) {
   const std::string base = "reconstruct --quiet --dataset " + tmp.Join("ds") + " --init " +
                            tmp.Join("ds/gt/mesh.ply");
   std::string out;
-  EXPECT_EQ(Sft(base + " --out " + tmp.Join("ds"), &out), 1);
+  EXPECT_EQ(RunSft(base + " --out " + tmp.Join("ds"), &out), 1);
   EXPECT_THAT(out, HasSubstr("--out"));
   EXPECT_EQ(CountLines(out), 1) << out;
   testing::WriteTestFile(tmp.Join("cfg.json"), "{\"stepz\": 3}");
-  EXPECT_EQ(Sft(base + " --out " + tmp.Join("o") + " --config " + tmp.Join("cfg.json"), &out), 1);
+  EXPECT_EQ(RunSft(base + " --out " + tmp.Join("o") + " --config " + tmp.Join("cfg.json"), &out), 1);
   EXPECT_THAT(out, HasSubstr("stepz: unknown key"));
   EXPECT_EQ(CountLines(out), 1) << out;
-  EXPECT_EQ(Sft(base + " --out " + tmp.Join("o") + " --steps 0", &out), 1);
+  EXPECT_EQ(RunSft(base + " --out " + tmp.Join("o") + " --steps 0", &out), 1);
   EXPECT_THAT(out, HasSubstr("--steps"));
-  EXPECT_EQ(Sft(base + " --out " + tmp.Join("o") + " --solver newton", &out), 1);
+  EXPECT_EQ(RunSft(base + " --out " + tmp.Join("o") + " --solver newton", &out), 1);
   EXPECT_THAT(out, HasSubstr("--solver"));
-  EXPECT_EQ(Sft("reconstruct --quiet --resume " + tmp.Join("nothing"), &out), 1);
+  EXPECT_EQ(RunSft("reconstruct --quiet --resume " + tmp.Join("nothing"), &out), 1);
   EXPECT_THAT(out, HasSubstr("state.json"));
   EXPECT_FALSE(fs::exists(tmp.Join("o/state.json")));
 }

@@ -15,6 +15,9 @@
 namespace sft {
 namespace {
 
+using testing::CountLines;
+using testing::RunSft;
+
 using ::testing::HasSubstr;
 using ::testing::Not;
 
@@ -173,10 +176,6 @@ TEST(ReportTest, ExposureAndDifference) {
   EXPECT_FLOAT_EQ(diff.at(0, 0, 0), 0.0f);
 }
 
-int Sft(const std::string& args, std::string* output) {
-  return testing::RunCommand(testing::SftBinary() + " " + args, output);
-}
-
 const char kBunnyMaterial[] =
     "'{\"albedo\": [0.7, 0.5, 0.3], \"roughness\": 0.5, \"specular\": 0}'";
 
@@ -187,7 +186,7 @@ TEST(RenderReportTest, ComparesWithCyclesAndWritesReport) {
   const std::string ds = testing::DataDir() + "/cycles/bunny_point_diffuse";
   const std::string out_dir = tmp.Join("r");
   std::string out;
-  ASSERT_EQ(Sft("render --quiet --dataset " + ds + " --mesh " + ds + "/gt/mesh.ply --material " +
+  ASSERT_EQ(RunSft("render --quiet --dataset " + ds + " --mesh " + ds + "/gt/mesh.ply --material " +
                     kBunnyMaterial + " --spp 16 --bounces 1 --views 0,1 --out " + out_dir,
                 &out),
             0)
@@ -248,7 +247,7 @@ TEST(RenderReportTest, MissingTargetAndNoReport) {
                              "/gt/mesh.ply --material " + kBunnyMaterial +
                              " --spp 4 --bounces 1 --views 0,1,2 --out ";
   std::string out;
-  ASSERT_EQ(Sft(common + tmp.Join("r"), &out), 0) << out;
+  ASSERT_EQ(RunSft(common + tmp.Join("r"), &out), 0) << out;
   std::string text;
   ASSERT_TRUE(ReadTextFile(tmp.Join("r/render.json"), &text).ok());
   const nlohmann::json json = nlohmann::json::parse(text);
@@ -267,7 +266,7 @@ TEST(RenderReportTest, MissingTargetAndNoReport) {
   EXPECT_EQ(CountOccurrences(html, "class=\"missing\""), 2);
   EXPECT_TRUE(FileExists(tmp.Join("r/report_files/view_002_render.png")));
 
-  ASSERT_EQ(Sft(common + tmp.Join("n") + " --no-report", &out), 0) << out;
+  ASSERT_EQ(RunSft(common + tmp.Join("n") + " --no-report", &out), 0) << out;
   ASSERT_TRUE(ReadTextFile(tmp.Join("n/render.json"), &text).ok());
   const nlohmann::json plain = nlohmann::json::parse(text);
   EXPECT_FALSE(plain.contains("comparison"));

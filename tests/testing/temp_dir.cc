@@ -41,5 +41,15 @@ int RunCommand(const std::string& command, std::string* output) {
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
+int RunSft(const std::string& args, std::string* output) {
+  return RunCommand(SftBinary() + " " + args, output);
+}
+
+int CountLines(const std::string& text) {
+  int lines = 0;
+  for (char c : text) lines += c == '\n';
+  return lines + (!text.empty() && text.back() != '\n');
+}
+
 }  // namespace testing
 }  // namespace sft

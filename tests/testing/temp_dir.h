@@ -28,6 +28,10 @@ std::string DataDir();
 std::string SftBinary();
 // Writes `contents` to `path` as is (binary), for fixtures written by tests.
 void WriteTestFile(const std::string& path, const std::string& contents);
+// Runs `sft ARGS` (the built binary), returns its exit code; output as RunCommand.
+int RunSft(const std::string& args, std::string* output = nullptr);
+// Lines of `text`, counting a last line without its newline.
+int CountLines(const std::string& text);
 // Runs a shell command, returns its exit code; stdout+stderr captured into *output if non-null.
 int RunCommand(const std::string& command, std::string* output = nullptr);
 
