@@ -30,10 +30,10 @@ struct MeshEvalOptions {
 
 struct EvalCommandOptions {
   MeshEvalOptions mesh;
-  std::string dataset;                    // reconstruction mode: the dataset.
-  std::string reconstruction;             // reconstruction mode: sft reconstruct's output folder.
-  ReconstructionEvalOptions images;       // reconstruction mode: re-render settings.
-  std::string json;  // optional copy of the printed JSON.
+  std::string dataset;               // reconstruction mode: the dataset.
+  std::string reconstruction;        // reconstruction mode: sft reconstruct's output folder.
+  ReconstructionEvalOptions images;  // reconstruction mode: re-render settings.
+  std::string json;                  // optional copy of the printed JSON.
 };
 
 Status RunMeshEval(const MeshEvalOptions& opts, nlohmann::json* report) {
@@ -83,9 +83,9 @@ int RunEvalCommand(const EvalCommandOptions& opts) {
     if (!where.ok()) return PrintError("eval", where);
   }
   nlohmann::json report;
-  Status status = images ? EvaluateReconstruction(opts.dataset, opts.reconstruction, opts.images,
-                                                  &report)
-                         : RunMeshEval(opts.mesh, &report);
+  Status status =
+      images ? EvaluateReconstruction(opts.dataset, opts.reconstruction, opts.images, &report)
+             : RunMeshEval(opts.mesh, &report);
   if (!status.ok()) return PrintError("eval", status);
   const std::string text = report.dump(1) + "\n";
   if (!opts.json.empty()) {

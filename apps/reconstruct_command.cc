@@ -4,14 +4,14 @@
 // `--resume OUT` continues from it.
 #include <csignal>
 #include <cstdio>
-#include <set>
 #include <nlohmann/json.hpp>
+#include <set>
 
 #include "apps/commands.h"
-#include "src/eval/reconstruct_report.h"
 #include "src/core/file_util.h"
 #include "src/core/progress.h"
 #include "src/eval/mesh_metrics.h"
+#include "src/eval/reconstruct_report.h"
 #include "src/geometry/material.h"
 #include "src/geometry/mesh.h"
 #include "src/io/dataset.h"
@@ -39,7 +39,7 @@ struct ReconstructCommandOptions {
   int64_t seed = 0;
   std::vector<int> views;
   std::set<std::string> given;  // config keys whose flag was on the command line.
-  std::string reference;  // ground-truth mesh: F1 and Chamfer after every outer iteration.
+  std::string reference;        // ground-truth mesh: F1 and Chamfer after every outer iteration.
   double reference_tolerance = 0.005;  // F1 tolerance, fraction of the reference's diagonal.
   bool quiet = false;
   bool no_report = false;
@@ -54,11 +54,10 @@ Status MakeOptions(const ReconstructCommandOptions& cli, const nlohmann::json* r
     SFT_RETURN_IF_ERROR(ApplyReconstructConfig(*resumed, cli.resume + "/state.json", options));
   }
   if (!cli.config.empty()) SFT_RETURN_IF_ERROR(ReadReconstructConfig(cli.config, options));
-  const nlohmann::json all = {{"phases", cli.phases},       {"solver", cli.solver},
-                              {"outer_iterations", cli.outer}, {"steps", cli.steps},
-                              {"spp", cli.spp},             {"bounces", cli.bounces},
-                              {"threads", cli.threads},     {"seed", cli.seed},
-                              {"views", cli.views}};
+  const nlohmann::json all = {
+      {"phases", cli.phases},   {"solver", cli.solver}, {"outer_iterations", cli.outer},
+      {"steps", cli.steps},     {"spp", cli.spp},       {"bounces", cli.bounces},
+      {"threads", cli.threads}, {"seed", cli.seed},     {"views", cli.views}};
   nlohmann::json flags = nlohmann::json::object();
   for (const auto& [key, value] : all.items()) {
     if (cli.given.count(key) > 0) flags[key] = value;
@@ -80,9 +79,9 @@ Status MakeOptions(const ReconstructCommandOptions& cli, const nlohmann::json* r
 
 // metrics.json's per-outer-iteration entry: cost, time, mesh quality against the initial mesh and,
 // with a reference, F1 and Chamfer (50k samples per surface).
-Status OuterRecord(int outer, const std::vector<IterationRecord>& records,
-                   const TriMesh& initial, const Reconstruction& reconstruction,
-                   const TriMesh* reference, double tolerance, nlohmann::json* out) {
+Status OuterRecord(int outer, const std::vector<IterationRecord>& records, const TriMesh& initial,
+                   const Reconstruction& reconstruction, const TriMesh* reference, double tolerance,
+                   nlohmann::json* out) {
   const TriMesh mesh = reconstruction.Mesh();
   const MeshQuality quality = CompareMeshQuality(initial, mesh);
   *out = {{"outer", outer},
@@ -233,9 +232,9 @@ CommandRunner SetupReconstructCommand(CLI::App* app) {
            "phases");
   key_flag(app->add_option("--solver", opts->solver, "lm | dogleg | lbfgs | adam (default lm)"),
            "solver");
-  key_flag(app->add_option("--outer", opts->outer,
-                           "Outer iterations (fresh seeds each; default 4)"),
-           "outer_iterations");
+  key_flag(
+      app->add_option("--outer", opts->outer, "Outer iterations (fresh seeds each; default 4)"),
+      "outer_iterations");
   key_flag(app->add_option("--steps", opts->steps,
                            "Solver iterations per outer iteration and phase (5)"),
            "steps");

@@ -37,10 +37,7 @@ class PyramidPixelCost : public ceres::CostFunction {
   // `level` and `finite` are owned by the render cache and outlive the cost function.
   PyramidPixelCost(const LevelCache* level, const bool* finite, int pixel,
                    std::vector<int> block_offsets, const std::vector<int>& block_sizes)
-      : level_(level),
-        finite_(finite),
-        pixel_(pixel),
-        offsets_(std::move(block_offsets)) {
+      : level_(level), finite_(finite), pixel_(pixel), offsets_(std::move(block_offsets)) {
     set_num_residuals(3);
     for (int size : block_sizes) mutable_parameter_block_sizes()->push_back(size);
   }

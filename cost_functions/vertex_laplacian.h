@@ -40,10 +40,10 @@
 #ifndef SFT_COST_FUNCTIONS_VERTEX_LAPLACIAN_H_
 #define SFT_COST_FUNCTIONS_VERTEX_LAPLACIAN_H_
 
-#include <Eigen/Core>
 #include <ceres/cost_function.h>
 #include <ceres/problem.h>
 
+#include <Eigen/Core>
 #include <string>
 #include <vector>
 

@@ -40,10 +40,12 @@ std::string LineChartSvg(const LineChart& chart) {
     }
   }
   std::string svg = "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" + Num(width) +
-                    "\" height=\"" + Num(height) + "\" font-family=\"sans-serif\" font-size=\"11\">\n";
+                    "\" height=\"" + Num(height) +
+                    "\" font-family=\"sans-serif\" font-size=\"11\">\n";
   svg += "<text x=\"" + Num(left) + "\" y=\"18\" font-size=\"13\">" + HtmlEscape(chart.title) +
          "</text>\n";
-  if (!(x_hi >= x_lo) || !(y_hi >= y_lo)) return svg + "<text x=\"80\" y=\"60\">no data</text></svg>\n";
+  if (!(x_hi >= x_lo) || !(y_hi >= y_lo))
+    return svg + "<text x=\"80\" y=\"60\">no data</text></svg>\n";
   if (x_hi == x_lo) x_hi = x_lo + 1;
   if (y_hi == y_lo) {
     y_hi += 0.5;
@@ -80,8 +82,8 @@ std::string LineChartSvg(const LineChart& chart) {
     const double ly = top + 14 * s + 8;
     svg += "<line x1=\"" + Num(left + plot_w + 10) + "\" y1=\"" + Num(ly) + "\" x2=\"" +
            Num(left + plot_w + 28) + "\" y2=\"" + Num(ly) + "\" stroke=\"" + color +
-           "\" stroke-width=\"2\"/><text x=\"" + Num(left + plot_w + 32) + "\" y=\"" +
-           Num(ly + 4) + "\">" + HtmlEscape(series.name) + "</text>\n";
+           "\" stroke-width=\"2\"/><text x=\"" + Num(left + plot_w + 32) + "\" y=\"" + Num(ly + 4) +
+           "\">" + HtmlEscape(series.name) + "</text>\n";
   }
   return svg + "</svg>\n";
 }

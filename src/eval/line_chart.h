@@ -9,8 +9,8 @@
 namespace sft {
 
 struct LineSeries {
-  std::string name;        // legend entry.
-  std::vector<double> x;   // same length as y; non-finite points are skipped.
+  std::string name;       // legend entry.
+  std::vector<double> x;  // same length as y; non-finite points are skipped.
   std::vector<double> y;
 };
 

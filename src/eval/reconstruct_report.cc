@@ -25,14 +25,13 @@ Status WriteReconstructReport(const std::string& out, const Dataset& dataset,
                               Reconstruction* reconstruction) {
   HtmlReport html(out, "sft reconstruct: " + dataset.root);
   const IterationRecord* last = records.empty() ? nullptr : &records.back();
-  html.AddSummaryTable(
-      {{"dataset", dataset.root},
-       {"views fitted", std::to_string(reconstruction->view_indices().size())},
-       {"iterations", std::to_string(records.size())},
-       {"final cost", last ? FormatNumber(last->cost) : "n/a"},
-       {"final mean PSNR (dB, peak 1, level 0 over the active pixels)",
-        last ? FormatNumber(MeanPsnr(*last)) : "n/a"},
-       {"wall time (s)", last ? FormatNumber(last->seconds) : "n/a"}});
+  html.AddSummaryTable({{"dataset", dataset.root},
+                        {"views fitted", std::to_string(reconstruction->view_indices().size())},
+                        {"iterations", std::to_string(records.size())},
+                        {"final cost", last ? FormatNumber(last->cost) : "n/a"},
+                        {"final mean PSNR (dB, peak 1, level 0 over the active pixels)",
+                         last ? FormatNumber(MeanPsnr(*last)) : "n/a"},
+                        {"wall time (s)", last ? FormatNumber(last->seconds) : "n/a"}});
   LineChart cost;
   cost.title = "objective against wall time";
   cost.x_label = "seconds";
@@ -67,7 +66,8 @@ Status WriteReconstructReport(const std::string& out, const Dataset& dataset,
     const Image& target = cache.Target(v);
     const double scale = ExposureScale(target, nullptr);
     char prefix[64];
-    std::snprintf(prefix, sizeof(prefix), "report_files/view_%03d_", reconstruction->view_indices()[v]);
+    std::snprintf(prefix, sizeof(prefix), "report_files/view_%03d_",
+                  reconstruction->view_indices()[v]);
     const std::string base(prefix);
     SFT_RETURN_IF_ERROR(html.WriteImage(base + "target.png", ScaledRgb(target, scale)));
     SFT_RETURN_IF_ERROR(html.WriteImage(base + "render.png", ScaledRgb(renders[v], scale)));
@@ -77,8 +77,8 @@ Status WriteReconstructReport(const std::string& out, const Dataset& dataset,
     row.label = "view " + std::to_string(reconstruction->view_indices()[v]);
     row.images = {{base + "target.png", "target", nullptr},
                   {base + "render.png", "render", nullptr},
-                  {base + "difference.png",
-                   "|render − target| ×" + std::to_string(kDifferenceGain), nullptr}};
+                  {base + "difference.png", "|render − target| ×" + std::to_string(kDifferenceGain),
+                   nullptr}};
     if (last != nullptr && v < static_cast<int>(last->view_psnr.size())) {
       row.notes = {{"PSNR (dB)", FormatNumber(last->view_psnr[v])}};
     }

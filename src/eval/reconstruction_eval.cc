@@ -26,10 +26,10 @@ struct Measure {
   Status Add(int v, const Image& ours, const Image& reference, const Image& mask) {
     double psnr = 0.0, ssim = 0.0;
     const ImageMetricsOptions options;
-    SFT_RETURN_IF_ERROR(ComputePsnr(ours, reference, mask, options, &psnr)
-                            .Prefixed("view " + std::to_string(v)));
-    SFT_RETURN_IF_ERROR(ComputeSsim(ours, reference, mask, options, &ssim)
-                            .Prefixed("view " + std::to_string(v)));
+    SFT_RETURN_IF_ERROR(
+        ComputePsnr(ours, reference, mask, options, &psnr).Prefixed("view " + std::to_string(v)));
+    SFT_RETURN_IF_ERROR(
+        ComputeSsim(ours, reference, mask, options, &ssim).Prefixed("view " + std::to_string(v)));
     views.push_back({{"view", v}, {"psnr", psnr}, {"ssim", ssim}});
     psnr_sum += psnr;
     ssim_sum += ssim;
@@ -127,8 +127,8 @@ Status EvaluateReconstruction(const std::string& dataset_dir, const std::string&
   const bool can_render_truth = !dataset.gt_mesh.empty() && !true_material_path.empty();
   if (can_render_truth) {
     SFT_RETURN_IF_ERROR(ReadMesh(JoinPath(dataset.root, dataset.gt_mesh), &true_mesh));
-    SFT_RETURN_IF_ERROR(LoadMaterial(JoinPath(dataset.root, true_material_path), true_mesh,
-                                     &true_material));
+    SFT_RETURN_IF_ERROR(
+        LoadMaterial(JoinPath(dataset.root, true_material_path), true_mesh, &true_material));
     true_scene = std::make_unique<RenderScene>(true_mesh);
   }
   DatasetViews views;
@@ -160,21 +160,16 @@ Status EvaluateReconstruction(const std::string& dataset_dir, const std::string&
     }
     if (!roughness_folder.empty() || can_render_truth) {
       Image truth;
-      SFT_RETURN_IF_ERROR(TruePass(dataset, v, roughness_folder, true_scene.get(),
-                                   &true_material, views.views[v], roughness_pass, &truth));
+      SFT_RETURN_IF_ERROR(TruePass(dataset, v, roughness_folder, true_scene.get(), &true_material,
+                                   views.views[v], roughness_pass, &truth));
       RenderView(scene, material, views.views[v], roughness_pass, &ours);
       SFT_RETURN_IF_ERROR(roughness.Add(v, Rgb(ours), truth, mask));
     }
   }
-  *report = {{"mode", "reconstruction"},
-             {"dataset", dataset_dir},
-             {"reconstruction", reconstruction},
-             {"spp", options.spp},
-             {"bounces", options.bounces},
-             {"psnr_peak", 1.0},
-             {"full", full.ToJson()},
-             {"albedo", albedo.ToJson()},
-             {"roughness", roughness.ToJson()}};
+  *report = {
+      {"mode", "reconstruction"}, {"dataset", dataset_dir},     {"reconstruction", reconstruction},
+      {"spp", options.spp},       {"bounces", options.bounces}, {"psnr_peak", 1.0},
+      {"full", full.ToJson()},    {"albedo", albedo.ToJson()},  {"roughness", roughness.ToJson()}};
   return Status::Ok();
 }
 

@@ -20,9 +20,9 @@
 namespace sft {
 
 struct ReconstructionEvalOptions {
-  int spp = 64;         // samples per pixel of the re-renders, [1, 65536].
-  int bounces = 2;      // path segments of the colour re-render, [1, 16].
-  uint64_t seed = 99;   // re-render seed.
+  int spp = 64;            // samples per pixel of the re-renders, [1, 65536].
+  int bounces = 2;         // path segments of the colour re-render, [1, 16].
+  uint64_t seed = 99;      // re-render seed.
   std::vector<int> views;  // view indices; empty = all.
 
   bool Check(std::string* why) const;

@@ -18,7 +18,12 @@ Status CompareRuns(const std::vector<std::string>& runs, const std::vector<std::
   }
   LineChart cost{"objective against wall time", "seconds", "cost ½Σr²", true, 640, 320, {}};
   LineChart chamfer{"Chamfer distance against wall time (after each outer iteration)",
-                    "seconds", "Chamfer / diagonal", true, 640, 320, {}};
+                    "seconds",
+                    "Chamfer / diagonal",
+                    true,
+                    640,
+                    320,
+                    {}};
   LineChart f1{"F1 against wall time", "seconds", "F1", false, 640, 320, {}};
   std::string csv = "run,kind,outer,seconds,cost,chamfer,f1\n";
   std::vector<std::vector<std::string>> table;

@@ -17,8 +17,7 @@ struct Key {
   std::function<json(const ReconstructOptions&)> get;
 };
 
-Key Int(std::function<int&(ReconstructOptions*)> field, int lo,
-        int hi) {
+Key Int(std::function<int&(ReconstructOptions*)> field, int lo, int hi) {
   return {[field, lo, hi](const json& v, ReconstructOptions* o) -> std::string {
             if (!v.is_number_integer() || v.get<int64_t>() < lo || v.get<int64_t>() > hi) {
               return "expected an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) +
@@ -95,16 +94,17 @@ const std::map<std::string, Key>& Keys() {
       {"pyramid_levels", Int([](O* o) -> int& { return o->cache.pyramid_levels; }, 1, 12)},
       {"level_weight", Real([](O* o) -> double& { return o->cache.level_weight; }, 1e-6, 64)},
       {"image_weight", Real([](O* o) -> double& { return o->cache.image_weight; }, 0, 1e6)},
-      {"laplacian_target",
-       Choice(
-           [](const std::string& s, O* o) -> std::string {
-             if (s != "displacement" && s != "shape") return "expected displacement or shape";
-             o->regularizers.laplacian_of_shape = s == "shape";
-             return "";
-           },
-           [](const O& o) {
-             return std::string(o.regularizers.laplacian_of_shape ? "shape" : "displacement");
-           })},
+      {"laplacian_target", Choice(
+                               [](const std::string& s, O* o) -> std::string {
+                                 if (s != "displacement" && s != "shape")
+                                   return "expected displacement or shape";
+                                 o->regularizers.laplacian_of_shape = s == "shape";
+                                 return "";
+                               },
+                               [](const O& o) {
+                                 return std::string(
+                                     o.regularizers.laplacian_of_shape ? "shape" : "displacement");
+                               })},
       {"mask_dilation", Int([](O* o) -> int& { return o->cache.mask_dilation; }, 0, 64)},
       {"primary_edge_ratio",
        Real([](O* o) -> double& { return o->cache.edges.primary_edge_ratio; }, 0, 16)},
@@ -114,10 +114,9 @@ const std::map<std::string, Key>& Keys() {
        Real([](O* o) -> double& { return o->cache.edges.secondary_edge_samples; }, 0, 16)},
       {"texel_edge_ratio",
        Real([](O* o) -> double& { return o->cache.edges.texel_edge_ratio; }, 0, 16)},
-      {"superset_renders",
-       Int([](O* o) -> int& { return o->problem.superset_renders; }, 1, 8)},
-      {"roughness_min", Real([](O* o) -> double& { return o->problem.bounds.roughness_min; }, 0,
-                             0.99)},
+      {"superset_renders", Int([](O* o) -> int& { return o->problem.superset_renders; }, 1, 8)},
+      {"roughness_min",
+       Real([](O* o) -> double& { return o->problem.bounds.roughness_min; }, 0, 0.99)},
       {"solver", Choice(
                      [](const std::string& s, O* o) -> std::string {
                        return SolverKindFromName(s, &o->solver.kind)
@@ -143,8 +142,8 @@ const std::map<std::string, Key>& Keys() {
            },
            [](const O& o) { return LinearSolverName(o.solver.trust_region.linear_solver_type); })},
       {"max_linear_solver_iterations",
-       Int([](O* o) -> int& { return o->solver.trust_region.max_linear_solver_iterations; },
-           1, 10000)},
+       Int([](O* o) -> int& { return o->solver.trust_region.max_linear_solver_iterations; }, 1,
+           10000)},
       {"initial_trust_region_radius",
        Real([](O* o) -> double& { return o->solver.trust_region.initial_trust_region_radius; },
             1e-12, 1e16)},
@@ -180,28 +179,29 @@ const std::map<std::string, Key>& Keys() {
                                   : "expected texture, geometry or alternate";
                      },
                      [](const O& o) { return std::string(PhaseScheduleName(o.phases)); })},
-      {"outer_iterations",
-       Int([](O* o) -> int& { return o->outer_iterations; }, 1, 10000)},
+      {"outer_iterations", Int([](O* o) -> int& { return o->outer_iterations; }, 1, 10000)},
       {"fit_specular", Bool([](O* o) -> bool& { return o->fit_specular; })},
       {"fit_lights", Bool([](O* o) -> bool& { return o->fit_lights; })},
-      {"seed", {[](const json& v, O* o) -> std::string {
-                  if (!v.is_number_integer() || (!v.is_number_unsigned() && v.get<int64_t>() < 0)) {
-                    return "expected a non-negative integer";
-                  }
-                  o->seed = v.get<uint64_t>();
-                  return "";
-                },
-                [](const O& o) { return json(o.seed); }}},
-      {"views", {[](const json& v, O* o) -> std::string {
-                   if (!v.is_array()) return "expected an array of view indices";
-                   o->views.clear();
-                   for (const json& e : v) {
-                     if (!e.is_number_integer()) return "expected an array of view indices";
-                     o->views.push_back(e.get<int>());
-                   }
-                   return "";
-                 },
-                 [](const O& o) { return json(o.views); }}},
+      {"seed",
+       {[](const json& v, O* o) -> std::string {
+          if (!v.is_number_integer() || (!v.is_number_unsigned() && v.get<int64_t>() < 0)) {
+            return "expected a non-negative integer";
+          }
+          o->seed = v.get<uint64_t>();
+          return "";
+        },
+        [](const O& o) { return json(o.seed); }}},
+      {"views",
+       {[](const json& v, O* o) -> std::string {
+          if (!v.is_array()) return "expected an array of view indices";
+          o->views.clear();
+          for (const json& e : v) {
+            if (!e.is_number_integer()) return "expected an array of view indices";
+            o->views.push_back(e.get<int>());
+          }
+          return "";
+        },
+        [](const O& o) { return json(o.views); }}},
   };
   return keys;
 }

@@ -31,9 +31,7 @@ ParameterSelection ActiveParameters::ToSelection() const {
   return selection;
 }
 
-bool ActiveParameters::Includes(ParameterKind kind) const {
-  return ToSelection().Selected(kind);
-}
+bool ActiveParameters::Includes(ParameterKind kind) const { return ToSelection().Selected(kind); }
 
 SceneParameters::SceneParameters(const std::vector<Eigen::Vector3d>& positions,
                                  const Material& material, int num_lights) {
@@ -104,8 +102,8 @@ void SceneParameters::WriteMaterial(Material* material) const {
   CHECK_EQ(material->roughness.num_texels(), layout_.num_roughness_texels);
   std::copy(values_.begin() + layout_.AlbedoOffset(), values_.begin() + layout_.RoughnessOffset(),
             material->albedo.values().begin());
-  std::copy(values_.begin() + layout_.RoughnessOffset(),
-            values_.begin() + layout_.SpecularIndex(), material->roughness.values().begin());
+  std::copy(values_.begin() + layout_.RoughnessOffset(), values_.begin() + layout_.SpecularIndex(),
+            material->roughness.values().begin());
   material->specular = values_[layout_.SpecularIndex()];
 }
 

@@ -180,8 +180,8 @@ void FillUnsampledTexels(MeshColors* colors) {
   for (int f = 0; f < colors->num_faces(); ++f) {
     for (int i = 0; i <= r; ++i) {
       const int j = r - i;
-      const int source = j > 0 ? MeshColors::LocalIndex(r, i, j - 1)
-                               : MeshColors::LocalIndex(r, i - 1, j);
+      const int source =
+          j > 0 ? MeshColors::LocalIndex(r, i, j - 1) : MeshColors::LocalIndex(r, i - 1, j);
       const double* from = colors->texel(f * per_face + source);
       double* to = colors->texel(f * per_face + MeshColors::LocalIndex(r, i, j));
       std::copy(from, from + colors->channels(), to);

@@ -36,8 +36,8 @@ Image DownsampleMean(const Image& fine) {
     for (int x = 0; x < coarse.width; ++x) {
       for (int c = 0; c < fine.channels; ++c) {
         double sum = 0.0;
-        const int n =
-            ForChildren(x, y, fine.width, fine.height, [&](int fx, int fy) { sum += fine.at(fx, fy, c); });
+        const int n = ForChildren(x, y, fine.width, fine.height,
+                                  [&](int fx, int fy) { sum += fine.at(fx, fy, c); });
         coarse.at(x, y, c) = static_cast<float>(sum / n);
       }
     }

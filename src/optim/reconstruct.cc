@@ -11,8 +11,7 @@ namespace sft {
 namespace {
 
 double NowSeconds() {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch())
-      .count();
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
 ActiveParameters TexturePhase(const ReconstructOptions& options) {
@@ -65,8 +64,7 @@ ReconstructOptions::ReconstructOptions() {
 }
 
 bool ReconstructOptions::Check(std::string* why) const {
-  if (!cache.Check(why) || !problem.Check(why) || !solver.Check(why) ||
-      !regularizers.Check(why)) {
+  if (!cache.Check(why) || !problem.Check(why) || !solver.Check(why) || !regularizers.Check(why)) {
     return false;
   }
   if (outer_iterations < 1 || outer_iterations > 10000) {
@@ -103,8 +101,8 @@ double PsnrFromMse(double mse) {
   return -10.0 * std::log10(mse);
 }
 
-Status Reconstruction::Create(const Dataset& dataset, const TriMesh& mesh,
-                              const Material& material, const std::vector<double>& light_scales,
+Status Reconstruction::Create(const Dataset& dataset, const TriMesh& mesh, const Material& material,
+                              const std::vector<double>& light_scales,
                               const ReconstructOptions& options,
                               std::unique_ptr<Reconstruction>* out) {
   std::string why;
@@ -178,8 +176,8 @@ Status Reconstruction::RunOuter(int outer,
     phase_record.outer = outer;
     phase_record.phase = name;
     if (options_.solver.kind == SolverKind::kAdam) {
-      SFT_RETURN_IF_ERROR(RunAdam(options_.solver, options_.problem, cache_.get(), &params_,
-                                  hooks, &adam_, &phase_record.stats));
+      SFT_RETURN_IF_ERROR(RunAdam(options_.solver, options_.problem, cache_.get(), &params_, hooks,
+                                  &adam_, &phase_record.stats));
     } else {
       SFT_RETURN_IF_ERROR(RunSolver(options_.solver, options_.problem, cache_.get(), &params_,
                                     hooks, &phase_record.stats));

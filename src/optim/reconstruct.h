@@ -25,12 +25,12 @@ bool PhaseScheduleFromName(const std::string& name, PhaseSchedule* schedule);
 const char* PhaseScheduleName(PhaseSchedule schedule);
 
 struct ReconstructOptions {
-  RenderCacheOptions cache;        // render (spp, bounces, effects, threads), pyramid, mask.
-  ProblemOptions problem;          // supersets and bounds.
-  SolverOptions solver;            // which solver and its options.
-  RegularizerOptions regularizers; // Laplacian and texel smoothness weights.
+  RenderCacheOptions cache;         // render (spp, bounces, effects, threads), pyramid, mask.
+  ProblemOptions problem;           // supersets and bounds.
+  SolverOptions solver;             // which solver and its options.
+  RegularizerOptions regularizers;  // Laplacian and texel smoothness weights.
   PhaseSchedule phases = PhaseSchedule::kAlternate;  // texture, geometry or both alternating.
-  int outer_iterations = 4;  // outer iterations (fresh seeds each), [1, 10000].
+  int outer_iterations = 4;   // outer iterations (fresh seeds each), [1, 10000].
   bool fit_specular = false;  // the texture phase also fits the specular weight.
   bool fit_lights = false;    // the texture phase also fits the light intensity scales.
   uint64_t seed = 1;          // base seed of the renders.
@@ -43,9 +43,9 @@ struct ReconstructOptions {
 // One solver iteration, as metrics.csv writes it.
 struct IterationRecord {
   int outer = 0;
-  std::string phase;  // "texture" | "geometry".
-  int iteration = 0;  // within the phase's solve.
-  double cost = 0.0;  // objective (image + regularizers) at the accepted point.
+  std::string phase;     // "texture" | "geometry".
+  int iteration = 0;     // within the phase's solve.
+  double cost = 0.0;     // objective (image + regularizers) at the accepted point.
   double seconds = 0.0;  // wall time since the start of the run (resumed runs continue it).
   bool accepted = false;
   std::vector<double> view_psnr;  // level-0 PSNR over active pixels, peak 1, per fitted view.

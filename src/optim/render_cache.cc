@@ -39,8 +39,9 @@ Status ActivePixels(const Dataset& dataset, int view, int width, int height, int
     for (int x = 0; x < width; ++x) m.at<uint8_t>(y, x) = mask.at(x, y) > 0.5f ? 1 : 0;
   }
   if (dilation > 0) {
-    cv::dilate(m, m, cv::getStructuringElement(cv::MORPH_RECT,
-                                               cv::Size(2 * dilation + 1, 2 * dilation + 1)));
+    cv::dilate(
+        m, m,
+        cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * dilation + 1, 2 * dilation + 1)));
   }
   active->assign(m.begin<uint8_t>(), m.end<uint8_t>());
   return Status::Ok();
@@ -91,17 +92,18 @@ Status RenderCache::Create(const Dataset& dataset, const DatasetViews* views,
     SFT_RETURN_IF_ERROR(LoadViewImage(dataset, v, &target));
     ViewTargets targets;
     std::vector<uint8_t> active;
-    SFT_RETURN_IF_ERROR(ActivePixels(dataset, v, target.width, target.height,
-                                     options.mask_dilation, &active, &targets.has_mask));
+    SFT_RETURN_IF_ERROR(ActivePixels(dataset, v, target.width, target.height, options.mask_dilation,
+                                     &active, &targets.has_mask));
     const std::vector<Image> pyramid = BuildPyramid(Rgb(target), options.pyramid_levels);
-    targets.active = MaskPyramid(active, target.width, target.height,
-                                 static_cast<int>(pyramid.size()));
+    targets.active =
+        MaskPyramid(active, target.width, target.height, static_cast<int>(pyramid.size()));
     std::vector<std::unique_ptr<LevelCache>> levels;
     for (size_t l = 0; l < pyramid.size(); ++l) {
       auto level = std::make_unique<LevelCache>();
       level->target = pyramid[l];
       level->render = Image(pyramid[l].width, pyramid[l].height, 3);
-      level->sqrt_weight = std::sqrt(options.image_weight) * std::pow(options.level_weight, 0.5 * l);
+      level->sqrt_weight =
+          std::sqrt(options.image_weight) * std::pow(options.level_weight, 0.5 * l);
       levels.push_back(std::move(level));
     }
     c->targets_.push_back(std::move(targets));

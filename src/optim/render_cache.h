@@ -29,12 +29,12 @@
 namespace sft {
 
 struct RenderCacheOptions {
-  RenderOptions render;         // spp, bounces, effects, threads (seed: see SetSeed).
-  DerivativeRequest edges;      // edge-sampling budgets of vertex derivatives (params ignored).
-  int pyramid_levels = 4;       // levels 0..L−1 (level l has 2^-l of the resolution), [1, 12].
-  double level_weight = 1.0;    // level l's residuals are weighted by level_weight^l, (0, 64].
-  double image_weight = 1.0;    // weight of the whole image term, [0, 1e6]; 0 = regularizers only.
-  int mask_dilation = 2;        // level-0 pixels within this many pixels of the mask count, [0, 64].
+  RenderOptions render;       // spp, bounces, effects, threads (seed: see SetSeed).
+  DerivativeRequest edges;    // edge-sampling budgets of vertex derivatives (params ignored).
+  int pyramid_levels = 4;     // levels 0..L−1 (level l has 2^-l of the resolution), [1, 12].
+  double level_weight = 1.0;  // level l's residuals are weighted by level_weight^l, (0, 64].
+  double image_weight = 1.0;  // weight of the whole image term, [0, 1e6]; 0 = regularizers only.
+  int mask_dilation = 2;      // level-0 pixels within this many pixels of the mask count, [0, 64].
 
   bool Check(std::string* why) const;
 };

@@ -26,8 +26,7 @@ Status ReadRunState(const std::string& out, RunState* state) {
   std::string text;
   SFT_RETURN_IF_ERROR(ReadTextFile(path, &text));
   const json j = json::parse(text, nullptr, /*allow_exceptions=*/false);
-  if (j.is_discarded() || !j.is_object() ||
-      j.value("format", "") != "sft-reconstruct-state/1") {
+  if (j.is_discarded() || !j.is_object() || j.value("format", "") != "sft-reconstruct-state/1") {
     return Status::Error(path + ": not an sft reconstruction state (format " +
                          "sft-reconstruct-state/1)");
   }
@@ -134,7 +133,8 @@ Status ReadIterationRecords(const std::string& out, std::vector<IterationRecord>
     r.seconds = e.value("seconds", 0.0);
     r.accepted = e.value("accepted", false);
     if (e.contains("view_psnr") && e["view_psnr"].is_array()) {
-      for (const json& p : e["view_psnr"]) r.view_psnr.push_back(p.is_number() ? p.get<double>() : 0.0);
+      for (const json& p : e["view_psnr"])
+        r.view_psnr.push_back(p.is_number() ? p.get<double>() : 0.0);
     }
     records->push_back(std::move(r));
   }

@@ -21,11 +21,11 @@ namespace sft {
 
 // The resumable state of a run (state.json).
 struct RunState {
-  std::string dataset;     // the dataset folder, as given.
-  nlohmann::json config;   // ReconstructConfigJson of the effective options.
-  int outer_done = 0;      // outer iterations completed.
-  double seconds = 0.0;    // wall time of the run so far (all sessions).
-  bool finished = false;   // every outer iteration done.
+  std::string dataset;    // the dataset folder, as given.
+  nlohmann::json config;  // ReconstructConfigJson of the effective options.
+  int outer_done = 0;     // outer iterations completed.
+  double seconds = 0.0;   // wall time of the run so far (all sessions).
+  bool finished = false;  // every outer iteration done.
 };
 
 Status WriteRunState(const std::string& out, const RunState& state);

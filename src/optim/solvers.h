@@ -74,7 +74,7 @@ struct SolverHooks {
 struct SolverRunStats {
   int iterations = 0;
   double seconds = 0.0;
-  double setup_seconds = 0.0;   // problem build (supersets included), trust region only.
+  double setup_seconds = 0.0;              // problem build (supersets included), trust region only.
   double dropped_jacobian_fraction = 0.0;  // trust region: at the last linearization.
   ProblemStats problem;
   std::string termination;  // Ceres' message or "steps".

@@ -40,7 +40,7 @@ TEST(CliInputTest, HugeCameraIsOneErrorNotBadAlloc) {
   std::string dataset = HugeCameraDataset(tmp, 100000, 100000);
   EXPECT_EQ(
       RunSft("render --quiet --dataset " + dataset + " --mesh " + mesh + " --out " + tmp.Join("o"),
-          &out),
+             &out),
       1)
       << out;
   EXPECT_EQ(CountLines(out), 1) << out;
@@ -50,7 +50,7 @@ TEST(CliInputTest, HugeCameraIsOneErrorNotBadAlloc) {
   if (AvailableMemoryBytes() >= 48 * (uint64_t{1} << 30)) GTEST_SKIP() << "48 GiB available";
   EXPECT_EQ(
       RunSft("render --quiet --dataset " + dataset + " --mesh " + mesh + " --out " + tmp.Join("o"),
-          &out),
+             &out),
       1)
       << out;
   EXPECT_EQ(CountLines(out), 1) << out;
@@ -93,7 +93,8 @@ TEST(CliInputTest, SynthFlagsOutOfRangeNameTheFlag) {
   // automatic value): the dataset's light has intensity 2.
   std::string out;
   ASSERT_EQ(
-      RunSft(base + "--cameras 1 --zooms 1 --res 8 --spp 1 --light-intensity 2 --light-offset 0.1,0,0",
+      RunSft(
+          base + "--cameras 1 --zooms 1 --res 8 --spp 1 --light-intensity 2 --light-offset 0.1,0,0",
           &out),
       0)
       << out;

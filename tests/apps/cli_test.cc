@@ -35,10 +35,10 @@ TEST(CliTest, SynthThenRenderRoundTrip) {
   const std::string mesh = testing::DataDir() + "/meshes/icosphere_r1_320f.obj";
   std::string out;
   ASSERT_EQ(RunSft("synth --quiet --mesh " + mesh + " --out " + tmp.Join("ds") +
-                    " --cameras 3 --zooms 1,2 --res 24 --spp 64 --bounces 2 "
-                    "--material '{\"albedo\": [0.5, 0.4, 0.3], \"roughness\": 0.3, "
-                    "\"specular\": 0.2}'",
-                &out),
+                       " --cameras 3 --zooms 1,2 --res 24 --spp 64 --bounces 2 "
+                       "--material '{\"albedo\": [0.5, 0.4, 0.3], \"roughness\": 0.3, "
+                       "\"specular\": 0.2}'",
+                   &out),
             0)
       << out;
   Dataset dataset;
@@ -50,11 +50,12 @@ TEST(CliTest, SynthThenRenderRoundTrip) {
   EXPECT_TRUE(std::filesystem::exists(tmp.Join("ds/gt/mesh.ply")));
   EXPECT_FALSE(std::filesystem::exists(tmp.Join("ds.partial")));
 
-  ASSERT_EQ(RunSft("render --quiet --dataset " + tmp.Join("ds") + " --mesh " +
-                    tmp.Join("ds/gt/mesh.ply") + " --material " + tmp.Join("ds/gt/material.json") +
-                    " --spp 64 --bounces 2 --seed 7 --out " + tmp.Join("r"),
-                &out),
-            0)
+  ASSERT_EQ(
+      RunSft("render --quiet --dataset " + tmp.Join("ds") + " --mesh " +
+                 tmp.Join("ds/gt/mesh.ply") + " --material " + tmp.Join("ds/gt/material.json") +
+                 " --spp 64 --bounces 2 --seed 7 --out " + tmp.Join("r"),
+             &out),
+      0)
       << out;
   for (int v = 0; v < 6; ++v) {
     Image target, ours;
@@ -86,12 +87,13 @@ TEST(CliTest, SynthWithEnvironmentAndProceduralMaterial) {
   const std::string mesh = testing::DataDir() + "/meshes/icosphere_r1_320f.obj";
   const std::string probe = testing::DataDir() + "/cycles/sphere_env_studio/probes/studio.exr";
   std::string out;
-  ASSERT_EQ(RunSft("synth --quiet --mesh " + mesh + " --out " + tmp.Join("ds") + " --envmap " + probe +
-                    " --background-environment --cameras 2 --zooms 1 --res 16 --spp 8 "
-                    "--bounces 1 --material '{\"procedural\": \"wood\", \"colors\": "
-                    "[[0.8, 0.6, 0.3], [0.3, 0.2, 0.1]], \"roughness\": 0.4, \"resolution\": 4}'",
-                &out),
-            0)
+  ASSERT_EQ(
+      RunSft("synth --quiet --mesh " + mesh + " --out " + tmp.Join("ds") + " --envmap " + probe +
+                 " --background-environment --cameras 2 --zooms 1 --res 16 --spp 8 "
+                 "--bounces 1 --material '{\"procedural\": \"wood\", \"colors\": "
+                 "[[0.8, 0.6, 0.3], [0.3, 0.2, 0.1]], \"roughness\": 0.4, \"resolution\": 4}'",
+             &out),
+      0)
       << out;
   Dataset dataset;
   ASSERT_TRUE(ReadDataset(tmp.Join("ds"), &dataset).ok());
@@ -104,11 +106,12 @@ TEST(CliTest, SynthWithEnvironmentAndProceduralMaterial) {
   // The background shows the probe: the corner pixel is not black.
   EXPECT_GT(image.at(0, 0, 0) + image.at(0, 0, 1) + image.at(0, 0, 2), 0.0f);
 
-  ASSERT_EQ(RunSft("render --quiet --dataset " + tmp.Join("ds") + " --mesh " +
-                    tmp.Join("ds/gt/mesh.ply") + " --material " + tmp.Join("ds/gt/material.json") +
-                    " --pass albedo --spp 4 --out " + tmp.Join("r"),
-                &out),
-            0)
+  ASSERT_EQ(
+      RunSft("render --quiet --dataset " + tmp.Join("ds") + " --mesh " +
+                 tmp.Join("ds/gt/mesh.ply") + " --material " + tmp.Join("ds/gt/material.json") +
+                 " --pass albedo --spp 4 --out " + tmp.Join("r"),
+             &out),
+      0)
       << out;
   Image albedo;
   ASSERT_TRUE(ReadImage(tmp.Join("r/images/000.exr"), &albedo).ok());
@@ -129,7 +132,8 @@ TEST(CliTest, SynthWithEnvironmentAndProceduralMaterial) {
 TEST(CliTest, BadInputGivesOneLineAndNonZeroExit) {
   testing::TempDir tmp;
   std::string out;
-  EXPECT_NE(RunSft("synth --mesh " + tmp.Join("missing.obj") + " --out " + tmp.Join("ds"), &out), 0);
+  EXPECT_NE(RunSft("synth --mesh " + tmp.Join("missing.obj") + " --out " + tmp.Join("ds"), &out),
+            0);
   EXPECT_EQ(CountLines(out), 1) << out;
   EXPECT_THAT(out, HasSubstr("missing.obj"));
 
@@ -141,21 +145,21 @@ TEST(CliTest, BadInputGivesOneLineAndNonZeroExit) {
 
   const std::string ds = testing::DataDir() + "/cycles/bunny_point_diffuse";
   EXPECT_NE(RunSft("render --dataset " + ds + " --mesh " + ds + "/gt/mesh.ply --bounces 0 --out " +
-                    tmp.Join("o"),
-                &out),
+                       tmp.Join("o"),
+                   &out),
             0);
   EXPECT_EQ(CountLines(out), 1) << out;
   EXPECT_THAT(out, HasSubstr("bounces"));
 
   EXPECT_NE(RunSft("render --dataset " + ds + " --mesh " + ds + "/gt/mesh.ply --pass glow --out " +
-                    tmp.Join("o"),
-                &out),
+                       tmp.Join("o"),
+                   &out),
             0);
   EXPECT_THAT(out, HasSubstr("--pass"));
 
   EXPECT_NE(RunSft("render --dataset " + ds + " --mesh " + ds +
-                    "/gt/mesh.ply --material '{\"albedo\": [2, 0, 0]}' --out " + tmp.Join("o"),
-                &out),
+                       "/gt/mesh.ply --material '{\"albedo\": [2, 0, 0]}' --out " + tmp.Join("o"),
+                   &out),
             0);
   EXPECT_EQ(CountLines(out), 1) << out;
   EXPECT_THAT(out, HasSubstr("albedo"));

@@ -24,8 +24,8 @@ TEST(EvalCommandTest, PrintsJsonAndWritesIt) {
   testing::TempDir tmp;
   std::string out;
   ASSERT_EQ(RunSft("eval --reference " + Sphere() + " --mesh " + Sphere() +
-                    " --samples 20000 --seed 3 --json " + tmp.Join("sub/eval.json"),
-                &out),
+                       " --samples 20000 --seed 3 --json " + tmp.Join("sub/eval.json"),
+                   &out),
             0)
       << out;
   const nlohmann::json printed = nlohmann::json::parse(out);
@@ -63,10 +63,10 @@ TEST(EvalCommandTest, DifferentMeshes) {
   }
   testing::WriteTestFile(tmp.Join("moved.obj"), moved.str());
   std::string out;
-  ASSERT_EQ(
-      RunSft("eval --reference " + Sphere() + " --mesh " + tmp.Join("moved.obj") + " --samples 50000",
-          &out),
-      0)
+  ASSERT_EQ(RunSft("eval --reference " + Sphere() + " --mesh " + tmp.Join("moved.obj") +
+                       " --samples 50000",
+                   &out),
+            0)
       << out;
   const nlohmann::json j = nlohmann::json::parse(out);
   EXPECT_NEAR(j["f1"].get<double>(), 0.5, 0.03);

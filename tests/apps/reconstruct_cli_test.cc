@@ -31,22 +31,23 @@ std::string ReadAll(const std::string& path) {
 // eval scores it, a resumed run continues from the checkpoint, render re-renders it.
 TEST(ReconstructCliTest, ReconstructEvalResume) {
   testing::TempDir tmp;
-  ASSERT_EQ(testing::SynthIcosphere(tmp.Join("ds"),
-                                    "--cameras 4 --zooms 1 --res 24 --spp 32 --bounces 1 "
-                                    "--material '{\"albedo\": [0.6, 0.5, 0.4], \"roughness\": 0.5}'"),
-            "");
+  ASSERT_EQ(
+      testing::SynthIcosphere(tmp.Join("ds"),
+                              "--cameras 4 --zooms 1 --res 24 --spp 32 --bounces 1 "
+                              "--material '{\"albedo\": [0.6, 0.5, 0.4], \"roughness\": 0.5}'"),
+      "");
   std::string out;
-  ASSERT_EQ(RunSft("perturb --mesh " + tmp.Join("ds/gt/mesh.ply") + " --out " + tmp.Join("init.ply") +
-                    " --amplitude 0.02 --seed 2",
-                &out),
+  ASSERT_EQ(RunSft("perturb --mesh " + tmp.Join("ds/gt/mesh.ply") + " --out " +
+                       tmp.Join("init.ply") + " --amplitude 0.02 --seed 2",
+                   &out),
             0)
       << out;
   const std::string common = "reconstruct --quiet --dataset " + tmp.Join("ds") +
                              " --spp 8 --bounces 1 --steps 2 --phases alternate";
-  ASSERT_EQ(RunSft(common + " --init " + tmp.Join("init.ply") + " --out " + tmp.Join("r") +
-                    " --outer 1",
-                &out),
-            0)
+  ASSERT_EQ(
+      RunSft(common + " --init " + tmp.Join("init.ply") + " --out " + tmp.Join("r") + " --outer 1",
+             &out),
+      0)
       << out;
   for (const char* file : {"mesh.ply", "mesh.obj", "material.json", "lights.json", "metrics.csv",
                            "metrics.json", "state.json", "report.html"}) {
@@ -58,7 +59,8 @@ TEST(ReconstructCliTest, ReconstructEvalResume) {
   EXPECT_EQ(iterations.front()["phase"], "texture");
   EXPECT_EQ(iterations.back()["phase"], "geometry");
   EXPECT_EQ(iterations.front()["view_psnr"].size(), 4u);
-  EXPECT_EQ(CountLines(ReadAll(tmp.Join("r/metrics.csv"))), 1 + static_cast<int>(iterations.size()));
+  EXPECT_EQ(CountLines(ReadAll(tmp.Join("r/metrics.csv"))),
+            1 + static_cast<int>(iterations.size()));
 
   // Resume to two outer iterations: the earlier records are kept, new ones follow.
   ASSERT_EQ(RunSft("reconstruct --quiet --resume " + tmp.Join("r") + " --outer 2", &out), 0) << out;
@@ -71,27 +73,27 @@ TEST(ReconstructCliTest, ReconstructEvalResume) {
 
   // eval, both modes.
   ASSERT_EQ(RunSft("eval --dataset " + tmp.Join("ds") + " --reconstruction " + tmp.Join("r") +
-                    " --spp 16 --bounces 1",
-                &out),
+                       " --spp 16 --bounces 1",
+                   &out),
             0)
       << out;
   const nlohmann::json images = nlohmann::json::parse(out);
   EXPECT_GT(images["full"]["psnr"].get<double>(), 20.0);
   EXPECT_GT(images["albedo"]["psnr"].get<double>(), 15.0);
   ASSERT_EQ(RunSft("eval --reference " + tmp.Join("ds/gt/mesh.ply") + " --mesh " +
-                    tmp.Join("r/mesh.ply") + " --samples 20000",
-                &out),
+                       tmp.Join("r/mesh.ply") + " --samples 20000",
+                   &out),
             0)
       << out;
   EXPECT_GT(nlohmann::json::parse(out)["f1"].get<double>(), 0.0);
 
   // The fitted lights re-render through sft render.
-  ASSERT_EQ(RunSft("render --quiet --no-report --dataset " + tmp.Join("ds") + " --mesh " +
-                    tmp.Join("r/mesh.ply") + " --material " + tmp.Join("r/material.json") +
-                    " --lights " + tmp.Join("r/lights.json") + " --spp 2 --out " +
-                    tmp.Join("rr"),
-                &out),
-            0)
+  ASSERT_EQ(
+      RunSft("render --quiet --no-report --dataset " + tmp.Join("ds") + " --mesh " +
+                 tmp.Join("r/mesh.ply") + " --material " + tmp.Join("r/material.json") +
+                 " --lights " + tmp.Join("r/lights.json") + " --spp 2 --out " + tmp.Join("rr"),
+             &out),
+      0)
       << out;
   EXPECT_TRUE(fs::exists(tmp.Join("rr/images/000.exr")));
 }
@@ -99,14 +101,15 @@ TEST(ReconstructCliTest, ReconstructEvalResume) {
 TEST(ReconstructCliTest, BadInputIsOneLine) {
   testing::TempDir tmp;
   ASSERT_EQ(testing::SynthIcosphere(tmp.Join("ds"), "--cameras 1 --zooms 1 --res 8 --spp 2"), "");
-  const std::string base = "reconstruct --quiet --dataset " + tmp.Join("ds") + " --init " +
-                           tmp.Join("ds/gt/mesh.ply");
+  const std::string base =
+      "reconstruct --quiet --dataset " + tmp.Join("ds") + " --init " + tmp.Join("ds/gt/mesh.ply");
   std::string out;
   EXPECT_EQ(RunSft(base + " --out " + tmp.Join("ds"), &out), 1);
   EXPECT_THAT(out, HasSubstr("--out"));
   EXPECT_EQ(CountLines(out), 1) << out;
   testing::WriteTestFile(tmp.Join("cfg.json"), "{\"stepz\": 3}");
-  EXPECT_EQ(RunSft(base + " --out " + tmp.Join("o") + " --config " + tmp.Join("cfg.json"), &out), 1);
+  EXPECT_EQ(RunSft(base + " --out " + tmp.Join("o") + " --config " + tmp.Join("cfg.json"), &out),
+            1);
   EXPECT_THAT(out, HasSubstr("stepz: unknown key"));
   EXPECT_EQ(CountLines(out), 1) << out;
   EXPECT_EQ(RunSft(base + " --out " + tmp.Join("o") + " --steps 0", &out), 1);

@@ -187,8 +187,8 @@ TEST(RenderReportTest, ComparesWithCyclesAndWritesReport) {
   const std::string out_dir = tmp.Join("r");
   std::string out;
   ASSERT_EQ(RunSft("render --quiet --dataset " + ds + " --mesh " + ds + "/gt/mesh.ply --material " +
-                    kBunnyMaterial + " --spp 16 --bounces 1 --views 0,1 --out " + out_dir,
-                &out),
+                       kBunnyMaterial + " --spp 16 --bounces 1 --views 0,1 --out " + out_dir,
+                   &out),
             0)
       << out;
   std::string text;

@@ -381,8 +381,8 @@ TEST(DatasetErrors, PathsMustStayInsideTheDataset) {
       {"/lights/1/image", "../probe.exr"},
       {"/ground_truth/mesh", "/home/user/mesh.ply"},
   };
-  const std::vector<std::string> fields = {"views[0].image", "views[1].image", "views[1].image",
-                                           "views[0].mask",  "views[0].mask",  "lights[1].image",
+  const std::vector<std::string> fields = {"views[0].image",   "views[1].image", "views[1].image",
+                                           "views[0].mask",    "views[0].mask",  "lights[1].image",
                                            "ground_truth.mesh"};
   for (size_t i = 0; i < cases.size(); ++i) {
     json scene = MinimalScene();
@@ -402,10 +402,9 @@ TEST(DatasetOutputPaths, MirrorUnderImagesAndNeverCollide) {
     dataset.views.push_back(view);
   }
   EXPECT_THAT(ViewOutputPaths(dataset, ".exr"),
-              ::testing::ElementsAre("images/000.exr", "images/cam1/000.exr",
-                                     "images/cam2/000.exr", "images/photos/a.exr",
-                                     "images/000_view004.exr", "images/000_view005.exr",
-                                     "images/b.exr"));
+              ::testing::ElementsAre("images/000.exr", "images/cam1/000.exr", "images/cam2/000.exr",
+                                     "images/photos/a.exr", "images/000_view004.exr",
+                                     "images/000_view005.exr", "images/b.exr"));
 }
 
 TEST(DatasetErrors, NoViews) {

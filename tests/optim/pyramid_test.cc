@@ -26,7 +26,7 @@ TEST(PyramidTest, LevelSizesAndMeans) {
   EXPECT_EQ(pyramid[1].height, 2);
   EXPECT_FLOAT_EQ(pyramid[1].at(0, 0), (0 + 1 + 10 + 11) / 4.0f);
   EXPECT_FLOAT_EQ(pyramid[1].at(2, 0), (4 + 14) / 2.0f);  // odd width: two children.
-  EXPECT_FLOAT_EQ(pyramid[1].at(2, 1), 24.0f);           // a single child.
+  EXPECT_FLOAT_EQ(pyramid[1].at(2, 1), 24.0f);            // a single child.
   EXPECT_EQ(pyramid[3].width, 1);
   EXPECT_EQ(pyramid[3].height, 1);
 }
@@ -72,7 +72,8 @@ TEST(PyramidTest, CoarseRowsAreTheMeanOfChildRows) {
     for (int p = 0; p < rows.width * rows.height; ++p) {
       for (uint64_t i = rows.offsets[p]; i < rows.offsets[p + 1]; ++i) {
         for (int c = 0; c < 3; ++c) {
-          image.data[3 * p + c] += static_cast<float>(rows.entries[i].d[c] * delta[rows.entries[i].param]);
+          image.data[3 * p + c] +=
+              static_cast<float>(rows.entries[i].d[c] * delta[rows.entries[i].param]);
         }
       }
       for (uint64_t i = rows.offsets[p] + 1; i < rows.offsets[p + 1]; ++i) {

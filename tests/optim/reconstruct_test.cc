@@ -1,6 +1,8 @@
 // The reconstruction layer on small synthesized datasets: the render cache's pyramids and rows
 // against finite differences, the residual blocks' Jacobians, the adjoint gradient, and the
 // solvers recovering a known material.
+#include "src/optim/reconstruct.h"
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -12,7 +14,6 @@
 #include "src/io/dataset.h"
 #include "src/optim/config.h"
 #include "src/optim/problem.h"
-#include "src/optim/reconstruct.h"
 #include "src/render/render.h"
 #include "tests/testing/synth_dataset.h"
 #include "tests/testing/temp_dir.h"
@@ -79,8 +80,8 @@ void MakeSetup(const Dataset& dataset, const TriMesh& mesh, const Material& mate
   s->params = SceneParameters(s->positions, material, static_cast<int>(dataset.lights.size()));
   std::vector<int> all(dataset.views.size());
   for (size_t v = 0; v < all.size(); ++v) all[v] = static_cast<int>(v);
-  ASSERT_TRUE(RenderCache::Create(dataset, &s->views, all, s->faces, material, &s->params,
-                                  options, &s->cache)
+  ASSERT_TRUE(RenderCache::Create(dataset, &s->views, all, s->faces, material, &s->params, options,
+                                  &s->cache)
                   .ok());
   s->cache->SetActive(active);
   s->cache->SetSeed(5);
@@ -130,7 +131,8 @@ TEST_F(ReconstructTest, CacheRowsMatchFiniteDifferencesOnEveryLevel) {
         for (int p = 0; p < rows.width * rows.height; ++p) {
           double jd[3] = {0, 0, 0};
           for (uint64_t i = rows.offsets[p]; i < rows.offsets[p + 1]; ++i) {
-            for (int c = 0; c < 3; ++c) jd[c] += rows.entries[i].d[c] * delta[rows.entries[i].param];
+            for (int c = 0; c < 3; ++c)
+              jd[c] += rows.entries[i].d[c] * delta[rows.entries[i].param];
           }
           for (int c = 0; c < 3; ++c) {
             const double fd =
@@ -160,8 +162,9 @@ TEST_F(ReconstructTest, ExpectedPyramidIsPyramidOfExpectedImage) {
     s.cache->SetSeed(100 + k);
     s.cache->Render(false);
     if (mean.empty()) {
-      for (int l = 0; l < 3; ++l) mean.push_back(Image(s.cache->level(0, l).render.width,
-                                                       s.cache->level(0, l).render.height, 3));
+      for (int l = 0; l < 3; ++l)
+        mean.push_back(
+            Image(s.cache->level(0, l).render.width, s.cache->level(0, l).render.height, 3));
     }
     for (int l = 0; l < 3; ++l) {
       for (size_t i = 0; i < mean[l].data.size(); ++i) {
@@ -264,15 +267,16 @@ TEST_F(ReconstructTest, GradientsMatchFiniteDifferencesOfTheCost) {
   std::unique_ptr<ReconstructionProblem> problem;
   ProblemOptions problem_options;
   problem_options.superset_renders = 4;
-  ASSERT_TRUE(ReconstructionProblem::Build(s.cache.get(), &s.params, problem_options, &problem).ok());
+  ASSERT_TRUE(
+      ReconstructionProblem::Build(s.cache.get(), &s.params, problem_options, &problem).ok());
   std::vector<double*> blocks;
   problem->problem()->GetParameterBlocks(&blocks);
   ceres::Problem::EvaluateOptions evaluate;
   evaluate.parameter_blocks = blocks;
   double problem_cost = 0.0;
   std::vector<double> problem_gradient;
-  ASSERT_TRUE(problem->problem()->Evaluate(evaluate, &problem_cost, nullptr, &problem_gradient,
-                                           nullptr));
+  ASSERT_TRUE(
+      problem->problem()->Evaluate(evaluate, &problem_cost, nullptr, &problem_gradient, nullptr));
   // Measured at the rows of this evaluation (not of the superset renders).
   const double dropped = problem->DroppedJacobianFraction(*s.cache);
   double problem_directional = 0.0;
@@ -294,8 +298,8 @@ TEST_F(ReconstructTest, GradientsMatchFiniteDifferencesOfTheCost) {
 // Texture only, from a constant grey guess: Levenberg–Marquardt recovers the albedo texels that
 // the views see; L-BFGS and Adam lower the cost.
 TEST_F(ReconstructTest, TexturePhaseRecoversAlbedo) {
-  for (SolverKind kind : {SolverKind::kLevenbergMarquardt, SolverKind::kDogleg,
-                          SolverKind::kLbfgs, SolverKind::kAdam}) {
+  for (SolverKind kind : {SolverKind::kLevenbergMarquardt, SolverKind::kDogleg, SolverKind::kLbfgs,
+                          SolverKind::kAdam}) {
     ReconstructOptions options = options_;
     options.solver.kind = kind;
     options.solver.steps = kind == SolverKind::kAdam ? 10 : 5;
@@ -344,10 +348,13 @@ TEST_F(ReconstructTest, TexturePhaseRecoversAlbedo) {
 
 TEST(ReconstructConfigTest, KeysRoundTripAndUnknownKeysAreErrors) {
   ReconstructOptions options;
-  ASSERT_TRUE(ApplyReconstructConfig(
-                  {{"solver", "dogleg"}, {"steps", 7}, {"laplacian", "cotangent"},
-                   {"linear_solver", "dense_qr"}, {"views", {0, 2}}, {"fit_lights", true}},
-                  "cfg.json", &options)
+  ASSERT_TRUE(ApplyReconstructConfig({{"solver", "dogleg"},
+                                      {"steps", 7},
+                                      {"laplacian", "cotangent"},
+                                      {"linear_solver", "dense_qr"},
+                                      {"views", {0, 2}},
+                                      {"fit_lights", true}},
+                                     "cfg.json", &options)
                   .ok());
   EXPECT_EQ(options.solver.kind, SolverKind::kDogleg);
   EXPECT_EQ(options.solver.steps, 7);
