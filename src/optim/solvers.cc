@@ -38,6 +38,20 @@ std::unique_ptr<ceres::Problem> RegularizerProblem(const SolverHooks& hooks) {
   return problem;
 }
 
+// The Ceres options of a trust-region run: the strategy follows the kind; dogleg needs an exact
+// factorization, so the default CGNR becomes sparse normal Cholesky for it (small problems only).
+ceres::Solver::Options TrustRegionOptions(const SolverOptions& options) {
+  ceres::Solver::Options tr = options.trust_region;
+  tr.minimizer_type = ceres::TRUST_REGION;
+  tr.trust_region_strategy_type =
+      options.kind == SolverKind::kDogleg ? ceres::DOGLEG : ceres::LEVENBERG_MARQUARDT;
+  if (options.kind == SolverKind::kDogleg && tr.linear_solver_type == ceres::CGNR) {
+    tr.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
+  }
+  tr.max_num_iterations = options.steps;
+  return tr;
+}
+
 }  // namespace
 
 bool SolverKindFromName(const std::string& name, SolverKind* kind) {
@@ -84,9 +98,7 @@ bool SolverOptions::Check(std::string* why) const {
     *why = "steps: must be in [1, 1000]";
     return false;
   }
-  ceres::Solver::Options tr = trust_region;
-  tr.trust_region_strategy_type =
-      kind == SolverKind::kDogleg ? ceres::DOGLEG : ceres::LEVENBERG_MARQUARDT;
+  const ceres::Solver::Options tr = TrustRegionOptions(*this);
   std::string error;
   if (kind != SolverKind::kLbfgs && kind != SolverKind::kAdam && !tr.IsValid(&error)) {
     *why = "solver: " + error;
@@ -204,11 +216,7 @@ Status RunSolver(const SolverOptions& options, const ProblemOptions& problem_opt
     if (hooks.add_regularizers) hooks.add_regularizers(problem->problem());
     stats->problem = problem->stats();
     stats->setup_seconds = problem->stats().build_seconds;
-    ceres::Solver::Options solver = options.trust_region;
-    solver.minimizer_type = ceres::TRUST_REGION;
-    solver.trust_region_strategy_type =
-        options.kind == SolverKind::kDogleg ? ceres::DOGLEG : ceres::LEVENBERG_MARQUARDT;
-    solver.max_num_iterations = options.steps;
+    ceres::Solver::Options solver = TrustRegionOptions(options);
     solver.callbacks.push_back(&callback);
     ceres::Solver::Summary summary;
     ceres::Solve(solver, problem->problem(), &summary);
