@@ -168,6 +168,11 @@ const std::map<std::string, Key>& Keys() {
                         [](const O& o) {
                           return std::string(o.regularizers.cotangent ? "cotangent" : "uniform");
                         })},
+      {"orientation_weight",
+       Real([](O* o) -> double& { return o->regularizers.orientation_weight; }, 0, 1e12)},
+      {"orientation_min_fraction",
+       Real([](O* o) -> double& { return o->regularizers.orientation_min_fraction; }, 1e-6,
+            0.999)},
       {"albedo_smoothness",
        Real([](O* o) -> double& { return o->regularizers.albedo_smoothness; }, 0, 1e12)},
       {"roughness_smoothness",

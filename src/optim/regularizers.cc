@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "cost_functions/face_orientation.h"
 #include "cost_functions/texel_smoothness.h"
 #include "cost_functions/vertex_laplacian.h"
 
@@ -39,6 +40,11 @@ bool RegularizerOptions::Check(std::string* why) const {
       return false;
     }
   }
+  if (!(orientation_weight >= 0.0 && std::isfinite(orientation_weight) &&
+        orientation_min_fraction > 0.0 && orientation_min_fraction < 1.0)) {
+    *why = "orientation_weight must be finite and >= 0, orientation_min_fraction in (0, 1)";
+    return false;
+  }
   return true;
 }
 
@@ -54,6 +60,14 @@ void AddRegularizers(const TriMesh& rest, const ActiveParameters& active,
     std::vector<double*> blocks(layout.num_vertices);
     for (int v = 0; v < layout.num_vertices; ++v) blocks[v] = params->data() + 3 * v;
     AddVertexLaplacian(rest, laplacian, blocks, problem);
+  }
+  if (active.vertices && options.orientation_weight > 0.0) {
+    std::vector<double*> blocks(layout.num_vertices);
+    for (int v = 0; v < layout.num_vertices; ++v) blocks[v] = params->data() + 3 * v;
+    FaceOrientationOptions orientation;
+    orientation.weight = std::sqrt(options.orientation_weight);
+    orientation.min_fraction = options.orientation_min_fraction;
+    AddFaceOrientation(rest, orientation, blocks, problem);
   }
   if (active.albedo && options.albedo_smoothness > 0.0) {
     AddSmoothness(rest, material.albedo.resolution(), 3, layout.AlbedoOffset(),

@@ -22,6 +22,11 @@ struct RegularizerOptions {
   // The Laplacian of the shape itself (smooths and shrinks it: what removes i.i.d. vertex noise)
   // instead of the Laplacian of the displacement.
   bool laplacian_of_shape = false;
+  // Weight of the fold barrier (cost_functions/face_orientation.h): faces that keep less than
+  // `orientation_min_fraction` of their starting area facing their starting normal are pushed
+  // back, ≥ 0; 0 = off.
+  double orientation_weight = 10.0;
+  double orientation_min_fraction = 0.25;  // in (0, 1).
   double albedo_smoothness = 0.0;     // weight of albedo differences of neighbouring texels, ≥ 0.
   double roughness_smoothness = 0.0;  // the same for roughness, ≥ 0.
 
