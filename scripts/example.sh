@@ -13,13 +13,14 @@ mkdir -p "$out"
 rm -rf "$out/reconstruction"
 ./build/sft synth --quiet --mesh data/meshes/bunny_watertight_5k.obj --up-axis y \
   --material '{"albedo": [0.7, 0.5, 0.3], "roughness": 0.5, "specular": 0.0}' \
-  --cameras 8 --zooms 1,2 --res 64 --spp 64 --bounces 1 --seed 1 \
+  --cameras 8 --zooms 1,2 --res 96 --spp 64 --bounces 1 --seed 1 \
   --out "$out/dataset" --overwrite
 ./build/sft perturb --mesh "$out/dataset/gt/mesh.ply" --out "$out/start.ply" \
   --amplitude 0.01 --seed 7
 ./build/sft reconstruct --dataset "$out/dataset" --init "$out/start.ply" \
   --material '{"albedo": [0.5, 0.5, 0.5], "roughness": 0.5, "resolution": 1}' \
-  --config data/example/reconstruct.json --out "$out/reconstruction"
+  --config data/example/reconstruct.json --reference "$out/dataset/gt/mesh.ply" \
+  --out "$out/reconstruction"
 echo "== start mesh against the truth (F1 at 0.5% of the size, Chamfer) =="
 ./build/sft eval --reference "$out/dataset/gt/mesh.ply" --mesh "$out/start.ply" \
   --tolerance 0.005 --samples 200000 | grep -E '"(f1|chamfer)"'
