@@ -44,8 +44,8 @@ struct SolverOptions {
   SolverKind kind = SolverKind::kLevenbergMarquardt;
   int steps = 5;  // iterations per outer iteration and phase, [1, 1000].
   // Trust-region options (lm, dogleg). Defaults set by the constructor: CGNR + Jacobi, at most
-  // 20 CG iterations, initial trust-region radius 10, 2 threads. The minimizer and strategy follow `kind`; max_num_iterations
-  // follows `steps`.
+  // 20 CG iterations, initial trust-region radius 10, 2 threads. The minimizer and strategy follow
+  // `kind`; max_num_iterations follows `steps`.
   ceres::Solver::Options trust_region;
   // Line-search options (lbfgs); max_num_iterations follows `steps`.
   ceres::GradientProblemSolver::Options line_search;

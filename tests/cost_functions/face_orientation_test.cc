@@ -18,7 +18,8 @@ TEST(FaceOrientationTest, GradientCheckerOnBothSides) {
     double p0[3] = {0, 0, 0}, p1[3] = {1, 0.1, 0.05}, p2[3] = {0.2, z_flip, 0.1};
     const double* params[] = {p0, p1, p2};
     ceres::NumericDiffOptions numeric;
-    ceres::GradientChecker checker(&cost, static_cast<const std::vector<const ceres::Manifold*>*>(nullptr), numeric);
+    ceres::GradientChecker checker(
+        &cost, static_cast<const std::vector<const ceres::Manifold*>*>(nullptr), numeric);
     ceres::GradientChecker::ProbeResults results;
     EXPECT_TRUE(checker.Probe(params, 1e-7, &results)) << results.error_log;
     double residual = 0.0;
