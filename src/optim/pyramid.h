@@ -10,38 +10,14 @@
 #include <cstdint>
 #include <vector>
 
+#include "cost_functions/pyramid_pixel.h"
 #include "src/core/image.h"
 #include "src/render/derivatives.h"
 
 namespace sft {
 
-// One Jacobian entry in double: ∂(pixel RGB)/∂(parameter `param`).
-struct RowEntry {
-  int32_t param;
-  double d[3];
-};
-
-// Sparse rows of one pyramid level, pixel-major, entries of each pixel sorted by parameter with no
-// duplicates: pixel p's entries are entries[offsets[p] .. offsets[p + 1]).
-struct LevelRows {
-  int width = 0;
-  int height = 0;
-  std::vector<uint64_t> offsets;
-  std::vector<RowEntry> entries;
-
-  size_t MemoryBytes() const {
-    return offsets.capacity() * sizeof(uint64_t) + entries.capacity() * sizeof(RowEntry);
-  }
-};
-
-// One level of one view as the residual blocks read it (owned by the render cache, updated in
-// place at every evaluation point; see cost_functions/pyramid_pixel.h).
-struct LevelCache {
-  Image render;              // the rendering's pyramid level, RGB.
-  Image target;              // the target's pyramid level, RGB.
-  LevelRows rows;            // Jacobian rows of `render`; empty when not rendered with derivatives.
-  double sqrt_weight = 1.0;  // the level's residual weight √w_l.
-};
+// RowEntry, LevelRows and LevelCache (what a residual block reads) are defined with the residual
+// in cost_functions/pyramid_pixel.h.
 
 // ⌈n/2⌉.
 inline int CoarserSize(int n) { return (n + 1) / 2; }
