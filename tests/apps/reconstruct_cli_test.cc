@@ -98,6 +98,35 @@ TEST(ReconstructCliTest, ReconstructEvalResume) {
   EXPECT_TRUE(fs::exists(tmp.Join("rr/images/000.exr")));
 }
 
+// Ctrl-C: the run stops after the current iteration, writes its checkpoint and exits 130;
+// --resume continues from it.
+TEST(ReconstructCliTest, InterruptWritesACheckpointAndResumes) {
+  testing::TempDir tmp;
+  ASSERT_EQ(testing::SynthIcosphere(tmp.Join("ds"), "--cameras 2 --zooms 1 --res 16 --spp 8"), "");
+  std::string out;
+  // SIGINT after 3 s into a run that would take minutes (`timeout` passes on the exit status).
+  const int code =
+      testing::RunCommand("timeout --preserve-status -s INT 3 " + testing::SftBinary() +
+                              " reconstruct --quiet --dataset " + tmp.Join("ds") + " --init " +
+                              tmp.Join("ds/gt/mesh.ply") + " --out " + tmp.Join("r") +
+                              " --outer 10000 --steps 2 --spp 4 --bounces 1 --phases texture",
+                          &out);
+  EXPECT_EQ(code, 130) << out;
+  EXPECT_THAT(out, HasSubstr("--resume"));
+  const nlohmann::json state = nlohmann::json::parse(ReadAll(tmp.Join("r/state.json")));
+  EXPECT_FALSE(state["finished"].get<bool>());
+  const int done = state["outer_done"].get<int>();
+  EXPECT_TRUE(fs::exists(tmp.Join("r/mesh.ply")));
+  ASSERT_EQ(RunSft("reconstruct --quiet --resume " + tmp.Join("r") + " --outer " +
+                       std::to_string(done + 1) + " --no-report",
+                   &out),
+            0)
+      << out;
+  const nlohmann::json resumed = nlohmann::json::parse(ReadAll(tmp.Join("r/state.json")));
+  EXPECT_EQ(resumed["outer_done"].get<int>(), done + 1);
+  EXPECT_TRUE(resumed["finished"].get<bool>());
+}
+
 TEST(ReconstructCliTest, BadInputIsOneLine) {
   testing::TempDir tmp;
   ASSERT_EQ(testing::SynthIcosphere(tmp.Join("ds"), "--cameras 1 --zooms 1 --res 8 --spp 2"), "");
