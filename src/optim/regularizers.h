@@ -16,8 +16,10 @@ namespace sft {
 struct RegularizerOptions {
   // Weight of the vertex Laplacian term (√ of the weight multiplies each residual), ≥ 0; 0 = off.
   // The residual is the Laplacian of the displacement from the phase's starting mesh, so the
-  // term smooths the update without shrinking the shape.
-  double laplacian_weight = 0.0;
+  // term smooths the update without shrinking the shape. The default suits scenes normalised to
+  // a bounding-box diagonal of 1 (as sft synth and the importers write them) and the image
+  // residuals of radiance around 0.5 (docs/design-notes.md, "Reconstruction").
+  double laplacian_weight = 30.0;
   bool cotangent = false;  // cotangent weights (at the starting mesh) instead of uniform ones.
   // The Laplacian of the shape itself (smooths and shrinks it: what removes i.i.d. vertex noise)
   // instead of the Laplacian of the displacement.

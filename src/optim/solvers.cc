@@ -12,15 +12,17 @@ double Since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-// Forwards Ceres iterations to the hooks.
+// Forwards Ceres iterations to the hooks. Ceres reports a rejected step with the cost of the
+// rejected trial point; the hooks get the cost of the point the solver stands on.
 class HookCallback : public ceres::IterationCallback {
  public:
   explicit HookCallback(const SolverHooks& hooks) : hooks_(hooks) {}
   ceres::CallbackReturnType operator()(const ceres::IterationSummary& summary) override {
+    if (summary.iteration == 0 || summary.step_is_successful) accepted_cost_ = summary.cost;
     if (summary.iteration == 0 || !hooks_.on_iteration) return ceres::SOLVER_CONTINUE;
     IterationInfo info;
     info.iteration = summary.iteration;
-    info.cost = summary.cost;
+    info.cost = accepted_cost_;
     info.accepted = summary.step_is_successful;
     return hooks_.on_iteration(info) ? ceres::SOLVER_CONTINUE
                                      : ceres::SOLVER_TERMINATE_SUCCESSFULLY;
@@ -28,6 +30,7 @@ class HookCallback : public ceres::IterationCallback {
 
  private:
   const SolverHooks& hooks_;
+  double accepted_cost_ = 0.0;
 };
 
 // The regularizers alone, for the adjoint objective.
