@@ -102,52 +102,63 @@ Status OuterRecord(int outer, const std::vector<IterationRecord>& records, const
   return Status::Ok();
 }
 
+// Settles the run's folders and options: a fresh run needs --dataset, --init and --out and an
+// output folder that overlaps no input and holds no earlier run; --resume reads the earlier
+// run's state (its dataset and effective options) from its own folder.
+Status PrepareRun(ReconstructCommandOptions* cli, RunState* state, ReconstructOptions* options) {
+  nlohmann::json resumed_config;
+  if (!cli->resume.empty()) {
+    if (!cli->out.empty() && cli->out != cli->resume) {
+      return Status::Error("--resume continues in its own folder: drop --out or give the same");
+    }
+    cli->out = cli->resume;
+    SFT_RETURN_IF_ERROR(ReadRunState(cli->resume, state));
+    if (cli->dataset.empty()) cli->dataset = state->dataset;
+    resumed_config = state->config;
+  } else if (cli->dataset.empty() || cli->init.empty() || cli->out.empty()) {
+    return Status::Error("--dataset, --init and --out are required (or --resume OUT)");
+  }
+  SFT_RETURN_IF_ERROR(MakeOptions(*cli, cli->resume.empty() ? nullptr : &resumed_config, options));
+  if (!(cli->reference_tolerance > 0.0 && cli->reference_tolerance <= 1.0)) {
+    return Status::Error("--reference-tolerance: must be in (0, 1]");
+  }
+  if (!cli->resume.empty()) {
+    return CheckOutputDirectory(cli->out, {{cli->dataset}, {}}, "--resume");
+  }
+  const RunInputs inputs{{cli->dataset},
+                         {cli->init, MaterialFile(cli->material), cli->config, cli->reference}};
+  SFT_RETURN_IF_ERROR(CheckOutputDirectory(cli->out, inputs, "--out"));
+  if (FileExists(JoinPath(cli->out, "state.json"))) {
+    return Status::Error("--out " + cli->out +
+                         ": holds an earlier reconstruction (continue it with --resume " +
+                         cli->out + ", or choose another folder)");
+  }
+  return Status::Ok();
+}
+
+// The starting mesh, material and light scales: --init and --material, or the checkpoint.
+Status LoadStart(const ReconstructCommandOptions& cli, const Dataset& dataset, TriMesh* mesh,
+                 Material* material, std::vector<double>* light_scales) {
+  if (cli.resume.empty()) {
+    SFT_RETURN_IF_ERROR(ReadMesh(cli.init, mesh));
+    return LoadMaterial(cli.material.empty() ? kInitialGuess : cli.material, *mesh, material);
+  }
+  SFT_RETURN_IF_ERROR(ReadMesh(JoinPath(cli.out, "mesh.ply"), mesh));
+  SFT_RETURN_IF_ERROR(LoadMaterial(JoinPath(cli.out, "material.json"), *mesh, material));
+  return ReadLightScales(JoinPath(cli.out, "lights.json"), dataset, light_scales);
+}
+
 Status RunReconstruct(const ReconstructCommandOptions& cli_in) {
   ReconstructCommandOptions cli = cli_in;
   RunState state;
-  nlohmann::json resumed_config;
-  if (!cli.resume.empty()) {
-    if (!cli.out.empty() && cli.out != cli.resume) {
-      return Status::Error("--resume continues in its own folder: drop --out or give the same");
-    }
-    cli.out = cli.resume;
-    SFT_RETURN_IF_ERROR(ReadRunState(cli.resume, &state));
-    if (cli.dataset.empty()) cli.dataset = state.dataset;
-    resumed_config = state.config;
-  } else if (cli.dataset.empty() || cli.init.empty() || cli.out.empty()) {
-    return Status::Error("--dataset, --init and --out are required (or --resume OUT)");
-  }
   ReconstructOptions options;
-  SFT_RETURN_IF_ERROR(MakeOptions(cli, cli.resume.empty() ? nullptr : &resumed_config, &options));
-  RunInputs inputs{{cli.dataset},
-                   {cli.init, MaterialFile(cli.material), cli.config, cli.reference}};
-  if (!(cli.reference_tolerance > 0.0 && cli.reference_tolerance <= 1.0)) {
-    return Status::Error("--reference-tolerance: must be in (0, 1]");
-  }
-  if (cli.resume.empty()) {
-    SFT_RETURN_IF_ERROR(CheckOutputDirectory(cli.out, inputs, "--out"));
-    if (FileExists(JoinPath(cli.out, "state.json"))) {
-      return Status::Error("--out " + cli.out +
-                           ": holds an earlier reconstruction (continue it with --resume " +
-                           cli.out + ", or choose another folder)");
-    }
-  } else {
-    SFT_RETURN_IF_ERROR(CheckOutputDirectory(cli.out, {{cli.dataset}, {}}, "--resume"));
-  }
+  SFT_RETURN_IF_ERROR(PrepareRun(&cli, &state, &options));
   Dataset dataset;
   SFT_RETURN_IF_ERROR(ReadDataset(cli.dataset, &dataset));
   TriMesh mesh;
   Material material;
   std::vector<double> light_scales;
-  if (cli.resume.empty()) {
-    SFT_RETURN_IF_ERROR(ReadMesh(cli.init, &mesh));
-    SFT_RETURN_IF_ERROR(
-        LoadMaterial(cli.material.empty() ? kInitialGuess : cli.material, mesh, &material));
-  } else {
-    SFT_RETURN_IF_ERROR(ReadMesh(JoinPath(cli.out, "mesh.ply"), &mesh));
-    SFT_RETURN_IF_ERROR(LoadMaterial(JoinPath(cli.out, "material.json"), mesh, &material));
-    SFT_RETURN_IF_ERROR(ReadLightScales(JoinPath(cli.out, "lights.json"), dataset, &light_scales));
-  }
+  SFT_RETURN_IF_ERROR(LoadStart(cli, dataset, &mesh, &material, &light_scales));
   std::unique_ptr<Reconstruction> reconstruction;
   SFT_RETURN_IF_ERROR(
       Reconstruction::Create(dataset, mesh, material, light_scales, options, &reconstruction));

@@ -27,6 +27,19 @@ struct Image {
   float at(int x, int y, int c = 0) const { return data[Index(x, y, c)]; }
 };
 
+// The first three channels of `image` as RGB (a 1- or 2-channel image repeats its first channel;
+// alpha and further channels are dropped).
+inline Image ToRgb(const Image& image) {
+  if (image.channels == 3) return image;
+  Image rgb(image.width, image.height, 3);
+  for (int y = 0; y < image.height; ++y) {
+    for (int x = 0; x < image.width; ++x) {
+      for (int c = 0; c < 3; ++c) rgb.at(x, y, c) = image.at(x, y, image.channels >= 3 ? c : 0);
+    }
+  }
+  return rgb;
+}
+
 }  // namespace sft
 
 #endif  // SFT_CORE_IMAGE_H_

@@ -42,16 +42,6 @@ struct Measure {
   }
 };
 
-Image Rgb(const Image& image) {
-  Image rgb(image.width, image.height, 3);
-  for (int y = 0; y < image.height; ++y) {
-    for (int x = 0; x < image.width; ++x) {
-      for (int c = 0; c < 3; ++c) rgb.at(x, y, c) = image.at(x, y, std::min(c, image.channels - 1));
-    }
-  }
-  return rgb;
-}
-
 // A ground-truth pass folder named by `key` of the dataset's ground_truth, or "" when absent.
 Status PassFolder(const Dataset& dataset, const char* key, std::string* folder) {
   folder->clear();
@@ -76,12 +66,12 @@ Status TruePass(const Dataset& dataset, int v, const std::string& folder, const 
     name.replace_extension(".exr");
     Image image;
     SFT_RETURN_IF_ERROR(ReadImage(JoinPath(JoinPath(dataset.root, folder), name.string()), &image));
-    *out = Rgb(image);
+    *out = ToRgb(image);
     return Status::Ok();
   }
   Image image;
   RenderView(*scene, *truth, view, options, &image);
-  *out = Rgb(image);
+  *out = ToRgb(image);
   return Status::Ok();
 }
 
@@ -150,20 +140,20 @@ Status EvaluateReconstruction(const std::string& dataset_dir, const std::string&
     SFT_RETURN_IF_ERROR(LoadViewImage(dataset, v, &target));
     if (!dataset.views[v].mask.empty()) SFT_RETURN_IF_ERROR(LoadViewMask(dataset, v, &mask));
     RenderView(scene, material, views.views[v], render, &ours);
-    SFT_RETURN_IF_ERROR(full.Add(v, Rgb(ours), target, mask));
+    SFT_RETURN_IF_ERROR(full.Add(v, ToRgb(ours), target, mask));
     if (!albedo_folder.empty() || can_render_truth) {
       Image truth;
       SFT_RETURN_IF_ERROR(TruePass(dataset, v, albedo_folder, true_scene.get(), &true_material,
                                    views.views[v], albedo_pass, &truth));
       RenderView(scene, material, views.views[v], albedo_pass, &ours);
-      SFT_RETURN_IF_ERROR(albedo.Add(v, Rgb(ours), truth, mask));
+      SFT_RETURN_IF_ERROR(albedo.Add(v, ToRgb(ours), truth, mask));
     }
     if (!roughness_folder.empty() || can_render_truth) {
       Image truth;
       SFT_RETURN_IF_ERROR(TruePass(dataset, v, roughness_folder, true_scene.get(), &true_material,
                                    views.views[v], roughness_pass, &truth));
       RenderView(scene, material, views.views[v], roughness_pass, &ours);
-      SFT_RETURN_IF_ERROR(roughness.Add(v, Rgb(ours), truth, mask));
+      SFT_RETURN_IF_ERROR(roughness.Add(v, ToRgb(ours), truth, mask));
     }
   }
   *report = {

@@ -490,19 +490,6 @@ Status CheckSize(const std::string& path, const char* what, const Image& image,
   return Status::Ok();
 }
 
-Image ToRgb(const Image& image) {
-  if (image.channels == 3) return image;
-  Image rgb(image.width, image.height, 3);
-  for (int y = 0; y < image.height; ++y) {
-    for (int x = 0; x < image.width; ++x) {
-      for (int c = 0; c < 3; ++c) {
-        rgb.at(x, y, c) = image.at(x, y, image.channels >= 3 ? c : 0);
-      }
-    }
-  }
-  return rgb;
-}
-
 std::string ScenePath(const Dataset& dataset) { return JoinPath(dataset.root, kSceneFile); }
 
 const Camera& ViewCamera(const Dataset& dataset, int index) {

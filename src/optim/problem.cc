@@ -60,6 +60,31 @@ void AddTouchedBlocks(const SceneParameters& params, const Material& material,
   }
 }
 
+// Supersets [view][level][pixel] -> block offsets: the union over `renders` derivative renders
+// with seeds derived from the cache's seed, which is left as it was.
+void CollectSupersets(RenderCache* cache, const SceneParameters& params, int renders,
+                      std::vector<std::vector<PixelBlocks>>* supersets) {
+  supersets->assign(cache->num_views(), {});
+  for (int v = 0; v < cache->num_views(); ++v) {
+    for (int l = 0; l < cache->num_levels(v); ++l) {
+      const Image& image = cache->level(v, l).target;
+      (*supersets)[v].emplace_back(static_cast<size_t>(image.width) * image.height);
+    }
+  }
+  const uint64_t seed = cache->seed();
+  for (int k = 0; k < renders; ++k) {
+    cache->SetSeed(seed * 1000003ull + 7919ull * (k + 1));
+    cache->Render(/*rows=*/true);
+    for (int v = 0; v < cache->num_views(); ++v) {
+      for (int l = 0; l < cache->num_levels(v); ++l) {
+        AddTouchedBlocks(params, cache->material(), cache->level(v, l).rows,
+                         cache->targets(v).active[l], &(*supersets)[v][l]);
+      }
+    }
+  }
+  cache->SetSeed(seed);
+}
+
 }  // namespace
 
 bool ProblemOptions::Check(std::string* why) const {
@@ -77,28 +102,10 @@ Status ReconstructionProblem::Build(RenderCache* cache, SceneParameters* params,
   if (!options.Check(&why)) return Status::Error(why);
   const auto start = std::chrono::steady_clock::now();
   auto result = std::unique_ptr<ReconstructionProblem>(new ReconstructionProblem());
-  // Supersets: [view][level][pixel] -> block offsets.
-  std::vector<std::vector<PixelBlocks>> supersets(cache->num_views());
-  for (int v = 0; v < cache->num_views(); ++v) {
-    for (int l = 0; l < cache->num_levels(v); ++l) {
-      const Image& image = cache->level(v, l).target;
-      supersets[v].emplace_back(static_cast<size_t>(image.width) * image.height);
-    }
-  }
-  const uint64_t seed = cache->seed();
   // Without an image term (regularizers only) there are no pixel blocks to build.
   const bool image_term = cache->level(0, 0).sqrt_weight > 0.0;
-  for (int k = 0; image_term && k < options.superset_renders; ++k) {
-    cache->SetSeed(seed * 1000003ull + 7919ull * (k + 1));
-    cache->Render(/*rows=*/true);
-    for (int v = 0; v < cache->num_views(); ++v) {
-      for (int l = 0; l < cache->num_levels(v); ++l) {
-        AddTouchedBlocks(*params, cache->material(), cache->level(v, l).rows,
-                         cache->targets(v).active[l], &supersets[v][l]);
-      }
-    }
-  }
-  cache->SetSeed(seed);
+  std::vector<std::vector<PixelBlocks>> supersets;
+  if (image_term) CollectSupersets(cache, *params, options.superset_renders, &supersets);
 
   ceres::Problem::Options problem_options;
   problem_options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
@@ -113,7 +120,7 @@ Status ReconstructionProblem::Build(RenderCache* cache, SceneParameters* params,
     for (int l = 0; l < cache->num_levels(v); ++l) {
       const std::vector<uint8_t>& active = cache->targets(v).active[l];
       for (size_t p = 0; p < active.size(); ++p) {
-        if (!active[p] || !image_term) continue;
+        if (!image_term || !active[p]) continue;
         std::vector<int>& offsets = supersets[v][l][p];
         if (offsets.empty()) {
           ++stats.pixels_without_parameters;

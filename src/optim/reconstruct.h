@@ -5,7 +5,6 @@
 #ifndef SFT_OPTIM_RECONSTRUCT_H_
 #define SFT_OPTIM_RECONSTRUCT_H_
 
-#include <atomic>
 #include <functional>
 #include <memory>
 #include <string>

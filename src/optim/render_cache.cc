@@ -13,17 +13,6 @@ double Seconds(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-Image Rgb(const Image& image) {
-  if (image.channels == 3) return image;
-  Image rgb(image.width, image.height, 3);
-  for (int y = 0; y < image.height; ++y) {
-    for (int x = 0; x < image.width; ++x) {
-      for (int c = 0; c < 3; ++c) rgb.at(x, y, c) = image.at(x, y, std::min(c, image.channels - 1));
-    }
-  }
-  return rgb;
-}
-
 // The view's active level-0 pixels: its mask dilated by `dilation` pixels, or every pixel.
 Status ActivePixels(const Dataset& dataset, int view, int width, int height, int dilation,
                     std::vector<uint8_t>* active, bool* has_mask) {
@@ -94,7 +83,7 @@ Status RenderCache::Create(const Dataset& dataset, const DatasetViews* views,
     std::vector<uint8_t> active;
     SFT_RETURN_IF_ERROR(ActivePixels(dataset, v, target.width, target.height, options.mask_dilation,
                                      &active, &targets.has_mask));
-    const std::vector<Image> pyramid = BuildPyramid(Rgb(target), options.pyramid_levels);
+    const std::vector<Image> pyramid = BuildPyramid(ToRgb(target), options.pyramid_levels);
     targets.active =
         MaskPyramid(active, target.width, target.height, static_cast<int>(pyramid.size()));
     std::vector<std::unique_ptr<LevelCache>> levels;
@@ -170,7 +159,7 @@ void RenderCache::Render(bool rows) {
 
 void RenderCache::StoreRender(int v, const Image& image, const JacobianRows* rows) {
   const auto start = std::chrono::steady_clock::now();
-  std::vector<Image> pyramid = BuildPyramid(Rgb(image), num_levels(v));
+  std::vector<Image> pyramid = BuildPyramid(ToRgb(image), num_levels(v));
   for (float value : pyramid[0].data) non_finite_ += !std::isfinite(value);
   LevelRows level_rows;
   if (rows != nullptr) {

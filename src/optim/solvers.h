@@ -17,7 +17,6 @@
 
 #include <ceres/ceres.h>
 
-#include <atomic>
 #include <functional>
 #include <string>
 #include <vector>
