@@ -17,6 +17,10 @@ PACKAGES=(
   libopenmesh-dev
   # nearest neighbours (sft eval)
   libnanoflann-dev
+  # real captures: COLMAP's CLI (sft import video), volumes and surfaces (sft init)
+  colmap libopenvdb-dev libcgal-dev
+  # clang and its runtime (libFuzzer, sanitizers) for the fuzz targets
+  clang libclang-rt-14-dev
   # CLI, JSON
   libcli11-dev nlohmann-json3-dev
   # tests and benchmarks
