@@ -6,6 +6,8 @@
 //   sft bench gradient forward-only vs forward + Jacobian rows vs forward + adjoint gradient time
 //                      over the views of one scene, and the rows' memory
 //                      (src/eval/derivative_cost.h).
+//   sft bench reconstruct  one outer iteration of sft reconstruct on a dataset, its time split
+//                      (apps/bench_reconstruct_command.cc).
 #include <cstdio>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -146,7 +148,8 @@ CommandRunner SetupBenchCommand(CLI::App* app) {
   AddEdgeBudgetOptions(gradient, &gradient_opts->cost.derivatives);
   gradient->add_option("--json", gradient_opts->json, "Also write the results to this JSON file");
   gradient->add_flag("--quiet", gradient_opts->quiet, "No progress lines");
-  return [render, render_opts, gradient, gradient_opts]() {
+  CommandRunner reconstruct = AddBenchReconstructCommand(app);
+  return [render, render_opts, gradient, gradient_opts, reconstruct]() {
     if (render->parsed()) {
       const Status status = RunBenchRender(*render_opts);
       return status.ok() ? 0 : PrintError("bench render", status);
@@ -155,7 +158,8 @@ CommandRunner SetupBenchCommand(CLI::App* app) {
       const Status status = RunBenchGradient(*gradient_opts);
       return status.ok() ? 0 : PrintError("bench gradient", status);
     }
-    return 2;
+    const int code = reconstruct();
+    return code >= 0 ? code : 2;
   };
 }
 

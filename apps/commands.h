@@ -42,6 +42,8 @@ CommandRunner SetupSynthCommand(CLI::App* app);
 CommandRunner SetupRenderCommand(CLI::App* app);
 CommandRunner SetupGradcheckCommand(CLI::App* app);
 CommandRunner SetupBenchCommand(CLI::App* app);
+// Adds `sft bench reconstruct` under `bench`; its runner returns -1 when it was not the one parsed.
+CommandRunner AddBenchReconstructCommand(CLI::App* bench);
 CommandRunner SetupReconstructCommand(CLI::App* app);
 CommandRunner SetupPerturbCommand(CLI::App* app);
 CommandRunner SetupEvalCommand(CLI::App* app);

@@ -88,4 +88,25 @@ bool CheckMemoryBudget(uint64_t bytes, const std::string& what, std::string* why
   return false;
 }
 
+int64_t ProcessStatusBytes(const std::string& key) {
+  std::ifstream in("/proc/self/status");
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.compare(0, key.size(), key) != 0) continue;
+    std::istringstream fields(line.substr(key.size()));
+    int64_t kilobytes = 0;
+    fields >> kilobytes;
+    return fields ? kilobytes * 1024 : 0;
+  }
+  return 0;
+}
+
+bool ResetPeakResidentSet() {
+  std::ofstream out("/proc/self/clear_refs");
+  if (!out) return false;
+  out << "5";
+  out.close();
+  return !out.fail();
+}
+
 }  // namespace sft

@@ -25,6 +25,14 @@ std::string FormatBytes(uint64_t bytes);
 // and *why = "<what> needs an estimated X, more than the Y of memory available".
 bool CheckMemoryBudget(uint64_t bytes, const std::string& what, std::string* why);
 
+// A field of /proc/self/status in bytes (e.g. "VmRSS:", "VmHWM:" the peak resident set); 0 when
+// unavailable.
+int64_t ProcessStatusBytes(const std::string& key);
+
+// Resets the process's peak resident set (VmHWM) to the current one (Linux ≥ 4.0); false when the
+// kernel does not allow it.
+bool ResetPeakResidentSet();
+
 }  // namespace sft
 
 #endif  // SFT_CORE_MEMORY_H_

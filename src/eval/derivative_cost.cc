@@ -12,6 +12,7 @@
 #include <utility>
 #include <vector>
 
+#include "src/core/memory.h"
 #include "src/core/progress.h"
 #include "src/core/rng.h"
 #include "src/geometry/material.h"
@@ -43,29 +44,6 @@ constexpr double kAim = 3.0;  // issue 3 item 6: either derivative pass ≤ 3× 
 // A uniform number in [0, 1) that is a pure function of (seed, stream, index).
 double UnitHash(uint64_t seed, uint64_t stream, uint64_t index) {
   return static_cast<double>(Mix64(Mix64(Mix64(seed) ^ stream) ^ index) >> 11) * 0x1.0p-53;
-}
-
-// A field of /proc/self/status in bytes ("VmRSS:", "VmHWM:"); 0 when unavailable.
-int64_t ProcStatusBytes(const std::string& key) {
-  std::ifstream in("/proc/self/status");
-  std::string line;
-  while (std::getline(in, line)) {
-    if (line.compare(0, key.size(), key) != 0) continue;
-    std::istringstream fields(line.substr(key.size()));
-    int64_t kilobytes = 0;
-    fields >> kilobytes;
-    return fields ? kilobytes * 1024 : 0;
-  }
-  return 0;
-}
-
-// Resets the process's peak resident set (VmHWM) to the current one (Linux ≥ 4.0).
-bool ResetPeakRss() {
-  std::ofstream out("/proc/self/clear_refs");
-  if (!out) return false;
-  out << "5";
-  out.close();
-  return !out.fail();
 }
 
 template <typename F>
@@ -213,11 +191,11 @@ Status MeasureDerivativeCost(const DerivativeCostOptions& options, const TriMesh
 
   // Resets the peak before a pass and reads it after; `cost` gets both.
   auto begin_pass = [&](DerivativePassCost* cost) {
-    result.peak_rss_reset = ResetPeakRss();
-    cost->rss_before_bytes = ProcStatusBytes("VmRSS:");
+    result.peak_rss_reset = ResetPeakResidentSet();
+    cost->rss_before_bytes = ProcessStatusBytes("VmRSS:");
   };
   auto end_pass = [&](DerivativePassCost* cost) {
-    cost->peak_rss_bytes = ProcStatusBytes("VmHWM:");
+    cost->peak_rss_bytes = ProcessStatusBytes("VmHWM:");
   };
 
   // Untimed warm-up (thread pool, first touch of the scene) so the forward pass is not charged.

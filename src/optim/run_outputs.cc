@@ -11,6 +11,21 @@ namespace sft {
 
 using json = nlohmann::json;
 
+namespace {
+
+json TimeSplitJson(const SolverTimeSplit& t) {
+  return {{"superset_renders", t.superset_renders},
+          {"problem_assembly", t.problem_assembly},
+          {"solve_startup", t.solve_startup},
+          {"render", t.render},
+          {"pyramid", t.pyramid},
+          {"evaluation", t.evaluation},
+          {"linear_solver", t.linear_solver},
+          {"other", t.other}};
+}
+
+}  // namespace
+
 Status WriteRunState(const std::string& out, const RunState& state) {
   json j = {{"format", "sft-reconstruct-state/1"},
             {"dataset", state.dataset},
@@ -93,6 +108,8 @@ Status WriteMetrics(const std::string& out, const std::vector<IterationRecord>& 
                           {"pixels_without_parameters", p.stats.problem.pixels_without_parameters},
                           {"dropped_jacobian_fraction", p.stats.dropped_jacobian_fraction},
                           {"non_finite_values", p.non_finite_values},
+                          {"evaluations", p.stats.evaluations},
+                          {"time_split", TimeSplitJson(p.stats.time)},
                           {"termination", p.stats.termination}});
   }
   json metrics = extra.is_object() ? extra : json::object();

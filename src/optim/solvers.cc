@@ -2,6 +2,7 @@
 
 #include <glog/logging.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
@@ -10,6 +11,33 @@ namespace {
 
 double Since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// The render cache's cumulative clocks at one moment; the difference of two is what a stretch of
+// the run spent rendering.
+struct CacheClock {
+  explicit CacheClock(const RenderCache& cache)
+      : render(cache.render_seconds()),
+        pyramid(cache.pyramid_seconds()),
+        renders(cache.renders()),
+        views(std::max(1, cache.num_views())) {}
+  // Adds the render and pyramid time since `start` to *time and the evaluations to *evaluations.
+  void AddSince(const CacheClock& start, SolverTimeSplit* time, int* evaluations) const {
+    time->render += render - start.render;
+    time->pyramid += pyramid - start.pyramid;
+    *evaluations += static_cast<int>((renders - start.renders) / views);
+  }
+  double render, pyramid;
+  int64_t renders;
+  int views;
+};
+
+// Sets the remainder of the split so that the parts add up to the call's wall time.
+void FinishTimeSplit(SolverRunStats* stats) {
+  const SolverTimeSplit& t = stats->time;
+  const double parts = t.superset_renders + t.problem_assembly + t.solve_startup + t.render +
+                       t.pyramid + t.evaluation + t.linear_solver;
+  stats->time.other = std::max(0.0, stats->seconds - parts);
 }
 
 // Forwards Ceres iterations to the hooks. Ceres reports a rejected step with the cost of the
@@ -213,25 +241,44 @@ Status RunSolver(const SolverOptions& options, const ProblemOptions& problem_opt
     solver.max_num_iterations = options.steps;
     solver.callbacks.push_back(&callback);
     ceres::GradientProblemSolver::Summary summary;
+    const CacheClock before(*cache);
     ceres::Solve(solver, problem, x.data(), &summary);
     objective->Store(x.data());
     stats->iterations = static_cast<int>(summary.iterations.size()) - 1;
     stats->termination = summary.message;
+    CacheClock(*cache).AddSince(before, &stats->time, &stats->evaluations);
+    stats->time.evaluation = std::max(0.0, summary.cost_evaluation_time_in_seconds +
+                                               summary.gradient_evaluation_time_in_seconds -
+                                               stats->time.render - stats->time.pyramid);
   } else {
     std::unique_ptr<ReconstructionProblem> problem;
+    const CacheClock before_build(*cache);
     SFT_RETURN_IF_ERROR(ReconstructionProblem::Build(cache, params, problem_options, &problem));
     if (hooks.add_regularizers) hooks.add_regularizers(problem->problem());
     stats->problem = problem->stats();
-    stats->setup_seconds = problem->stats().build_seconds;
+    SolverTimeSplit build;
+    int superset_renders = 0;
+    CacheClock(*cache).AddSince(before_build, &build, &superset_renders);
+    stats->time.superset_renders = build.render + build.pyramid;
+    stats->time.problem_assembly = std::max(0.0, Since(start) - stats->time.superset_renders);
+    stats->setup_seconds = Since(start);
     ceres::Solver::Options solver = TrustRegionOptions(options);
     solver.callbacks.push_back(&callback);
     ceres::Solver::Summary summary;
+    const CacheClock before(*cache);
     ceres::Solve(solver, problem->problem(), &summary);
     stats->iterations = static_cast<int>(summary.iterations.size()) - 1;
     stats->termination = summary.message;
+    CacheClock(*cache).AddSince(before, &stats->time, &stats->evaluations);
+    stats->time.solve_startup = summary.preprocessor_time_in_seconds;
+    stats->time.linear_solver = summary.linear_solver_time_in_seconds;
+    stats->time.evaluation = std::max(0.0, summary.residual_evaluation_time_in_seconds +
+                                               summary.jacobian_evaluation_time_in_seconds -
+                                               stats->time.render - stats->time.pyramid);
     stats->dropped_jacobian_fraction = problem->DroppedJacobianFraction(*cache);
   }
   stats->seconds = Since(start);
+  FinishTimeSplit(stats);
   return Status::Ok();
 }
 
@@ -254,6 +301,7 @@ Status RunAdam(const SolverOptions& options, const ProblemOptions& problem_optio
   const AdamOptions& adam = options.adam;
   double cost = 0.0;
   stats->termination = "steps";
+  const CacheClock before(*cache);
   for (int step = 1; step <= options.steps; ++step) {
     if (!objective.Evaluate(x.data(), &cost, gradient.data())) {
       stats->termination = "non-finite render";
@@ -283,7 +331,11 @@ Status RunAdam(const SolverOptions& options, const ProblemOptions& problem_optio
       break;
     }
   }
+  CacheClock(*cache).AddSince(before, &stats->time, &stats->evaluations);
   stats->seconds = Since(start);
+  // Adam's evaluations are its whole loop apart from the renders.
+  stats->time.evaluation = std::max(0.0, stats->seconds - stats->time.render - stats->time.pyramid);
+  FinishTimeSplit(stats);
   return Status::Ok();
 }
 

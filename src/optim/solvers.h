@@ -69,11 +69,28 @@ struct SolverHooks {
   std::function<void(ceres::Problem*)> add_regularizers;
 };
 
+// Where one call's wall time went, in seconds (`sft bench reconstruct`). The parts add up to
+// SolverRunStats::seconds; `other` is the remainder (minimizer bookkeeping, trust-region or line
+// search logic, callbacks).
+struct SolverTimeSplit {
+  double superset_renders = 0.0;  // the problem build's superset renders (trust region).
+  double problem_assembly = 0.0;  // the rest of the problem build: blocks, bounds, regularizers.
+  double solve_startup = 0.0;     // Ceres' preprocessor (program, evaluator, linear solver setup).
+  double render = 0.0;            // renders in the evaluations (forward + rows, or adjoint).
+  double pyramid = 0.0;           // pyramid levels of images and rows.
+  double evaluation = 0.0;        // the rest of the evaluations: rows copied into Ceres' Jacobian
+                                  // in double, regularizers, gradients.
+  double linear_solver = 0.0;     // the trust-region step's linear solve (CGNR, Cholesky, QR).
+  double other = 0.0;             // the remainder.
+};
+
 // Counters of one call, for the report.
 struct SolverRunStats {
   int iterations = 0;
+  int evaluations = 0;  // renders of every view at new points (function evaluations).
   double seconds = 0.0;
-  double setup_seconds = 0.0;              // problem build (supersets included), trust region only.
+  double setup_seconds = 0.0;  // problem build (supersets included), trust region only.
+  SolverTimeSplit time;
   double dropped_jacobian_fraction = 0.0;  // trust region: at the last linearization.
   ProblemStats problem;
   std::string termination;  // Ceres' message or "steps".
