@@ -171,8 +171,21 @@ Status RunReconstruct(const ReconstructCommandOptions& cli_in) {
   }
   TriMesh reference;
   if (!cli.reference.empty()) SFT_RETURN_IF_ERROR(ReadMesh(cli.reference, &reference));
-  const TriMesh initial_mesh = mesh;
   SFT_RETURN_IF_ERROR(MakeDirectories(cli.out));
+  // Folded faces are counted against the run's start, also after --resume.
+  TriMesh initial_mesh = mesh;
+  const std::string initial_path = JoinPath(cli.out, "initial_mesh.ply");
+  if (cli.resume.empty()) {
+    SFT_RETURN_IF_ERROR(WriteMesh(initial_path, mesh));
+    state.init = cli.init;
+  } else if (FileExists(initial_path)) {
+    SFT_RETURN_IF_ERROR(ReadMesh(initial_path, &initial_mesh));
+    if (initial_mesh.n_faces() != mesh.n_faces()) {
+      return Status::Error(initial_path + ": " + std::to_string(initial_mesh.n_faces()) +
+                           " faces, the checkpoint's mesh.ply has " +
+                           std::to_string(mesh.n_faces()));
+    }
+  }
 
   state.dataset = cli.dataset;
   state.config = ReconstructConfigJson(options);
@@ -183,7 +196,7 @@ Status RunReconstruct(const ReconstructCommandOptions& cli_in) {
                     !cli.quiet);
   std::signal(SIGINT, OnInterrupt);
   const nlohmann::json run_info = {{"dataset", cli.dataset},
-                                   {"init", cli.init},
+                                   {"init", state.init},
                                    {"config", state.config},
                                    {"views", reconstruction->view_indices()}};
   for (int outer = state.outer_done; outer < options.outer_iterations && !g_interrupted; ++outer) {

@@ -29,6 +29,7 @@ json TimeSplitJson(const SolverTimeSplit& t) {
 Status WriteRunState(const std::string& out, const RunState& state) {
   json j = {{"format", "sft-reconstruct-state/1"},
             {"dataset", state.dataset},
+            {"init", state.init},
             {"config", state.config},
             {"outer_done", state.outer_done},
             {"seconds", state.seconds},
@@ -51,6 +52,7 @@ Status ReadRunState(const std::string& out, RunState* state) {
     return Status::Error(path + ": missing dataset, config or outer_done");
   }
   state->dataset = j["dataset"].get<std::string>();
+  state->init = j.value("init", "");
   state->config = j["config"];
   state->outer_done = j["outer_done"].get<int>();
   state->seconds = j.value("seconds", 0.0);

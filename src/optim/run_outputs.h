@@ -5,7 +5,9 @@
 //   metrics.csv, metrics.json   per iteration: outer, phase, iteration, cost, seconds, accepted,
 //                               per-view PSNR; metrics.json adds per-phase solver statistics;
 //   state.json                  what --resume needs: dataset, effective config, outer iterations
-//                               done, elapsed seconds.
+//                               done, elapsed seconds, the --init path as given;
+//   initial_mesh.ply            the starting mesh, the baseline of the folded-face count (kept so
+//                               a resumed run compares with the run's start, not its checkpoint).
 // A checkpoint is written after every outer iteration and when the run is interrupted.
 #ifndef SFT_OPTIM_RUN_OUTPUTS_H_
 #define SFT_OPTIM_RUN_OUTPUTS_H_
@@ -22,6 +24,7 @@ namespace sft {
 // The resumable state of a run (state.json).
 struct RunState {
   std::string dataset;    // the dataset folder, as given.
+  std::string init;       // the --init mesh, as given (for the record; initial_mesh.ply is used).
   nlohmann::json config;  // ReconstructConfigJson of the effective options.
   int outer_done = 0;     // outer iterations completed.
   double seconds = 0.0;   // wall time of the run so far (all sessions).

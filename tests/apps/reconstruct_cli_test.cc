@@ -50,7 +50,7 @@ TEST(ReconstructCliTest, ReconstructEvalResume) {
       0)
       << out;
   for (const char* file : {"mesh.ply", "mesh.obj", "material.json", "lights.json", "metrics.csv",
-                           "metrics.json", "state.json", "report.html"}) {
+                           "metrics.json", "state.json", "report.html", "initial_mesh.ply"}) {
     EXPECT_TRUE(fs::exists(tmp.Join(std::string("r/") + file))) << file;
   }
   const nlohmann::json metrics = nlohmann::json::parse(ReadAll(tmp.Join("r/metrics.json")));
@@ -62,14 +62,18 @@ TEST(ReconstructCliTest, ReconstructEvalResume) {
   EXPECT_EQ(CountLines(ReadAll(tmp.Join("r/metrics.csv"))),
             1 + static_cast<int>(iterations.size()));
 
-  // Resume to two outer iterations: the earlier records are kept, new ones follow.
+  // Resume to two outer iterations: the earlier records are kept, new ones follow, and folded
+  // faces are still counted against the run's start (initial_mesh.ply, not rewritten).
+  const std::string initial_mesh = ReadAll(tmp.Join("r/initial_mesh.ply"));
   ASSERT_EQ(RunSft("reconstruct --quiet --resume " + tmp.Join("r") + " --outer 2", &out), 0) << out;
+  EXPECT_EQ(ReadAll(tmp.Join("r/initial_mesh.ply")), initial_mesh);
   const nlohmann::json resumed = nlohmann::json::parse(ReadAll(tmp.Join("r/metrics.json")));
   EXPECT_GT(resumed["iterations"].size(), iterations.size());
   EXPECT_EQ(resumed["iterations"].back()["outer"], 1);
   const nlohmann::json state = nlohmann::json::parse(ReadAll(tmp.Join("r/state.json")));
   EXPECT_EQ(state["outer_done"], 2);
   EXPECT_TRUE(state["finished"].get<bool>());
+  EXPECT_EQ(state["init"], tmp.Join("init.ply"));
 
   // eval, both modes.
   ASSERT_EQ(RunSft("eval --dataset " + tmp.Join("ds") + " --reconstruction " + tmp.Join("r") +
