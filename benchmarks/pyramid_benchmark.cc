@@ -128,8 +128,8 @@ void Noise(int per_level, benchmark::State& state) {
       double m = 0, m2 = 0, r = 0, r2 = 0;
       for (int s = 0; s < kNoiseSeeds; ++s) {
         const Image& im = images[s][l];
-        const double value = im.data[p * im.channels] + im.data[p * im.channels + 1] +
-                             im.data[p * im.channels + 2];
+        const double value =
+            im.data[p * im.channels] + im.data[p * im.channels + 1] + im.data[p * im.channels + 2];
         const double row = RowDot(rows[s][l], p);
         m += value, m2 += value * value, r += row, r2 += row * row;
       }

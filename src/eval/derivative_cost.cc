@@ -16,6 +16,7 @@
 #include "src/core/progress.h"
 #include "src/core/rng.h"
 #include "src/geometry/material.h"
+#include "src/io/scene_setup.h"
 #include "src/render/camera_rig.h"
 #include "src/render/scene.h"
 
@@ -101,8 +102,8 @@ Material MakeMaterial(const TriMesh& mesh, uint64_t seed) {
 }
 
 // The adjoint weights: uniform in [−1, 1] per pixel and channel.
-Image MakeWeights(int resolution, uint64_t seed) {
-  Image weights(resolution, resolution, 3);
+Image MakeWeights(int width, int height, uint64_t seed) {
+  Image weights(width, height, 3);
   for (size_t i = 0; i < weights.data.size(); ++i) {
     weights.data[i] = static_cast<float>(2.0 * UnitHash(seed, kWeightStream, i) - 1.0);
   }
@@ -141,35 +142,117 @@ bool DerivativeCostOptions::Check(std::string* why) const {
   return render.Check(why);
 }
 
-Status MeasureDerivativeCost(const DerivativeCostOptions& options, const TriMesh& mesh,
-                             DerivativeCostReport* report) {
-  std::string why;
-  if (!options.Check(&why)) return Status::Error(why);
-  if (mesh.n_faces() == 0) return Status::Error("mesh: has no faces");
-  Eigen::Vector3d lo, hi;
-  MeshBounds(mesh, &lo, &hi);
-  if (!((hi - lo).norm() > 0.0)) return Status::Error("mesh: has zero extent");
+namespace {
 
-  DerivativeCostReport result;
-  result.num_faces = static_cast<int>(mesh.n_faces());
-  result.num_vertices = static_cast<int>(mesh.n_vertices());
+// What the three passes render: a scene, its material and views, and the lights' count.
+struct CostScene {
+  const RenderScene* scene;
+  const Material* material;
+  const std::vector<ViewSetup>* views;
+  int num_lights;
+};
+
+// Resets the peak before a pass; EndPass reads it.
+void BeginPass(DerivativeCostReport* result, DerivativePassCost* cost) {
+  result->peak_rss_reset = ResetPeakResidentSet();
+  cost->rss_before_bytes = ProcessStatusBytes("VmRSS:");
+}
+void EndPass(DerivativePassCost* cost) { cost->peak_rss_bytes = ProcessStatusBytes("VmHWM:"); }
+
+// (1) Forward only.
+void ForwardPass(const CostScene& s, const RenderOptions& render, bool progress_lines,
+                 DerivativeCostReport* result) {
+  BeginPass(result, &result->forward);
+  Progress progress("forward", static_cast<int64_t>(s.views->size()), progress_lines);
+  for (const ViewSetup& view : *s.views) {
+    Image image;
+    RenderStats stats;
+    result->forward.seconds +=
+        WallSeconds([&] { RenderView(*s.scene, *s.material, view, render, &image, &stats); });
+    AddRays(stats, &result->forward.rays);
+    for (int y = 0; y < image.height; ++y) {
+      for (int x = 0; x < image.width; ++x) result->covered_pixels += image.at(x, y, 3) > 0.f;
+    }
+    progress.Advance();
+  }
+  progress.Finish();
+  EndPass(&result->forward);
+}
+
+// (2) Forward + Jacobian rows; the rows of a view are freed before the next unless kept.
+void RowsPass(const CostScene& s, const RenderOptions& render, const DerivativeRequest& request,
+              const DerivativeCostOptions& options, DerivativeCostReport* result) {
+  BeginPass(result, &result->jacobian_rows);
+  std::vector<DerivativeOutput> kept;
+  if (options.keep_rows) kept.reserve(s.views->size());
+  Progress progress("jacobian rows", static_cast<int64_t>(s.views->size()), options.progress);
+  for (const ViewSetup& view : *s.views) {
+    Image image;
+    DerivativeOutput output;
+    RenderStats stats;
+    result->jacobian_rows.seconds += WallSeconds([&] {
+      RenderViewWithDerivatives(*s.scene, *s.material, view, render, request, s.num_lights, &image,
+                                &output, &stats);
+    });
+    AddRays(stats, &result->jacobian_rows.rays);
+    result->num_parameters = output.layout.size();
+    result->num_differentiated = output.layout.size();
+    const int64_t bytes = static_cast<int64_t>(output.rows.MemoryBytes());
+    result->jacobian_entries += static_cast<int64_t>(output.rows.entries.size());
+    result->rows_bytes_total += bytes;
+    result->rows_bytes_peak_view = std::max(result->rows_bytes_peak_view, bytes);
+    if (options.keep_rows) kept.push_back(std::move(output));
+    progress.Advance();
+  }
+  progress.Finish();
+  EndPass(&result->jacobian_rows);  // with keep_rows, every view's rows are still alive here.
+  result->rows_bytes_resident =
+      options.keep_rows ? result->rows_bytes_total : result->rows_bytes_peak_view;
+}
+
+// (3) Forward + adjoint gradient for fixed random weights of each view's size.
+void AdjointPass(const CostScene& s, const RenderOptions& render, DerivativeRequest request,
+                 const DerivativeCostOptions& options, DerivativeCostReport* result) {
+  BeginPass(result, &result->adjoint);
+  std::vector<double> gradient;
+  Progress progress("adjoint", static_cast<int64_t>(s.views->size()), options.progress);
+  for (const ViewSetup& view : *s.views) {
+    const Image weights = MakeWeights(view.camera.width, view.camera.height, options.seed);
+    request.adjoint_weights = &weights;
+    Image image;
+    DerivativeOutput output;
+    RenderStats stats;
+    result->adjoint.seconds += WallSeconds([&] {
+      RenderViewWithDerivatives(*s.scene, *s.material, view, render, request, s.num_lights, &image,
+                                &output, &stats);
+    });
+    AddRays(stats, &result->adjoint.rays);
+    if (gradient.empty()) gradient.assign(output.gradient.size(), 0.0);
+    for (size_t i = 0; i < gradient.size() && i < output.gradient.size(); ++i) {
+      gradient[i] += output.gradient[i];
+    }
+    progress.Advance();
+  }
+  progress.Finish();
+  EndPass(&result->adjoint);
+  double sum2 = 0.0;
+  for (double g : gradient) sum2 += g * g;
+  result->gradient_norm = std::sqrt(sum2);
+}
+
+// The three passes over `s`; `result` already holds the setup fields.
+Status MeasureScene(const CostScene& s, const DerivativeCostOptions& options,
+                    DerivativeCostReport* result) {
   {
     tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
     arena.initialize();
-    result.threads = arena.max_concurrency();
+    result->threads = arena.max_concurrency();
   }
-  result.views = options.views;
-  result.width = result.height = options.resolution;
-  result.spp = options.spp;
-  result.bounces = options.bounces;
-  result.keep_rows = options.keep_rows;
-  result.derivatives = options.derivatives;
-  result.derivatives.adjoint_weights = nullptr;
-
-  const RenderScene scene(mesh);
-  const Material material = MakeMaterial(mesh, options.seed);
-  const std::vector<ViewSetup> views = MakeViews(mesh, options);
-  const Image weights = MakeWeights(options.resolution, options.seed);
+  result->spp = options.spp;
+  result->bounces = options.bounces;
+  result->keep_rows = options.keep_rows;
+  result->derivatives = options.derivatives;
+  result->derivatives.adjoint_weights = nullptr;
   RenderOptions render;
   render.spp = options.spp;
   render.bounces = options.bounces;
@@ -184,106 +267,75 @@ Status MeasureDerivativeCost(const DerivativeCostOptions& options, const TriMesh
   rows_request.adjoint_weights = nullptr;
   DerivativeRequest adjoint_request = rows_request;
   adjoint_request.jacobian_rows = false;
-  adjoint_request.adjoint_weights = &weights;
+  const Image probe(1, 1, 3);  // Check needs weights; the pass sets each view's own.
+  adjoint_request.adjoint_weights = &probe;
+  std::string why;
   if (!rows_request.Check(&why) || !adjoint_request.Check(&why)) {
     return Status::Error("derivative request: " + why);
   }
 
-  // Resets the peak before a pass and reads it after; `cost` gets both.
-  auto begin_pass = [&](DerivativePassCost* cost) {
-    result.peak_rss_reset = ResetPeakResidentSet();
-    cost->rss_before_bytes = ProcessStatusBytes("VmRSS:");
-  };
-  auto end_pass = [&](DerivativePassCost* cost) {
-    cost->peak_rss_bytes = ProcessStatusBytes("VmHWM:");
-  };
-
   // Untimed warm-up (thread pool, first touch of the scene) so the forward pass is not charged.
   {
     Image image;
-    RenderView(scene, material, views[0], render, &image);
+    RenderView(*s.scene, *s.material, s.views->front(), render, &image);
   }
+  ForwardPass(s, render, options.progress, result);
+  RowsPass(s, render, rows_request, options, result);
+  AdjointPass(s, render, adjoint_request, options, result);
 
-  // (1) Forward only.
-  {
-    begin_pass(&result.forward);
-    Progress progress("forward", options.views, options.progress);
-    for (const ViewSetup& view : views) {
-      Image image;
-      RenderStats stats;
-      result.forward.seconds +=
-          WallSeconds([&] { RenderView(scene, material, view, render, &image, &stats); });
-      AddRays(stats, &result.forward.rays);
-      for (int y = 0; y < image.height; ++y) {
-        for (int x = 0; x < image.width; ++x) result.covered_pixels += image.at(x, y, 3) > 0.f;
-      }
-      progress.Advance();
-    }
-    progress.Finish();
-    end_pass(&result.forward);
-  }
+  const double forward = result->forward.seconds;
+  result->forward.ratio = forward > 0.0 ? 1.0 : 0.0;
+  result->jacobian_rows.ratio = forward > 0.0 ? result->jacobian_rows.seconds / forward : 0.0;
+  result->adjoint.ratio = forward > 0.0 ? result->adjoint.seconds / forward : 0.0;
+  return Status::Ok();
+}
 
-  // (2) Forward + Jacobian rows; the rows of a view are freed before the next unless kept.
-  {
-    begin_pass(&result.jacobian_rows);
-    std::vector<DerivativeOutput> kept;
-    if (options.keep_rows) kept.reserve(views.size());
-    Progress progress("jacobian rows", options.views, options.progress);
-    for (const ViewSetup& view : views) {
-      Image image;
-      DerivativeOutput output;
-      RenderStats stats;
-      result.jacobian_rows.seconds += WallSeconds([&] {
-        RenderViewWithDerivatives(scene, material, view, render, rows_request, kNumLights, &image,
-                                  &output, &stats);
-      });
-      AddRays(stats, &result.jacobian_rows.rays);
-      result.num_parameters = output.layout.size();
-      result.num_differentiated = output.layout.size();
-      const int64_t bytes = static_cast<int64_t>(output.rows.MemoryBytes());
-      result.jacobian_entries += static_cast<int64_t>(output.rows.entries.size());
-      result.rows_bytes_total += bytes;
-      result.rows_bytes_peak_view = std::max(result.rows_bytes_peak_view, bytes);
-      if (options.keep_rows) kept.push_back(std::move(output));
-      progress.Advance();
-    }
-    progress.Finish();
-    end_pass(&result.jacobian_rows);  // with keep_rows, every view's rows are still alive here.
-    result.rows_bytes_resident =
-        options.keep_rows ? result.rows_bytes_total : result.rows_bytes_peak_view;
-  }
+}  // namespace
 
-  // (3) Forward + adjoint gradient.
-  {
-    begin_pass(&result.adjoint);
-    std::vector<double> gradient;
-    Progress progress("adjoint", options.views, options.progress);
-    for (const ViewSetup& view : views) {
-      Image image;
-      DerivativeOutput output;
-      RenderStats stats;
-      result.adjoint.seconds += WallSeconds([&] {
-        RenderViewWithDerivatives(scene, material, view, render, adjoint_request, kNumLights,
-                                  &image, &output, &stats);
-      });
-      AddRays(stats, &result.adjoint.rays);
-      if (gradient.empty()) gradient.assign(output.gradient.size(), 0.0);
-      for (size_t i = 0; i < gradient.size() && i < output.gradient.size(); ++i) {
-        gradient[i] += output.gradient[i];
-      }
-      progress.Advance();
-    }
-    progress.Finish();
-    end_pass(&result.adjoint);
-    double sum2 = 0.0;
-    for (double g : gradient) sum2 += g * g;
-    result.gradient_norm = std::sqrt(sum2);
-  }
+Status MeasureDerivativeCost(const DerivativeCostOptions& options, const TriMesh& mesh,
+                             DerivativeCostReport* report) {
+  std::string why;
+  if (!options.Check(&why)) return Status::Error(why);
+  if (mesh.n_faces() == 0) return Status::Error("mesh: has no faces");
+  Eigen::Vector3d lo, hi;
+  MeshBounds(mesh, &lo, &hi);
+  if (!((hi - lo).norm() > 0.0)) return Status::Error("mesh: has zero extent");
 
-  const double forward = result.forward.seconds;
-  result.forward.ratio = forward > 0.0 ? 1.0 : 0.0;
-  result.jacobian_rows.ratio = forward > 0.0 ? result.jacobian_rows.seconds / forward : 0.0;
-  result.adjoint.ratio = forward > 0.0 ? result.adjoint.seconds / forward : 0.0;
+  DerivativeCostReport result;
+  result.num_faces = static_cast<int>(mesh.n_faces());
+  result.num_vertices = static_cast<int>(mesh.n_vertices());
+  result.views = options.views;
+  result.width = result.height = options.resolution;
+  const RenderScene scene(mesh);
+  const Material material = MakeMaterial(mesh, options.seed);
+  const std::vector<ViewSetup> views = MakeViews(mesh, options);
+  SFT_RETURN_IF_ERROR(MeasureScene({&scene, &material, &views, kNumLights}, options, &result));
+  *report = result;
+  return Status::Ok();
+}
+
+Status MeasureDatasetDerivativeCost(const DerivativeCostOptions& options, const Dataset& dataset,
+                                    const std::vector<int>& view_indices, const TriMesh& mesh,
+                                    const Material& material, DerivativeCostReport* report) {
+  std::string why;
+  if (!options.Check(&why)) return Status::Error(why);
+  if (mesh.n_faces() == 0) return Status::Error("mesh: has no faces");
+  DatasetViews all;
+  SFT_RETURN_IF_ERROR(MakeDatasetViews(dataset, &all));
+  std::vector<int> selected;
+  SFT_RETURN_IF_ERROR(SelectViews(view_indices, static_cast<int>(all.views.size()), &selected));
+  std::vector<ViewSetup> views;
+  for (int v : selected) views.push_back(all.views[v]);
+
+  DerivativeCostReport result;
+  result.num_faces = static_cast<int>(mesh.n_faces());
+  result.num_vertices = static_cast<int>(mesh.n_vertices());
+  result.views = static_cast<int>(views.size());
+  result.width = views.front().camera.width;  // of the first view (datasets may mix sizes).
+  result.height = views.front().camera.height;
+  const RenderScene scene(mesh);
+  SFT_RETURN_IF_ERROR(MeasureScene(
+      {&scene, &material, &views, static_cast<int>(dataset.lights.size())}, options, &result));
   *report = result;
   return Status::Ok();
 }

@@ -26,9 +26,12 @@
 #include <cstdint>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "src/core/status.h"
+#include "src/geometry/material.h"
 #include "src/geometry/mesh.h"
+#include "src/io/dataset.h"
 #include "src/render/derivatives.h"
 #include "src/render/render.h"
 
@@ -88,6 +91,14 @@ struct DerivativeCostReport {
 // faces or with zero extent.
 Status MeasureDerivativeCost(const DerivativeCostOptions& options, const TriMesh& mesh,
                              DerivativeCostReport* report);
+
+// The same three passes on a dataset's own cameras, lights and views (`view_indices`; empty = all),
+// with `mesh` and `material` (`sft bench gradient --dataset`); options.views and resolution are
+// not used, width and height in the report are the first view's. Errors: invalid options, a mesh
+// without faces, a view index out of range, unreadable environment maps.
+Status MeasureDatasetDerivativeCost(const DerivativeCostOptions& options, const Dataset& dataset,
+                                    const std::vector<int>& view_indices, const TriMesh& mesh,
+                                    const Material& material, DerivativeCostReport* report);
 
 // The report as JSON (bytes, seconds) and as a small human-readable table (MiB, s).
 nlohmann::json DerivativeCostReportToJson(const DerivativeCostReport& report);

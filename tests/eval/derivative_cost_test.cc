@@ -6,7 +6,10 @@
 #include <string>
 
 #include "src/core/file_util.h"
+#include "src/geometry/material.h"
 #include "src/geometry/mesh.h"
+#include "src/io/dataset.h"
+#include "tests/testing/synth_dataset.h"
 #include "tests/testing/temp_dir.h"
 
 namespace sft {
@@ -180,6 +183,35 @@ TEST(BenchGradientCommandTest, BadEdgeBudgetIsOneErrorLine) {
   EXPECT_EQ(code, 1);
   EXPECT_NE(output.find("--primary-edge-ratio"), std::string::npos) << output;
   EXPECT_EQ(output.find('\n'), output.size() - 1) << output;
+}
+
+// `sft bench gradient --dataset`: the passes run on the dataset's own views (sizes, lights),
+// with the dataset's light as the light-scale parameter, and a bad view index is an error.
+TEST(DerivativeCostTest, DatasetViews) {
+  testing::TempDir tmp;
+  ASSERT_EQ(testing::SynthIcosphere(tmp.Join("ds"), "--cameras 3 --zooms 1 --res 20 --spp 4"), "");
+  Dataset dataset;
+  ASSERT_TRUE(ReadDataset(tmp.Join("ds"), &dataset).ok());
+  TriMesh mesh;
+  ASSERT_TRUE(ReadMesh(tmp.Join("ds/gt/mesh.ply"), &mesh).ok());
+  Material material;
+  ASSERT_TRUE(LoadMaterial(tmp.Join("ds/gt/material.json"), mesh, &material).ok());
+  DerivativeCostOptions options;
+  options.spp = 2;
+  DerivativeCostReport report;
+  ASSERT_TRUE(MeasureDatasetDerivativeCost(options, dataset, {0, 2}, mesh, material, &report).ok());
+  EXPECT_EQ(report.views, 2);
+  EXPECT_EQ(report.width, 20);
+  EXPECT_EQ(report.forward.rays.camera_rays, int64_t{2} * 20 * 20 * 2);
+  EXPECT_GT(report.covered_pixels, 0);
+  EXPECT_GT(report.jacobian_entries, 0);
+  EXPECT_GT(report.gradient_norm, 0.0);
+  EXPECT_GT(report.jacobian_rows.ratio, 0.0);
+  EXPECT_GT(report.adjoint.ratio, 0.0);
+
+  const Status bad = MeasureDatasetDerivativeCost(options, dataset, {3}, mesh, material, &report);
+  EXPECT_FALSE(bad.ok());
+  EXPECT_NE(bad.message().find("3"), std::string::npos) << bad.message();
 }
 
 }  // namespace
