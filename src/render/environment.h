@@ -1,9 +1,21 @@
 // An equirectangular environment light (DESIGN.md §2.5): the env frame is z-up; a direction
 // d = (x, y, z) in it maps to u = 0.5 − atan2(y, x)/(2π), v = acos(z)/π (u to the right, v down
 // from the top row), so the image centre looks along +x — Blender's convention. World directions
-// are taken to the env frame by world_from_envᵀ. Radiance = scale · texel (nearest texel; negative
-// texels clamped to 0). Importance sampling is piecewise constant over texels, proportional to
-// luminance·sin θ, so the sampled density matches the lookup exactly.
+// are taken to the env frame by world_from_envᵀ.
+//
+// Radiance = scale · the bilinear interpolation of the texels (negative texels clamped to 0), as
+// Cycles' default Linear interpolation: texel (x, y) holds the value at its centre
+// ((x + 0.5)/W, (y + 0.5)/H); u wraps around, and above the first row's centres (below the last
+// row's) the row's value holds to the pole.
+//
+// Importance sampling draws from exactly that function. The (u, v) plane is cut into cells between
+// neighbouring texel centres (W per band; H + 1 bands, the first and last half as tall, reaching
+// the poles), on each of which the interpolated value f (mean of RGB) is bilinear. A cell is picked
+// with probability ∝ ∫ f sin θ over it (the radiance times the solid angle), then a point in it
+// with density ∝ f: first the row coordinate from its linear marginal, then the column coordinate
+// from its linear conditional, each by inverting a quadratic CDF. Pdf() evaluates the same density,
+// so the pdf is what is looked up (up to the cell's mean sin θ), and Sample() never picks a
+// direction where the lookup is zero.
 #ifndef SFT_RENDER_ENVIRONMENT_H_
 #define SFT_RENDER_ENVIRONMENT_H_
 
@@ -29,23 +41,48 @@ class EnvironmentMap {
   // Solid-angle pdf of Sample() producing world direction `dir`.
   double Pdf(const Eigen::Vector3d& dir) const;
 
-  // Mean radiance over the sphere (solid-angle weighted), for tests and planning.
+  // Mean radiance over the sphere (solid-angle weighted, of the interpolated map), for tests and
+  // planning.
   Eigen::Vector3d MeanRadiance() const;
 
   int width() const { return width_; }
   int height() const { return height_; }
 
  private:
-  // Texel coordinates of a world direction.
-  void TexelOf(const Eigen::Vector3d& dir, int* x, int* y) const;
+  // A point of the (u, v) plane as its cell (column i: between the centres of texel columns i and
+  // i + 1 mod W; band j in [0, H]: between the centres of rows j − 1 and j) and its bilinear
+  // coordinates (s, t) in [0, 1]² within the cell.
+  struct CellPoint {
+    int i = 0, j = 0;
+    double s = 0.0, t = 0.0;
+  };
+  // One band of cells: its v range and the rows at its top and bottom edges (equal in the polar
+  // half bands), and ∫₀¹ sin θ(t) dt, ∫₀¹ t sin θ(t) dt over it.
+  struct Band {
+    double v0 = 0.0, dv = 0.0;
+    int row0 = 0, row1 = 0;
+    double sin0 = 0.0, sin1 = 0.0;
+  };
+
+  CellPoint CellOf(double u, double v) const;
+  CellPoint CellOfDirection(const Eigen::Vector3d& dir) const;
+  // The cell's corner values of f: top-left, top-right, bottom-left, bottom-right.
+  Eigen::Vector4d Corners(int i, int j) const;
+  // ∫∫ f sin θ ds dt over cell (i, j) (proportional to its sampling probability).
+  double CellWeight(int i, int j) const;
+  Eigen::Vector3d Interpolate(const CellPoint& p) const;
+  // Density of Sample() in (u, v) at p.
+  double UvPdf(const CellPoint& p) const;
 
   int width_ = 0;
   int height_ = 0;
   std::vector<Eigen::Vector3f> texels_;  // scaled, clamped radiance.
+  std::vector<double> value_;            // f = mean of RGB per texel.
+  std::vector<Band> bands_;              // H + 1 bands.
   Eigen::Matrix3d world_from_env_;
-  std::vector<double> row_cdf_;     // height_ + 1 entries, normalized.
-  std::vector<double> column_cdf_;  // height_ rows of width_ + 1 entries, normalized per row.
-  std::vector<double> texel_pdf_;   // probability of each texel (sums to 1).
+  std::vector<double> band_cdf_;    // H + 2 entries, normalized.
+  std::vector<double> column_cdf_;  // H + 1 bands of W + 1 entries, normalized per band.
+  double total_weight_ = 0.0;       // Σ CellWeight.
   bool black_ = true;
 };
 
