@@ -166,7 +166,9 @@ std::map<std::string, std::string> Snapshot(const fs::path& root) {
     const std::string rel = fs::relative(entry.path(), root).string();
     if (rel == "out" || rel.rfind("out/", 0) == 0) continue;
     std::string contents;
-    if (entry.is_regular_file()) EXPECT_TRUE(ReadTextFile(entry.path().string(), &contents).ok());
+    if (entry.is_regular_file()) {
+      EXPECT_TRUE(ReadTextFile(entry.path().string(), &contents).ok());
+    }
     files[rel] = contents;
   }
   return files;
