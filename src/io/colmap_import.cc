@@ -322,8 +322,7 @@ Status ImportInto(const ColmapImportOptions& opts, const std::string& root,
 
   if (opts.import_dense) {
     FindDense(opts.model, &report->dense_mesh, &report->dense_points);
-    SFT_RETURN_IF_ERROR(
-        ImportDense(report->dense_mesh, report->dense_points, s, root, &dataset));
+    SFT_RETURN_IF_ERROR(ImportDense(report->dense_mesh, report->dense_points, s, root, &dataset));
   }
 
   if (!opts.probe.empty()) {
@@ -365,11 +364,16 @@ Status ImportInto(const ColmapImportOptions& opts, const std::string& root,
 }  // namespace
 
 bool ColmapImportOptions::Check(std::string* why) const {
-  if (model.empty()) *why = "--model: required";
-  else if (images.empty()) *why = "--images: required";
-  else if (out.empty()) *why = "--out: required";
-  else if (!normalization.Check(why)) *why = "normalisation: " + *why;
-  else return true;
+  if (model.empty())
+    *why = "--model: required";
+  else if (images.empty())
+    *why = "--images: required";
+  else if (out.empty())
+    *why = "--out: required";
+  else if (!normalization.Check(why))
+    return false;
+  else
+    return true;
   return false;
 }
 
@@ -411,8 +415,7 @@ Status ImportColmap(const ColmapImportOptions& opts, ColmapImportReport* report)
     }
   }
   if (!status.ok()) fs::remove_all(partial, ec);
-  report->seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  report->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return status;
 }
 

@@ -27,9 +27,9 @@ struct ColmapImportOptions {
   std::string probe;   // optional equirectangular probe: .exr/.hdr (linear) or 8-bit (sRGB).
   std::string out;     // output dataset folder.
   NormalizationOptions normalization;  // how the object is found among the sparse points.
-  bool import_dense = true;  // import fused.ply / meshed-*.ply found beside the model.
-  bool overwrite = false;    // replace an existing, non-empty output folder.
-  bool quiet = false;        // no progress line.
+  bool import_dense = true;            // import fused.ply / meshed-*.ply found beside the model.
+  bool overwrite = false;              // replace an existing, non-empty output folder.
+  bool quiet = false;                  // no progress line.
 
   bool Check(std::string* why) const;
 };

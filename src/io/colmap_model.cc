@@ -23,10 +23,17 @@ struct ModelInfo {
 };
 // COLMAP 3.8's camera models (src/base/camera_models.h): id, name, parameter count.
 constexpr ModelInfo kModels[] = {
-    {0, "SIMPLE_PINHOLE", 3}, {1, "PINHOLE", 4},      {2, "SIMPLE_RADIAL", 4},
-    {3, "RADIAL", 5},         {4, "OPENCV", 8},       {5, "OPENCV_FISHEYE", 8},
-    {6, "FULL_OPENCV", 12},   {7, "FOV", 5},          {8, "SIMPLE_RADIAL_FISHEYE", 4},
-    {9, "RADIAL_FISHEYE", 5}, {10, "THIN_PRISM_FISHEYE", 12},
+    {0, "SIMPLE_PINHOLE", 3},
+    {1, "PINHOLE", 4},
+    {2, "SIMPLE_RADIAL", 4},
+    {3, "RADIAL", 5},
+    {4, "OPENCV", 8},
+    {5, "OPENCV_FISHEYE", 8},
+    {6, "FULL_OPENCV", 12},
+    {7, "FOV", 5},
+    {8, "SIMPLE_RADIAL_FISHEYE", 4},
+    {9, "RADIAL_FISHEYE", 5},
+    {10, "THIN_PRISM_FISHEYE", 12},
 };
 
 constexpr uint64_t kInvalidPoint3DId = std::numeric_limits<uint64_t>::max();
@@ -112,8 +119,7 @@ class LineError {
  public:
   LineError(const std::string& file, const TextLines& lines) : file_(file), lines_(lines) {}
   Status operator()(const std::string& message) const {
-    return Status::Error(file_ + ": line " + std::to_string(lines_.line_number()) + ": " +
-                         message);
+    return Status::Error(file_ + ": line " + std::to_string(lines_.line_number()) + ": " + message);
   }
   Status Number(const char* what, const std::string& token) const {
     return (*this)(std::string("expected ") + what + ", got \"" + Shorten(token) + "\"");
@@ -188,8 +194,8 @@ Status Truncated(const std::string& file, const std::string& what, const Reader&
 }
 
 // Reads a record count and checks that `min_record_bytes` per record fit in the rest of the file.
-Status ReadCount(Reader* reader, const std::string& file, const char* what,
-                 size_t min_record_bytes, uint64_t* count) {
+Status ReadCount(Reader* reader, const std::string& file, const char* what, size_t min_record_bytes,
+                 uint64_t* count) {
   if (!reader->Read(count)) return Truncated(file, std::string("number of ") + what, *reader);
   if (*count > reader->remaining() / min_record_bytes) {
     return Status::Error(file + ": " + std::to_string(*count) + " " + what + " announced at byte " +
@@ -303,9 +309,8 @@ Status ParseColmapImagesText(const std::string& data, const std::string& file,
     // The 2D points line follows directly (it may be empty; a file may end without it).
     if (lines.Next(&t)) {
       if (t.size() % 3 != 0) {
-        return err("image " + std::to_string(image.id) +
-                   ": expected X Y POINT3D_ID triples, got " + std::to_string(t.size()) +
-                   " fields");
+        return err("image " + std::to_string(image.id) + ": expected X Y POINT3D_ID triples, got " +
+                   std::to_string(t.size()) + " fields");
       }
       image.points2d.reserve(t.size() / 3);
       image.point3d_ids.reserve(t.size() / 3);
@@ -469,8 +474,8 @@ Status ParseColmapPointsBinary(const std::string& data, const std::string& file,
     const std::string where = "point " + std::to_string(k) + " of " + std::to_string(count);
     ColmapPoint3D point;
     if (!reader.Read(&point.id) || !reader.ReadDoubles(point.xyz.data(), 3) ||
-        !reader.Read(&point.rgb[0]) || !reader.Read(&point.rgb[1]) ||
-        !reader.Read(&point.rgb[2]) || !reader.Read(&point.error)) {
+        !reader.Read(&point.rgb[0]) || !reader.Read(&point.rgb[1]) || !reader.Read(&point.rgb[2]) ||
+        !reader.Read(&point.error)) {
       return Truncated(file, where, reader);
     }
     const std::string name = file + ": point " + std::to_string(point.id);
@@ -516,9 +521,9 @@ Status CheckColmapModel(const ColmapModel& model, const std::string& dir) {
                              std::to_string(e.image_id) + ", which is not in the images file");
       }
       if (e.point2d_index >= it->second) {
-        return Status::Error(dir + ": point " + std::to_string(point.id) + ": track names 2D point " +
-                             std::to_string(e.point2d_index) + " of image " +
-                             std::to_string(e.image_id) + ", which has " +
+        return Status::Error(dir + ": point " + std::to_string(point.id) +
+                             ": track names 2D point " + std::to_string(e.point2d_index) +
+                             " of image " + std::to_string(e.image_id) + ", which has " +
                              std::to_string(it->second));
       }
     }

@@ -48,7 +48,7 @@ struct ColmapImage {
   Eigen::Quaterniond cam_from_world_rotation = Eigen::Quaterniond::Identity();  // normalised.
   Eigen::Vector3d cam_from_world_translation = Eigen::Vector3d::Zero();
   uint32_t camera_id = 0;
-  std::string name;  // relative to the image folder, as COLMAP stores it.
+  std::string name;                       // relative to the image folder, as COLMAP stores it.
   std::vector<Eigen::Vector2d> points2d;  // pixel coordinates (COLMAP's: centre of (0,0) at 0.5).
   std::vector<int64_t> point3d_ids;       // parallel to points2d; -1 = not triangulated.
 };

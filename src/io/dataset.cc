@@ -30,10 +30,10 @@ constexpr char kSceneFile[] = "scene.json";
 constexpr double kRotationTolerance = 1e-3;
 // Keys of each object that ReadDataset interprets; all others are kept verbatim as extras.
 using Keys = std::initializer_list<const char*>;
-constexpr Keys kTopLevelKeys = {"format",         "cameras",        "lights",
-                                "views",          "background",     "ground_truth",
-                                "sparse_points",  "initial_mesh",   "dense_points",
-                                "source_from_world", "image_encoding", "lighting"};
+constexpr Keys kTopLevelKeys = {
+    "format",       "cameras",           "lights",         "views",
+    "background",   "ground_truth",      "sparse_points",  "initial_mesh",
+    "dense_points", "source_from_world", "image_encoding", "lighting"};
 constexpr Keys kSimilarityKeys = {"scale", "rotation", "translation"};
 constexpr Keys kCameraKeys = {"id", "model", "width", "height", "params"};
 constexpr Keys kPointLightKeys = {"id", "type", "frame", "position", "intensity"};
@@ -481,10 +481,10 @@ class SceneParser {
   // The optional keys of importers (DESIGN.md §2.5, docs/import.md): file paths follow the
   // dataset's path rules, texts are free, source_from_world is a similarity with scale > 0.
   Status ParseImportKeys(const json& root, Dataset* dataset) const {
-    for (const auto& [key, out] : {std::pair<const char*, std::string*>{"sparse_points",
-                                                                        &dataset->sparse_points},
-                                   {"initial_mesh", &dataset->initial_mesh},
-                                   {"dense_points", &dataset->dense_points}}) {
+    for (const auto& [key, out] :
+         {std::pair<const char*, std::string*>{"sparse_points", &dataset->sparse_points},
+          {"initial_mesh", &dataset->initial_mesh},
+          {"dense_points", &dataset->dense_points}}) {
       if (const json* value = Find(root, key); value != nullptr && !value->is_null()) {
         SFT_RETURN_IF_ERROR(String(*value, key, false, out));
         SFT_RETURN_IF_ERROR(ContainedPath(key, *out));

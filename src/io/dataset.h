@@ -102,14 +102,14 @@ struct Dataset {
   std::string gt_mesh;          // `ground_truth.mesh` (relative), empty when absent.
   nlohmann::json ground_truth;  // the whole `ground_truth` object as read (null when absent).
   // Optional keys written by importers (DESIGN.md §2.5, docs/import.md); empty when absent.
-  std::string sparse_points;   // "sparse_points": PLY point cloud (xyz, rgb), world frame.
-  std::string initial_mesh;    // "initial_mesh": starting mesh, world frame.
-  std::string dense_points;    // "dense_points": dense point cloud (e.g. COLMAP fused.ply).
-  std::string image_encoding;  // "image_encoding": free text, where the pixels came from.
-  std::string lighting;        // "lighting": free text, e.g. "unknown".
+  std::string sparse_points;           // "sparse_points": PLY point cloud (xyz, rgb), world frame.
+  std::string initial_mesh;            // "initial_mesh": starting mesh, world frame.
+  std::string dense_points;            // "dense_points": dense point cloud (e.g. COLMAP fused.ply).
+  std::string image_encoding;          // "image_encoding": free text, where the pixels came from.
+  std::string lighting;                // "lighting": free text, e.g. "unknown".
   bool has_source_from_world = false;  // "source_from_world" is present.
   Similarity3d source_from_world;      // maps this dataset's world into the import's frame.
-  nlohmann::json extra;         // top-level keys this version does not interpret, kept verbatim.
+  nlohmann::json extra;  // top-level keys this version does not interpret, kept verbatim.
 };
 
 // Reads and validates DIR/scene.json: format tag, camera models and parameter counts, positive

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 namespace sft {
 namespace {
@@ -36,19 +37,25 @@ double Percentile(std::vector<double>* values, double q) {
   return (*values)[k];
 }
 
+std::string Text(double value) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof(buffer), "%g", value);
+  return buffer;
+}
+
 }  // namespace
 
 bool NormalizationOptions::Check(std::string* why) const {
   if (!(axis_cone > 0 && axis_cone <= 1)) {
-    *why = "axis cone must be in (0, 1], got " + std::to_string(axis_cone);
+    *why = "--axis-cone: must be in (0, 1], got " + Text(axis_cone);
     return false;
   }
   if (!(percentile >= 0 && percentile < 50)) {
-    *why = "percentile must be in [0, 50), got " + std::to_string(percentile);
+    *why = "--percentile: must be in [0, 50), got " + Text(percentile);
     return false;
   }
   if (min_points < 1) {
-    *why = "min_points must be >= 1";
+    *why = "min_points: must be >= 1, got " + std::to_string(min_points);
     return false;
   }
   return true;
@@ -85,12 +92,12 @@ Status ComputeNormalization(const ColmapModel& model,
   }
   result->points_used = static_cast<int>(kept.size());
   if (result->points_used < options.min_points) {
-    return Status::Error(
-        "normalisation: only " + std::to_string(result->points_used) + " of " +
-        std::to_string(result->points_total) + " sparse points " +
-        (masks ? "project inside the masks in most of their views"
-               : "are seen near the optical axes by at least half of their views") +
-        " (need " + std::to_string(options.min_points) + ")");
+    return Status::Error("normalisation: only " + std::to_string(result->points_used) + " of " +
+                         std::to_string(result->points_total) + " sparse points " +
+                         (masks
+                              ? "project inside the masks in most of their views"
+                              : "are seen near the optical axes by at least half of their views") +
+                         " (need " + std::to_string(options.min_points) + ")");
   }
   Eigen::Vector3d lo, hi;
   const double q = masks ? 0.0 : options.percentile;

@@ -35,8 +35,8 @@ struct MaskBits {
 // One registered view of the model, as the normalisation sees it.
 struct ObservingView {
   Camera camera;
-  Rigid3d cam_from_world;           // in the model's frame.
-  const MaskBits* mask = nullptr;   // null without masks.
+  Rigid3d cam_from_world;          // in the model's frame.
+  const MaskBits* mask = nullptr;  // null without masks.
 };
 
 struct NormalizationOptions {
@@ -47,16 +47,17 @@ struct NormalizationOptions {
   // Fewest object points accepted, >= 1.
   int min_points = 8;
 
+  // Errors name the command-line flags of `sft import colmap` (--axis-cone, --percentile).
   bool Check(std::string* why) const;
 };
 
 struct NormalizationResult {
-  std::string method;          // "masks" or "optical_axes".
+  std::string method;                                // "masks" or "optical_axes".
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();  // box centre in the model's frame.
-  double diagonal = 0;         // box diagonal in the model's units (> 0).
-  int points_total = 0;        // sparse points with a non-empty track.
-  int points_used = 0;         // object points that define the box.
-  std::vector<bool> used;      // parallel to model.points.
+  double diagonal = 0;                               // box diagonal in the model's units (> 0).
+  int points_total = 0;                              // sparse points with a non-empty track.
+  int points_used = 0;                               // object points that define the box.
+  std::vector<bool> used;                            // parallel to model.points.
 };
 
 // `views` maps COLMAP image ids to views; track elements of other images are ignored. Errors:

@@ -25,9 +25,9 @@ bool TypeFromName(const std::string& name, Type* type, int* size) {
     int size;
   };
   static const Entry kTypes[] = {
-      {"char", "int8", Type::kInt8, 1},       {"uchar", "uint8", Type::kUint8, 1},
-      {"short", "int16", Type::kInt16, 2},    {"ushort", "uint16", Type::kUint16, 2},
-      {"int", "int32", Type::kInt32, 4},      {"uint", "uint32", Type::kUint32, 4},
+      {"char", "int8", Type::kInt8, 1},        {"uchar", "uint8", Type::kUint8, 1},
+      {"short", "int16", Type::kInt16, 2},     {"ushort", "uint16", Type::kUint16, 2},
+      {"int", "int32", Type::kInt32, 4},       {"uint", "uint32", Type::kUint32, 4},
       {"float", "float32", Type::kFloat32, 4}, {"double", "float64", Type::kFloat64, 8}};
   for (const Entry& e : kTypes) {
     if (name == e.a || name == e.b) {
@@ -41,14 +41,40 @@ bool TypeFromName(const std::string& name, Type* type, int* size) {
 
 double Decode(const char* p, Type type) {
   switch (type) {
-    case Type::kInt8: return static_cast<int8_t>(*p);
-    case Type::kUint8: return static_cast<uint8_t>(*p);
-    case Type::kInt16: { int16_t v; std::memcpy(&v, p, 2); return v; }
-    case Type::kUint16: { uint16_t v; std::memcpy(&v, p, 2); return v; }
-    case Type::kInt32: { int32_t v; std::memcpy(&v, p, 4); return v; }
-    case Type::kUint32: { uint32_t v; std::memcpy(&v, p, 4); return v; }
-    case Type::kFloat32: { float v; std::memcpy(&v, p, 4); return v; }
-    case Type::kFloat64: { double v; std::memcpy(&v, p, 8); return v; }
+    case Type::kInt8:
+      return static_cast<int8_t>(*p);
+    case Type::kUint8:
+      return static_cast<uint8_t>(*p);
+    case Type::kInt16: {
+      int16_t v;
+      std::memcpy(&v, p, 2);
+      return v;
+    }
+    case Type::kUint16: {
+      uint16_t v;
+      std::memcpy(&v, p, 2);
+      return v;
+    }
+    case Type::kInt32: {
+      int32_t v;
+      std::memcpy(&v, p, 4);
+      return v;
+    }
+    case Type::kUint32: {
+      uint32_t v;
+      std::memcpy(&v, p, 4);
+      return v;
+    }
+    case Type::kFloat32: {
+      float v;
+      std::memcpy(&v, p, 4);
+      return v;
+    }
+    case Type::kFloat64: {
+      double v;
+      std::memcpy(&v, p, 8);
+      return v;
+    }
   }
   return 0;
 }
@@ -163,7 +189,8 @@ Status ParsePointCloudPly(const std::string& data, const std::string& file, Poin
   for (uint64_t i = 0; i < count; ++i) {
     if (binary) {
       const char* p = data.data() + pos + i * row;
-      for (size_t k = 0; k < props.size(); ++k) values[k] = Decode(p + props[k].offset, props[k].type);
+      for (size_t k = 0; k < props.size(); ++k)
+        values[k] = Decode(p + props[k].offset, props[k].type);
     } else {
       if (!next_line(&line)) return fail("vertex " + std::to_string(i) + ": file ends early");
       std::istringstream in(line);
@@ -186,7 +213,8 @@ Status ParsePointCloudPly(const std::string& data, const std::string& file, Poin
     if (has_colors) {
       for (int c = 0; c < 3; ++c) {
         const double v = values[c == 0 ? r : c == 1 ? g : b];
-        cloud->colors[i][c] = static_cast<uint8_t>(std::isfinite(v) ? std::clamp(v, 0.0, 255.0) : 0);
+        cloud->colors[i][c] =
+            static_cast<uint8_t>(std::isfinite(v) ? std::clamp(v, 0.0, 255.0) : 0);
       }
     }
   }

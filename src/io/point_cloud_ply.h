@@ -23,8 +23,8 @@ namespace sft {
 
 struct PointCloud {
   std::vector<Eigen::Vector3d> positions;
-  std::vector<Eigen::Vector3d> normals;             // empty, or one per position.
-  std::vector<std::array<uint8_t, 3>> colors;       // empty, or one per position (RGB).
+  std::vector<Eigen::Vector3d> normals;        // empty, or one per position.
+  std::vector<std::array<uint8_t, 3>> colors;  // empty, or one per position (RGB).
 };
 
 // Parses PLY file contents; `file` names the file in error messages.
