@@ -246,6 +246,52 @@ std::string ImageOutputName(const ColmapImage& image, std::set<std::string>* tak
   return out;
 }
 
+// Copies every registered image (and its mask) into `root`, appending one view per image to
+// `dataset` (poses still in the model's frame) and filling `observing` for the normalisation.
+Status ImportViews(const ColmapImportOptions& opts, const ColmapModel& model,
+                   const std::string& root, const std::map<uint32_t, int>& camera_index,
+                   Dataset* dataset, std::vector<MaskBits>* masks,
+                   std::unordered_map<uint32_t, ObservingView>* observing,
+                   std::vector<std::string>* encodings) {
+  std::set<std::string> taken;
+  Progress progress("import", static_cast<int64_t>(model.images.size()), !opts.quiet);
+  for (size_t i = 0; i < model.images.size(); ++i) {
+    const ColmapImage& image = model.images[i];
+    std::string why;
+    if (!IsContainedRelativePath(image.name, &why)) {
+      return Status::Error(opts.model + ": image " + std::to_string(image.id) + ": name \"" +
+                           image.name + "\": " + why);
+    }
+    ViewSpec view;
+    view.camera = camera_index.at(image.camera_id);
+    const Camera& camera = dataset->cameras[view.camera];
+    view.camera_id = camera.id;
+    view.image = ImageOutputName(image, &taken);
+    std::string encoding;
+    SFT_RETURN_IF_ERROR(
+        ImportImage(JoinPath(opts.images, image.name), camera, root, view.image, &encoding));
+    if (std::find(encodings->begin(), encodings->end(), encoding) == encodings->end()) {
+      encodings->push_back(encoding);
+    }
+    ObservingView& obs = (*observing)[image.id];
+    obs.camera = camera;
+    obs.cam_from_world.rotation = image.cam_from_world_rotation;
+    obs.cam_from_world.translation = image.cam_from_world_translation;
+    if (!opts.masks.empty()) {
+      view.mask = "masks/" + WithoutExtension(view.image.substr(7)) + ".png";
+      SFT_RETURN_IF_ERROR(
+          ImportMask(opts.masks, image.name, camera, root, view.mask, &(*masks)[i]));
+      obs.mask = &(*masks)[i];
+    }
+    view.cam_from_world = obs.cam_from_world;
+    dataset->views.push_back(view);
+    progress.Advance();
+  }
+  progress.Finish();
+
+  return Status::Ok();
+}
+
 Status ImportInto(const ColmapImportOptions& opts, const std::string& root,
                   ColmapImportReport* report) {
   ColmapModel model;
@@ -262,40 +308,8 @@ Status ImportInto(const ColmapImportOptions& opts, const std::string& root,
   std::vector<MaskBits> masks(opts.masks.empty() ? 0 : model.images.size());
   std::unordered_map<uint32_t, ObservingView> observing;
   std::vector<std::string> encodings;
-  std::set<std::string> taken;
-  Progress progress("import", static_cast<int64_t>(model.images.size()), !opts.quiet);
-  for (size_t i = 0; i < model.images.size(); ++i) {
-    const ColmapImage& image = model.images[i];
-    std::string why;
-    if (!IsContainedRelativePath(image.name, &why)) {
-      return Status::Error(opts.model + ": image " + std::to_string(image.id) + ": name \"" +
-                           image.name + "\": " + why);
-    }
-    ViewSpec view;
-    view.camera = camera_index.at(image.camera_id);
-    const Camera& camera = dataset.cameras[view.camera];
-    view.camera_id = camera.id;
-    view.image = ImageOutputName(image, &taken);
-    std::string encoding;
-    SFT_RETURN_IF_ERROR(
-        ImportImage(JoinPath(opts.images, image.name), camera, root, view.image, &encoding));
-    if (std::find(encodings.begin(), encodings.end(), encoding) == encodings.end()) {
-      encodings.push_back(encoding);
-    }
-    ObservingView& obs = observing[image.id];
-    obs.camera = camera;
-    obs.cam_from_world.rotation = image.cam_from_world_rotation;
-    obs.cam_from_world.translation = image.cam_from_world_translation;
-    if (!opts.masks.empty()) {
-      view.mask = "masks/" + WithoutExtension(view.image.substr(7)) + ".png";
-      SFT_RETURN_IF_ERROR(ImportMask(opts.masks, image.name, camera, root, view.mask, &masks[i]));
-      obs.mask = &masks[i];
-    }
-    view.cam_from_world = obs.cam_from_world;
-    dataset.views.push_back(view);
-    progress.Advance();
-  }
-  progress.Finish();
+  SFT_RETURN_IF_ERROR(
+      ImportViews(opts, model, root, camera_index, &dataset, &masks, &observing, &encodings));
 
   NormalizationResult& norm = report->normalization;
   SFT_RETURN_IF_ERROR(

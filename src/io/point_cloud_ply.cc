@@ -94,34 +94,49 @@ int Column(const std::vector<Property>& props, const char* name) {
   return -1;
 }
 
-}  // namespace
-
-Status ParsePointCloudPly(const std::string& data, const std::string& file, PointCloud* cloud) {
-  *cloud = PointCloud();
-  auto fail = [&](const std::string& m) { return Status::Error(file + ": " + m); };
-  size_t pos = 0;
-  int line_number = 0;
-  auto next_line = [&](std::string* line) {
-    if (pos >= data.size()) return false;
-    size_t end = data.find('\n', pos);
-    if (end == std::string::npos) end = data.size();
-    *line = data.substr(pos, end - pos);
+// Splits a buffer into lines (LF or CRLF), counting them.
+class Lines {
+ public:
+  explicit Lines(const std::string& data) : data_(data) {}
+  bool Next(std::string* line) {
+    if (pos_ >= data_.size()) return false;
+    size_t end = data_.find('\n', pos_);
+    if (end == std::string::npos) end = data_.size();
+    *line = data_.substr(pos_, end - pos_);
     if (!line->empty() && line->back() == '\r') line->pop_back();
-    pos = end + 1;
-    ++line_number;
+    pos_ = end + 1;
+    ++number_;
     return true;
-  };
+  }
+  size_t position() const { return std::min(pos_, data_.size()); }
+  int number() const { return number_; }
+
+ private:
+  const std::string& data_;
+  size_t pos_ = 0;
+  int number_ = 0;
+};
+
+struct Header {
+  bool binary = false;
+  uint64_t count = 0;           // vertices.
+  std::vector<Property> props;  // of the vertex element.
+};
+
+// Parses the header after the "ply" line, up to and including end_header.
+Status ParseHeader(Lines* lines, const std::string& file, Header* header) {
+  auto fail = [&](const std::string& m) { return Status::Error(file + ": " + m); };
+  bool have_format = false, in_vertex = false, vertex_seen = false;
+  bool& binary = header->binary;
+  uint64_t& count = header->count;
+  std::vector<Property>& props = header->props;
   std::string line;
-  if (!next_line(&line) || line != "ply") return fail("not a PLY file (no \"ply\" first line)");
-  bool binary = false, have_format = false, in_vertex = false, vertex_seen = false;
-  uint64_t count = 0;
-  std::vector<Property> props;
   for (;;) {
-    if (!next_line(&line)) return fail("header ends without end_header");
+    if (!lines->Next(&line)) return fail("header ends without end_header");
     std::istringstream in(line);
     std::string word;
     in >> word;
-    const std::string where = "header line " + std::to_string(line_number) + ": ";
+    const std::string where = "header line " + std::to_string(lines->number()) + ": ";
     if (word == "end_header") break;
     if (word == "comment" || word == "obj_info" || word.empty()) continue;
     if (word == "format") {
@@ -168,13 +183,30 @@ Status ParsePointCloudPly(const std::string& data, const std::string& file, Poin
   }
   if (!have_format) return fail("header has no format line");
   if (!vertex_seen) return fail("no vertex element");
+  return Status::Ok();
+}
+
+}  // namespace
+
+Status ParsePointCloudPly(const std::string& data, const std::string& file, PointCloud* cloud) {
+  *cloud = PointCloud();
+  auto fail = [&](const std::string& m) { return Status::Error(file + ": " + m); };
+  Lines lines(data);
+  std::string line;
+  if (!lines.Next(&line) || line != "ply") return fail("not a PLY file (no \"ply\" first line)");
+  Header header;
+  SFT_RETURN_IF_ERROR(ParseHeader(&lines, file, &header));
+  const bool binary = header.binary;
+  const uint64_t count = header.count;
+  const std::vector<Property>& props = header.props;
+  const size_t pos = lines.position();
   const int x = Column(props, "x"), y = Column(props, "y"), z = Column(props, "z");
   if (x < 0 || y < 0 || z < 0) return fail("vertex element lacks x, y or z");
   const int nx = Column(props, "nx"), ny = Column(props, "ny"), nz = Column(props, "nz");
   const int r = Column(props, "red"), g = Column(props, "green"), b = Column(props, "blue");
   const bool has_normals = nx >= 0 && ny >= 0 && nz >= 0;
   const bool has_colors = r >= 0 && g >= 0 && b >= 0;
-  const size_t remaining = data.size() - std::min(pos, data.size());
+  const size_t remaining = data.size() - pos;
   const size_t row = props.back().offset + props.back().size;
   // Each vertex takes `row` bytes in binary and at least 2 characters per value in ascii.
   const size_t min_bytes = binary ? row : 2 * props.size();
@@ -192,7 +224,7 @@ Status ParsePointCloudPly(const std::string& data, const std::string& file, Poin
       for (size_t k = 0; k < props.size(); ++k)
         values[k] = Decode(p + props[k].offset, props[k].type);
     } else {
-      if (!next_line(&line)) return fail("vertex " + std::to_string(i) + ": file ends early");
+      if (!lines.Next(&line)) return fail("vertex " + std::to_string(i) + ": file ends early");
       std::istringstream in(line);
       for (size_t k = 0; k < props.size(); ++k) {
         std::string token;
@@ -200,7 +232,7 @@ Status ParsePointCloudPly(const std::string& data, const std::string& file, Poin
         char* end = nullptr;
         values[k] = std::strtod(token.c_str(), &end);
         if (token.empty() || *end != '\0') {
-          return fail("line " + std::to_string(line_number) + ": expected " +
+          return fail("line " + std::to_string(lines.number()) + ": expected " +
                       std::to_string(props.size()) + " numbers");
         }
       }
