@@ -21,6 +21,8 @@ const CommandEntry kCommands[] = {
      &SetupPerturbCommand},
     {"compare", "Cost, Chamfer and F1 against wall time over several reconstruct runs (CSV, HTML)",
      &SetupCompareCommand},
+    {"import", "Bring captures into the dataset format (colmap: a COLMAP sparse model)",
+     &SetupImportCommand},
     {"bench", "Measure throughput against the limit (raw Embree rays/s)", &SetupBenchCommand},
     {"eval", "Measure a reconstructed mesh against a reference mesh (F1, Chamfer) as JSON",
      &SetupEvalCommand},

@@ -48,6 +48,7 @@ CommandRunner SetupReconstructCommand(CLI::App* app);
 CommandRunner SetupPerturbCommand(CLI::App* app);
 CommandRunner SetupEvalCommand(CLI::App* app);
 CommandRunner SetupCompareCommand(CLI::App* app);
+CommandRunner SetupImportCommand(CLI::App* app);
 
 }  // namespace sft
 

@@ -155,6 +155,7 @@ Status RunReconstruct(const ReconstructCommandOptions& cli_in) {
   SFT_RETURN_IF_ERROR(PrepareRun(&cli, &state, &options));
   Dataset dataset;
   SFT_RETURN_IF_ERROR(ReadDataset(cli.dataset, &dataset));
+  SFT_RETURN_IF_ERROR(CheckViewsHaveLights(dataset));
   TriMesh mesh;
   Material material;
   std::vector<double> light_scales;

@@ -192,6 +192,7 @@ Status RunRender(const RenderCommandOptions& opts) {
       opts.out, {{opts.dataset}, {opts.mesh, MaterialFile(opts.material), opts.lights}}, "--out"));
   Dataset dataset;
   SFT_RETURN_IF_ERROR(ReadDataset(opts.dataset, &dataset));
+  SFT_RETURN_IF_ERROR(CheckViewsHaveLights(dataset));
   if (!opts.lights.empty()) {
     std::vector<double> scales;
     SFT_RETURN_IF_ERROR(ReadLightScales(opts.lights, dataset, &scales));

@@ -30,8 +30,11 @@ constexpr char kSceneFile[] = "scene.json";
 constexpr double kRotationTolerance = 1e-3;
 // Keys of each object that ReadDataset interprets; all others are kept verbatim as extras.
 using Keys = std::initializer_list<const char*>;
-constexpr Keys kTopLevelKeys = {"format", "cameras",    "lights",
-                                "views",  "background", "ground_truth"};
+constexpr Keys kTopLevelKeys = {
+    "format",       "cameras",           "lights",         "views",
+    "background",   "ground_truth",      "sparse_points",  "initial_mesh",
+    "dense_points", "source_from_world", "image_encoding", "lighting"};
+constexpr Keys kSimilarityKeys = {"scale", "rotation", "translation"};
 constexpr Keys kCameraKeys = {"id", "model", "width", "height", "params"};
 constexpr Keys kPointLightKeys = {"id", "type", "frame", "position", "intensity"};
 constexpr Keys kEnvironmentLightKeys = {"id", "type", "image", "world_from_env", "scale"};
@@ -100,6 +103,7 @@ class SceneParser {
     SFT_RETURN_IF_ERROR(ParseViews(root, dataset));
     SFT_RETURN_IF_ERROR(ParseBackground(root, dataset));
     SFT_RETURN_IF_ERROR(ParseGroundTruth(root, dataset));
+    SFT_RETURN_IF_ERROR(ParseImportKeys(root, dataset));
     dataset->extra = UnknownKeys(root, kTopLevelKeys);
     return Status::Ok();
   }
@@ -354,6 +358,23 @@ class SceneParser {
     return Status::Ok();
   }
 
+  // A unit quaternion [w, x, y, z]; a non-unit one is normalized, a zero one is an error.
+  Status Quaternion(const json& value, const std::string& path, Eigen::Quaterniond* out) const {
+    std::vector<double> q;
+    SFT_RETURN_IF_ERROR(Numbers(value, path, 4, &q));
+    Eigen::Quaterniond quaternion(q[0], q[1], q[2], q[3]);  // (w, x, y, z)
+    const double norm = quaternion.norm();
+    if (!(norm > 1e-12) || !std::isfinite(norm)) {
+      return Error(path, "quaternion must have a non-zero finite norm");
+    }
+    // Leave already-unit quaternions untouched so that write/read cycles are exact.
+    if (std::abs(norm - 1.0) > 4 * std::numeric_limits<double>::epsilon()) {
+      quaternion.coeffs() /= norm;
+    }
+    *out = quaternion;
+    return Status::Ok();
+  }
+
   // Also returns the unknown keys of `cam_from_world` in `extra`.
   Status ParsePose(const json& view, const std::string& view_path, Rigid3d* pose,
                    json* extra) const {
@@ -363,18 +384,7 @@ class SceneParser {
     if (!value->is_object()) return Error(path, "expected an object, got " + Describe(*value));
     const json* rotation = nullptr;
     SFT_RETURN_IF_ERROR(Require(*value, path, "rotation", &rotation));
-    std::vector<double> q;
-    SFT_RETURN_IF_ERROR(Numbers(*rotation, Field(path, "rotation"), 4, &q));
-    Eigen::Quaterniond quaternion(q[0], q[1], q[2], q[3]);  // (w, x, y, z)
-    const double norm = quaternion.norm();
-    if (!(norm > 1e-12) || !std::isfinite(norm)) {
-      return Error(Field(path, "rotation"), "quaternion must have a non-zero finite norm");
-    }
-    // Leave already-unit quaternions untouched so that write/read cycles are exact.
-    if (std::abs(norm - 1.0) > 4 * std::numeric_limits<double>::epsilon()) {
-      quaternion.coeffs() /= norm;
-    }
-    pose->rotation = quaternion;
+    SFT_RETURN_IF_ERROR(Quaternion(*rotation, Field(path, "rotation"), &pose->rotation));
     const json* translation = nullptr;
     SFT_RETURN_IF_ERROR(Require(*value, path, "translation", &translation));
     SFT_RETURN_IF_ERROR(Vector3(*translation, Field(path, "translation"), &pose->translation));
@@ -468,6 +478,46 @@ class SceneParser {
     return Status::Ok();
   }
 
+  // The optional keys of importers (DESIGN.md §2.5, docs/import.md): file paths follow the
+  // dataset's path rules, texts are free, source_from_world is a similarity with scale > 0.
+  Status ParseImportKeys(const json& root, Dataset* dataset) const {
+    for (const auto& [key, out] :
+         {std::pair<const char*, std::string*>{"sparse_points", &dataset->sparse_points},
+          {"initial_mesh", &dataset->initial_mesh},
+          {"dense_points", &dataset->dense_points}}) {
+      if (const json* value = Find(root, key); value != nullptr && !value->is_null()) {
+        SFT_RETURN_IF_ERROR(String(*value, key, false, out));
+        SFT_RETURN_IF_ERROR(ContainedPath(key, *out));
+      }
+    }
+    for (const auto& [key, out] :
+         {std::pair<const char*, std::string*>{"image_encoding", &dataset->image_encoding},
+          {"lighting", &dataset->lighting}}) {
+      if (const json* value = Find(root, key); value != nullptr && !value->is_null()) {
+        SFT_RETURN_IF_ERROR(String(*value, key, true, out));
+      }
+    }
+    const json* value = Find(root, "source_from_world");
+    if (value == nullptr || value->is_null()) return Status::Ok();
+    const std::string path = "source_from_world";
+    if (!value->is_object()) return Error(path, "expected an object, got " + Describe(*value));
+    Similarity3d similarity;
+    const json* field = nullptr;
+    SFT_RETURN_IF_ERROR(Require(*value, path, "scale", &field));
+    SFT_RETURN_IF_ERROR(Number(*field, Field(path, "scale"), &similarity.scale));
+    if (!(similarity.scale > 0)) {
+      return Error(Field(path, "scale"), "expected a positive number, got " + Describe(*field));
+    }
+    SFT_RETURN_IF_ERROR(Require(*value, path, "rotation", &field));
+    SFT_RETURN_IF_ERROR(Quaternion(*field, Field(path, "rotation"), &similarity.rotation));
+    SFT_RETURN_IF_ERROR(Require(*value, path, "translation", &field));
+    SFT_RETURN_IF_ERROR(Vector3(*field, Field(path, "translation"), &similarity.translation));
+    similarity.extra = UnknownKeys(*value, kSimilarityKeys);
+    dataset->source_from_world = similarity;
+    dataset->has_source_from_world = true;
+    return Status::Ok();
+  }
+
   std::string file_;
 };
 
@@ -543,6 +593,19 @@ Status ReadDataset(const std::string& dir, Dataset* dataset) {
   } catch (const std::exception& e) {
     return Status::Error(file + ": " + StripJsonExceptionId(e.what()));
   }
+}
+
+Status CheckViewsHaveLights(const Dataset& dataset) {
+  for (size_t i = 0; i < dataset.views.size(); ++i) {
+    if (dataset.views[i].lights.empty()) {
+      return Status::Error(ScenePath(dataset) + ": " + Index("views", i) +
+                           ".lights: empty (unknown lighting" +
+                           (dataset.lighting.empty() ? "" : ": \"" + dataset.lighting + "\"") +
+                           "); rendering needs every view's lights (estimating unknown lighting "
+                           "is not supported yet)");
+    }
+  }
+  return Status::Ok();
 }
 
 Status CheckDatasetFiles(const Dataset& dataset) {
@@ -664,6 +727,20 @@ Status WriteSceneJson(const Dataset& dataset, const std::string& dir) {
     if (dataset.ground_truth.is_object()) ground_truth = dataset.ground_truth;
     if (!dataset.gt_mesh.empty()) ground_truth["mesh"] = dataset.gt_mesh;
     if (!ground_truth.is_null()) root["ground_truth"] = std::move(ground_truth);
+    if (!dataset.sparse_points.empty()) root["sparse_points"] = dataset.sparse_points;
+    if (!dataset.initial_mesh.empty()) root["initial_mesh"] = dataset.initial_mesh;
+    if (!dataset.dense_points.empty()) root["dense_points"] = dataset.dense_points;
+    if (dataset.has_source_from_world) {
+      const Similarity3d& s = dataset.source_from_world;
+      nlohmann::ordered_json entry;
+      entry["scale"] = s.scale;
+      entry["rotation"] = {s.rotation.w(), s.rotation.x(), s.rotation.y(), s.rotation.z()};
+      entry["translation"] = {s.translation.x(), s.translation.y(), s.translation.z()};
+      AppendExtra(s.extra, &entry);
+      root["source_from_world"] = std::move(entry);
+    }
+    if (!dataset.image_encoding.empty()) root["image_encoding"] = dataset.image_encoding;
+    if (!dataset.lighting.empty()) root["lighting"] = dataset.lighting;
 
     AppendExtra(dataset.extra, &root);
     return WriteTextFile(file, root.dump(1, ' ', false, json::error_handler_t::replace) + "\n");

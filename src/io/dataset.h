@@ -73,6 +73,20 @@ struct ViewSpec {
   nlohmann::json cam_from_world_extra;
 };
 
+// A similarity transform y = scale * (rotation * x) + translation (DESIGN.md §2.5
+// "source_from_world": p_source = s·R·p + t).
+struct Similarity3d {
+  double scale = 1.0;  // > 0.
+  Eigen::Quaterniond rotation = Eigen::Quaterniond::Identity();
+  Eigen::Vector3d translation = Eigen::Vector3d::Zero();
+  // Keys of the JSON object other than scale, rotation and translation, kept verbatim (or null).
+  nlohmann::json extra;
+
+  Eigen::Vector3d operator*(const Eigen::Vector3d& x) const {
+    return scale * (rotation * x) + translation;
+  }
+};
+
 struct Dataset {
   std::string root;  // the dataset directory (paths in the specs are relative to it).
   std::vector<Camera> cameras;
@@ -87,7 +101,15 @@ struct Dataset {
   Background background = Background::kBlack;
   std::string gt_mesh;          // `ground_truth.mesh` (relative), empty when absent.
   nlohmann::json ground_truth;  // the whole `ground_truth` object as read (null when absent).
-  nlohmann::json extra;         // top-level keys this version does not interpret, kept verbatim.
+  // Optional keys written by importers (DESIGN.md §2.5, docs/import.md); empty when absent.
+  std::string sparse_points;           // "sparse_points": PLY point cloud (xyz, rgb), world frame.
+  std::string initial_mesh;            // "initial_mesh": starting mesh, world frame.
+  std::string dense_points;            // "dense_points": dense point cloud (e.g. COLMAP fused.ply).
+  std::string image_encoding;          // "image_encoding": free text, where the pixels came from.
+  std::string lighting;                // "lighting": free text, e.g. "unknown".
+  bool has_source_from_world = false;  // "source_from_world" is present.
+  Similarity3d source_from_world;      // maps this dataset's world into the import's frame.
+  nlohmann::json extra;  // top-level keys this version does not interpret, kept verbatim.
 };
 
 // Reads and validates DIR/scene.json: format tag, camera models and parameter counts, positive
@@ -96,6 +118,11 @@ struct Dataset {
 // Does not open images (see CheckDatasetFiles). Errors name the file and the JSON path, e.g.
 // "data/x/scene.json: views[3].cam_from_world.rotation: expected 4 numbers, got 3".
 Status ReadDataset(const std::string& dir, Dataset* dataset);
+
+// Renderers need every view's lighting: an error naming the first view whose `lights` list is
+// empty (unknown lighting, as importers write it; DESIGN.md §2.5), else OK. Reading such a
+// dataset is fine; commands that render it call this first.
+Status CheckViewsHaveLights(const Dataset& dataset);
 
 // Opens every view image, mask and light probe once and checks sizes against the cameras
 // (an image whose size differs from its camera's is an error naming both sizes).

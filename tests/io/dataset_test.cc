@@ -166,6 +166,72 @@ TEST(DatasetRead, UnknownTopLevelKeysAreKept) {
   EXPECT_EQ(dataset.extra["note"], "hello");
 }
 
+TEST(DatasetRead, ImportKeysAreParsedAndWrittenBack) {
+  json scene = MinimalScene();
+  scene["sparse_points"] = "sparse/points3D.ply";
+  scene["initial_mesh"] = "init/mesh.ply";
+  scene["dense_points"] = "init/fused.ply";
+  scene["source_from_world"] = {
+      {"scale", 3.5}, {"rotation", {0, 0, 0, 2}}, {"translation", {1, 2, 3}}, {"note", "kept"}};
+  scene["image_encoding"] = "sRGB 8-bit JPEG converted to PNG";
+  scene["lighting"] = "unknown";
+  scene["views"][0]["lights"] = json::array();  // unknown lighting reads fine.
+  TempDir dir;
+  WriteJson(dir.path(), scene);
+  Dataset dataset;
+  ASSERT_TRUE(ReadDataset(dir.path(), &dataset).ok());
+  EXPECT_TRUE(dataset.extra.is_null());
+  EXPECT_EQ(dataset.sparse_points, "sparse/points3D.ply");
+  EXPECT_EQ(dataset.initial_mesh, "init/mesh.ply");
+  EXPECT_EQ(dataset.dense_points, "init/fused.ply");
+  EXPECT_EQ(dataset.image_encoding, "sRGB 8-bit JPEG converted to PNG");
+  EXPECT_EQ(dataset.lighting, "unknown");
+  ASSERT_TRUE(dataset.has_source_from_world);
+  EXPECT_EQ(dataset.source_from_world.scale, 3.5);
+  EXPECT_EQ(dataset.source_from_world.rotation.z(), 1.0);  // normalised.
+  // 180° about z, scale 3.5, then the translation.
+  EXPECT_LT(
+      (dataset.source_from_world * Eigen::Vector3d(1, 0, 0) - Eigen::Vector3d(-2.5, 2, 3)).norm(),
+      1e-12);
+  EXPECT_TRUE(dataset.views[0].lights.empty());
+  EXPECT_THAT(CheckViewsHaveLights(dataset).message(), HasSubstr("views[0].lights: empty"));
+  TempDir copy;
+  ASSERT_TRUE(WriteSceneJson(dataset, copy.path()).ok());
+  Dataset again;
+  ASSERT_TRUE(ReadDataset(copy.path(), &again).ok());
+  EXPECT_EQ(again.sparse_points, dataset.sparse_points);
+  EXPECT_EQ(again.lighting, dataset.lighting);
+  EXPECT_EQ(again.source_from_world.translation, Eigen::Vector3d(1, 2, 3));
+  EXPECT_EQ(again.source_from_world.extra["note"], "kept");
+  // Without the keys nothing changes.
+  Dataset plain;
+  WriteJson(copy.path(), MinimalScene());
+  ASSERT_TRUE(ReadDataset(copy.path(), &plain).ok());
+  EXPECT_FALSE(plain.has_source_from_world);
+  EXPECT_TRUE(plain.sparse_points.empty());
+  EXPECT_TRUE(CheckViewsHaveLights(plain).ok());
+}
+
+TEST(DatasetErrors, BadImportKeys) {
+  json scene = MinimalScene();
+  scene["initial_mesh"] = "../outside.ply";
+  EXPECT_THAT(ReadError(scene), HasSubstr("initial_mesh"));
+  scene = MinimalScene();
+  scene["sparse_points"] = "/abs/points.ply";
+  EXPECT_THAT(ReadError(scene), HasSubstr("sparse_points"));
+  scene = MinimalScene();
+  scene["source_from_world"] = {
+      {"scale", 0}, {"rotation", {1, 0, 0, 0}}, {"translation", {0, 0, 0}}};
+  EXPECT_THAT(ReadError(scene), HasSubstr("source_from_world.scale"));
+  scene["source_from_world"] = {{"scale", 1}, {"rotation", {1, 0, 0}}, {"translation", {0, 0, 0}}};
+  EXPECT_THAT(ReadError(scene), HasSubstr("source_from_world.rotation"));
+  scene["source_from_world"] = {{"scale", 1}, {"rotation", {1, 0, 0, 0}}};
+  EXPECT_THAT(ReadError(scene), HasSubstr("source_from_world.translation: missing"));
+  scene = MinimalScene();
+  scene["lighting"] = 3;
+  EXPECT_THAT(ReadError(scene), HasSubstr("lighting"));
+}
+
 // A scene with unknown keys in a camera, both kinds of light, a view and a pose.
 json SceneWithNestedExtras() {
   json scene = MinimalScene();

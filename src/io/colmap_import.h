@@ -1,0 +1,52 @@
+// `sft import colmap`: a COLMAP sparse model (text or binary) and its images become an
+// sft-dataset/1 (DESIGN.md §2.5) with the optional import keys of docs/import.md
+// (source_from_world, sparse_points, initial_mesh, dense_points, image_encoding, lighting).
+//
+// Decisions (docs/import.md): only registered images become views, in COLMAP image-id order; each
+// COLMAP camera used by them becomes a camera "c<ID>" (models SIMPLE_PINHOLE, PINHOLE,
+// SIMPLE_RADIAL, RADIAL, OPENCV; any other is an error). PNG and EXR images are copied byte for
+// byte; other formats (JPEG, TIFF, ...) are decoded with OpenCV and written as PNG at their bit
+// depth (8 or 16), which is lossless with respect to the decoded pixels. The scene is normalised
+// like `sft synth`'s (import_normalization.h) and the similarity recorded as source_from_world.
+// Everything is written to OUT.partial and renamed to OUT at the end; a failure removes
+// OUT.partial.
+#ifndef SFT_IO_COLMAP_IMPORT_H_
+#define SFT_IO_COLMAP_IMPORT_H_
+
+#include <string>
+
+#include "src/core/status.h"
+#include "src/io/import_normalization.h"
+
+namespace sft {
+
+struct ColmapImportOptions {
+  std::string model;   // COLMAP sparse model folder (cameras/images/points3D .bin or .txt).
+  std::string images;  // folder the model's image names are relative to.
+  std::string masks;   // optional mask folder: NAME.png (COLMAP's convention) or STEM.png.
+  std::string probe;   // optional equirectangular probe: .exr/.hdr (linear) or 8-bit (sRGB).
+  std::string out;     // output dataset folder.
+  NormalizationOptions normalization;  // how the object is found among the sparse points.
+  bool import_dense = true;            // import fused.ply / meshed-*.ply found beside the model.
+  bool overwrite = false;              // replace an existing, non-empty output folder.
+  bool quiet = false;                  // no progress line.
+
+  bool Check(std::string* why) const;
+};
+
+// What the import did, for the command's summary and for tests.
+struct ColmapImportReport {
+  std::string format;  // "binary" or "text".
+  int cameras = 0;     // cameras written.
+  int views = 0;       // registered images imported.
+  NormalizationResult normalization;
+  std::string dense_mesh;    // source file imported as init/mesh.ply, or "".
+  std::string dense_points;  // source file imported as init/fused.ply, or "".
+  double seconds = 0;        // wall time.
+};
+
+Status ImportColmap(const ColmapImportOptions& options, ColmapImportReport* report);
+
+}  // namespace sft
+
+#endif  // SFT_IO_COLMAP_IMPORT_H_
