@@ -46,6 +46,7 @@ CommandRunner SetupReconstructCommand(CLI::App* app);
 CommandRunner SetupPerturbCommand(CLI::App* app);
 CommandRunner SetupEvalCommand(CLI::App* app);
 CommandRunner SetupCompareCommand(CLI::App* app);
+CommandRunner SetupInitCommand(CLI::App* app);
 
 }  // namespace sft
 
