@@ -10,7 +10,8 @@
 // An existing mesh.ply is replaced only with --overwrite. A JSON summary goes to stdout.
 //
 // Sparse points: --points, else the file that scene.json's "sparse_points" names, else
-// D/sparse/points3D.ply when it exists; they are counted against the hull (src/init/initial_mesh.h).
+// D/sparse/points3D.ply when it exists; they are counted against the hull
+// (src/init/initial_mesh.h).
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -33,12 +34,12 @@ constexpr char kDefaultMeshPath[] = "init/mesh.ply";
 constexpr char kDefaultPointsPath[] = "sparse/points3D.ply";
 
 struct InitCommandOptions {
-  std::string dataset;         // the dataset (read; written only without --out).
-  std::string out;             // output folder; "" = D/init.
-  std::string points;          // sparse points PLY in the dataset's world frame; "" = default.
-  InitialMeshOptions mesh;     // resolution, faces.
-  bool overwrite = false;      // replace an existing mesh.ply.
-  bool quiet = false;          // no progress line.
+  std::string dataset;      // the dataset (read; written only without --out).
+  std::string out;          // output folder; "" = D/init.
+  std::string points;       // sparse points PLY in the dataset's world frame; "" = default.
+  InitialMeshOptions mesh;  // resolution, faces.
+  bool overwrite = false;   // replace an existing mesh.ply.
+  bool quiet = false;       // no progress line.
 };
 
 // The sparse point file to use ("" when there is none): --points, scene.json's "sparse_points",
@@ -90,8 +91,8 @@ nlohmann::ordered_json Summary(const std::string& mesh_path, const std::string& 
       {"mesh", mesh_path},
       {"faces", r.faces},
       {"vertices", r.vertices},
-      {"carving_box", {{"lo", {r.box.lo.x(), r.box.lo.y(), r.box.lo.z()}},
-                       {"hi", {hi.x(), hi.y(), hi.z()}}}},
+      {"carving_box",
+       {{"lo", {r.box.lo.x(), r.box.lo.y(), r.box.lo.z()}}, {"hi", {hi.x(), hi.y(), hi.z()}}}},
       {"voxel_size", r.box.voxel_size},
       {"voxels", {r.box.dims.x(), r.box.dims.y(), r.box.dims.z()}},
       {"min_views", r.min_views},
@@ -106,6 +107,8 @@ nlohmann::ordered_json Summary(const std::string& mesh_path, const std::string& 
       {"points_outside_box", r.points_outside_box},
       {"points_inside_hull", r.points_inside},
       {"carve_seconds", r.carve_seconds},
+      {"extract_seconds", r.extract_seconds},
+      {"decimate_seconds", r.decimate_seconds},
       {"seconds", r.total_seconds},
   };
 }
@@ -149,8 +152,7 @@ Status RunInit(const InitCommandOptions& opts) {
     view_pixels += int64_t{camera.width} * camera.height;
   }
   if (!CheckMemoryBudget(EstimateCarvingBytes(view_pixels, opts.mesh.hull.resolution),
-                         "carving at --resolution " +
-                             std::to_string(opts.mesh.hull.resolution),
+                         "carving at --resolution " + std::to_string(opts.mesh.hull.resolution),
                          &why)) {
     return Status::Error(why);
   }

@@ -99,7 +99,9 @@ Status MakeInitialMesh(const std::vector<CarvingView>& views, const InitialMeshO
   hull = VisualHull();  // the field is no longer needed; free it before decimation.
   TriMesh result;
   SFT_RETURN_IF_ERROR(BuildClosedSurface(points, triangles, &result, &report->cleanup));
+  report->extract_seconds = SecondsSince(start) - report->carve_seconds;
   DecimateMesh(options.faces, &result);
+  report->decimate_seconds = SecondsSince(start) - report->carve_seconds - report->extract_seconds;
   if (!IsClosedManifold(result, &why)) return Status::Error("after decimation: " + why);
   report->faces = static_cast<int>(result.n_faces());
   report->vertices = static_cast<int>(result.n_vertices());

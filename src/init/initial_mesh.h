@@ -42,18 +42,20 @@ struct InitialMeshOptions {
 constexpr double kInsidePointVoxels = 2.0;
 
 struct InitialMeshReport {
-  VoxelBox box;               // the carving grid.
-  int min_views = 0;          // views that must see a voxel.
-  int inside_voxels = 0;      // voxels inside the hull.
+  VoxelBox box;           // the carving grid.
+  int min_views = 0;      // views that must see a voxel.
+  int inside_voxels = 0;  // voxels inside the hull.
   int extracted_triangles = 0;
   SurfaceCleanupReport cleanup;
-  int faces = 0;              // output faces.
-  int vertices = 0;           // output vertices.
-  int points = 0;             // sparse points checked.
-  int points_outside = 0;     // farther than one voxel outside the hull.
-  int points_outside_box = 0;  // of those, outside the carving box altogether.
-  int points_inside = 0;      // deeper than kInsidePointVoxels voxels inside.
-  double carve_seconds = 0.0;
+  int faces = 0;                 // output faces.
+  int vertices = 0;              // output vertices.
+  int points = 0;                // sparse points checked.
+  int points_outside = 0;        // farther than one voxel outside the hull.
+  int points_outside_box = 0;    // of those, outside the carving box altogether.
+  int points_inside = 0;         // deeper than kInsidePointVoxels voxels inside.
+  double carve_seconds = 0.0;    // both passes of the field.
+  double extract_seconds = 0.0;  // OpenVDB extraction and the clean-up.
+  double decimate_seconds = 0.0;
   double total_seconds = 0.0;
 };
 

@@ -123,9 +123,10 @@ Status BuildClosedSurface(const std::vector<Eigen::Vector3d>& points,
   std::unordered_map<int, int> sizes;
   for (int t = 0; t < static_cast<int>(valid.size()); ++t) ++sizes[components.Find(t)];
   report->components = static_cast<int>(sizes.size());
-  const int largest = std::max_element(sizes.begin(), sizes.end(), [](const auto& a, const auto& b) {
-                        return a.second < b.second;
-                      })->first;
+  const int largest =
+      std::max_element(sizes.begin(), sizes.end(), [](const auto& a, const auto& b) {
+        return a.second < b.second;
+      })->first;
   std::vector<Eigen::Vector3i> kept;
   for (int t = 0; t < static_cast<int>(valid.size()); ++t) {
     if (components.Find(t) == largest) kept.push_back(valid[t]);

@@ -138,8 +138,8 @@ bool VisualHullOptions::Check(std::string* why) const {
   return true;
 }
 
-Status MakeCarvingView(const std::string& name, const Camera& camera,
-                       const Rigid3d& cam_from_world, const Image& mask, CarvingView* view) {
+Status MakeCarvingView(const std::string& name, const Camera& camera, const Rigid3d& cam_from_world,
+                       const Image& mask, CarvingView* view) {
   CHECK_EQ(mask.channels, 1);
   CHECK_EQ(mask.width, camera.width);
   CHECK_EQ(mask.height, camera.height);
@@ -153,9 +153,10 @@ Status MakeCarvingView(const std::string& name, const Camera& camera,
     }
   }
   if (count == 0) {
-    return Status::Error(name + ": the mask is empty (no object pixel); a view that does not see "
-                                "the object cannot be carved with (remove the view or fix its "
-                                "mask)");
+    return Status::Error(name +
+                         ": the mask is empty (no object pixel); a view that does not see "
+                         "the object cannot be carved with (remove the view or fix its "
+                         "mask)");
   }
   // distanceTransform: each non-zero pixel's distance to the nearest zero pixel (centre to
   // centre). Outside pixels measure to the nearest object pixel and vice versa; the silhouette
@@ -201,10 +202,11 @@ Status CarveVisualHull(const std::vector<CarvingView>& views, const VisualHullOp
       static_cast<int>(std::ceil(options.min_view_fraction * num_views - 1e-9)), 2, num_views);
   VoxelBox box;
   if (!FindCarvingBox(views, options, min_views, progress, &box)) {
-    return Status::Error("the visual hull is empty: no point of [-" + std::to_string(options.bounds) +
-                         ", " + std::to_string(options.bounds) + "]^3 projects inside the masks of "
-                         "all views that see it (seen by at least " + std::to_string(min_views) +
-                         " views); check the cameras and masks");
+    return Status::Error("the visual hull is empty: no point of [-" +
+                         std::to_string(options.bounds) + ", " + std::to_string(options.bounds) +
+                         "]^3 projects inside the masks of "
+                         "all views that see it (seen by at least " +
+                         std::to_string(min_views) + " views); check the cameras and masks");
   }
   hull->box = box;
   hull->band = kBandVoxels * box.voxel_size;
@@ -242,8 +244,7 @@ double SampleHull(const VisualHull& hull, const Eigen::Vector3d& p) {
   double value = 0.0;
   for (int c = 0; c < 8; ++c) {
     const int di = c & 1, dj = (c >> 1) & 1, dk = (c >> 2) & 1;
-    const double w =
-        (di ? f.x() : 1 - f.x()) * (dj ? f.y() : 1 - f.y()) * (dk ? f.z() : 1 - f.z());
+    const double w = (di ? f.x() : 1 - f.x()) * (dj ? f.y() : 1 - f.y()) * (dk ? f.z() : 1 - f.z());
     value += w * at(di, dj, dk);
   }
   return value;
@@ -266,9 +267,9 @@ Status ExtractHullSurface(const VisualHull& hull, std::vector<Eigen::Vector3d>* 
     transform->postTranslate(openvdb::Vec3d(origin.x(), origin.y(), origin.z()));
     grid->setTransform(transform);
     grid->setGridClass(openvdb::GRID_LEVEL_SET);
-    const openvdb::CoordBBox bbox(openvdb::Coord(0, 0, 0),
-                                  openvdb::Coord(box.dims.x() - 1, box.dims.y() - 1,
-                                                 box.dims.z() - 1));
+    const openvdb::CoordBBox bbox(
+        openvdb::Coord(0, 0, 0),
+        openvdb::Coord(box.dims.x() - 1, box.dims.y() - 1, box.dims.z() - 1));
     // Dense only reads through this pointer (copyFromDense).
     openvdb::tools::Dense<float, openvdb::tools::LayoutXYZ> dense(
         bbox, const_cast<float*>(hull.field.data()));

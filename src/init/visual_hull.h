@@ -70,8 +70,8 @@ struct CarvingView {
 
 // Prepares a view from its 0/1 mask (1 channel, the camera's size). An all-background mask is an
 // error naming the view: it says the object is nowhere, which would carve everything it sees.
-Status MakeCarvingView(const std::string& name, const Camera& camera,
-                       const Rigid3d& cam_from_world, const Image& mask, CarvingView* view);
+Status MakeCarvingView(const std::string& name, const Camera& camera, const Rigid3d& cam_from_world,
+                       const Image& mask, CarvingView* view);
 
 // An axis-aligned grid of cubic voxels; voxel (i, j, k)'s centre is lo + (i + ½, j + ½, k + ½)·h.
 struct VoxelBox {
@@ -89,8 +89,8 @@ struct VisualHull {
   VoxelBox box;
   // Field values (scene units, negative inside), x fastest: index (k·ny + j)·nx + i.
   std::vector<float> field;
-  double band = 0.0;    // |field| ≤ band (scene units).
-  int min_views = 0;    // views that must see a point (from min_view_fraction).
+  double band = 0.0;      // |field| ≤ band (scene units).
+  int min_views = 0;      // views that must see a point (from min_view_fraction).
   int inside_voxels = 0;  // voxels with a negative value.
 };
 

@@ -11,8 +11,8 @@
 
 #include "src/core/image.h"
 #include "src/geometry/mesh.h"
-#include "src/io/image_io.h"
 #include "src/init/surface_cleanup.h"
+#include "src/io/image_io.h"
 #include "tests/testing/synth_dataset.h"
 #include "tests/testing/temp_dir.h"
 
@@ -21,8 +21,8 @@ namespace {
 
 namespace fs = std::filesystem;
 using testing::CountLines;
-using testing::RunSft;
 using ::testing::HasSubstr;
+using testing::RunSft;
 using ::testing::StartsWith;
 
 std::string ReadAll(const std::string& path) {
@@ -56,8 +56,7 @@ TEST(InitCommandTest, DefaultOutputGoesIntoTheDatasetAndAddsTheKey) {
   const nlohmann::ordered_json scene_before =
       nlohmann::ordered_json::parse(ReadAll(d + "/scene.json"));
   std::string out;
-  ASSERT_EQ(RunSft("init --quiet --dataset " + d + " --resolution 48 --faces 400", &out), 0)
-      << out;
+  ASSERT_EQ(RunSft("init --quiet --dataset " + d + " --resolution 48 --faces 400", &out), 0) << out;
   const nlohmann::json summary = nlohmann::json::parse(out);
   EXPECT_EQ(summary["mesh"], d + "/init/mesh.ply");
   EXPECT_LE(summary["faces"].get<int>(), 400);
@@ -90,9 +89,8 @@ TEST(InitCommandTest, DefaultOutputGoesIntoTheDatasetAndAddsTheKey) {
   ASSERT_NE(RunSft("init --quiet --dataset " + d + " --resolution 48 --faces 400", &out), 0);
   EXPECT_EQ(CountLines(out), 1) << out;
   EXPECT_THAT(out, StartsWith("sft init: error: " + d + "/init/mesh.ply: exists"));
-  ASSERT_EQ(RunSft("init --quiet --overwrite --dataset " + d + " --resolution 32 --faces 300",
-                   &out),
-            0)
+  ASSERT_EQ(
+      RunSft("init --quiet --overwrite --dataset " + d + " --resolution 32 --faces 300", &out), 0)
       << out;
   EXPECT_EQ(nlohmann::json::parse(out)["scene_json"], "initial_mesh already set");
   EXPECT_EQ(ReadAll(d + "/scene.json"), scene_text);
@@ -122,19 +120,22 @@ TEST(InitCommandTest, OutElsewhereLeavesTheDatasetByteIdentical) {
 TEST(InitCommandTest, SparsePointsAreCountedAgainstTheHull) {
   testing::TempDir tmp;
   const std::string d = MakeDataset(tmp);
-  // The synth icosphere has radius ~0.29: one point at the centre (well inside), one on the
-  // surface, two far outside.
+  // The synth icosphere has radius 0.2887 and the carving box reaches ±0.34: one point at the
+  // centre (well inside), one just inside the surface (neither), one outside the hull but inside
+  // the box, one far away.
   testing::WriteTestFile(tmp.Join("p.ply"),
                          "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\n"
                          "property float y\nproperty float z\nend_header\n"
-                         "0 0 0\n0.2887 0 0\n0.6 0 0\n3 3 3\n");
+                         "0 0 0\n0.275 0 0\n0.33 0 0\n3 3 3\n");
   std::string out;
   ASSERT_EQ(RunSft("init --quiet --dataset " + d + " --out " + tmp.Join("o") +
-                       " --resolution 48 --faces 300 --points " + tmp.Join("p.ply") + " 2>/dev/null",
+                       " --resolution 48 --faces 300 --points " + tmp.Join("p.ply"),
                    &out),
             0)
       << out;
-  const nlohmann::json summary = nlohmann::json::parse(out);
+  // One warning line on stderr, then the JSON.
+  EXPECT_THAT(out, StartsWith("sft init: warning: 2 of 4 sparse points lie outside the hull"));
+  const nlohmann::json summary = nlohmann::json::parse(out.substr(out.find('{')));
   EXPECT_EQ(summary["points"], 4);
   EXPECT_EQ(summary["points_outside_hull"], 2);
   EXPECT_EQ(summary["points_outside_box"], 1);

@@ -47,8 +47,8 @@ CarvingView SphereView(int k, int n, int res) {
     }
   }
   CarvingView view;
-  const Status status = MakeCarvingView("sphere view " + std::to_string(k), camera,
-                                        cam_from_world, mask, &view);
+  const Status status =
+      MakeCarvingView("sphere view " + std::to_string(k), camera, cam_from_world, mask, &view);
   EXPECT_TRUE(status.ok()) << status.message();
   return view;
 }
@@ -86,8 +86,9 @@ TEST(VisualHullTest, SphereFromManyViewsIsTheSphere) {
   const double mean_error = sum_error / mesh.n_vertices();
   RecordProperty("max_error_voxels", std::to_string(max_error / h));
   RecordProperty("mean_error_voxels", std::to_string(mean_error / h));
-  EXPECT_LT(max_error, 1.0 * h);
-  EXPECT_LT(std::abs(mean_error), 0.25 * h);
+  // Measured: max 0.24 voxels, mean −0.09 voxels (docs/init.md).
+  EXPECT_LT(max_error, 0.5 * h);
+  EXPECT_LT(std::abs(mean_error), 0.2 * h);
   // Volume of the ball within 3%.
   const double volume = 4.0 / 3.0 * M_PI * std::pow(kRadius, 3);
   EXPECT_NEAR(EnclosedVolume(mesh), volume, 0.03 * volume);
@@ -102,11 +103,10 @@ TEST(VisualHullTest, EmptyMaskIsAnErrorNamingTheView) {
   camera.width = camera.height = 8;
   camera.params = {8, 8, 4, 4};
   CarvingView view;
-  const Status status = MakeCarvingView("views[3] (masks/003.png)", camera, Rigid3d(),
-                                        Image(8, 8, 1, 0.f), &view);
+  const Status status =
+      MakeCarvingView("views[3] (masks/003.png)", camera, Rigid3d(), Image(8, 8, 1, 0.f), &view);
   ASSERT_FALSE(status.ok());
-  EXPECT_NE(status.message().find("views[3] (masks/003.png): the mask is empty"),
-            std::string::npos)
+  EXPECT_NE(status.message().find("views[3] (masks/003.png): the mask is empty"), std::string::npos)
       << status.message();
 }
 
@@ -158,8 +158,8 @@ void AddTetrahedron(int base, bool outward, std::vector<Eigen::Vector3i>* triang
 TEST(SurfaceCleanupTest, KeepsTheLargestComponentAndOrientsItOutwards) {
   // An inward-facing octahedron (8 triangles), a separate small tetrahedron (4) and a degenerate
   // triangle.
-  std::vector<Eigen::Vector3d> points = {{1, 0, 0},   {0, 1, 0},   {-1, 0, 0},  {0, -1, 0},
-                                         {0, 0, 1},   {0, 0, -1},  {5, 5, 5},   {5.1, 5, 5},
+  std::vector<Eigen::Vector3d> points = {{1, 0, 0},   {0, 1, 0},  {-1, 0, 0}, {0, -1, 0},
+                                         {0, 0, 1},   {0, 0, -1}, {5, 5, 5},  {5.1, 5, 5},
                                          {5, 5.1, 5}, {5, 5, 5.1}};
   std::vector<Eigen::Vector3i> triangles;
   for (int i = 0; i < 4; ++i) {
@@ -293,12 +293,11 @@ TEST(InitialMeshTest, BunnyHullAgainstTheTrueMesh) {
   ASSERT_TRUE(ComputeMeshMetrics(truth, mesh, metrics_options, &metrics).ok());
   RecordProperty("f1", std::to_string(metrics.f1));
   RecordProperty("chamfer", std::to_string(metrics.chamfer));
-  // Measured: see docs/init.md. The hull contains the bunny (recall high), its concavities
-  // (between the ears, under the chin) cost precision.
-  EXPECT_GT(metrics.f1, 0.0);
-  EXPECT_LT(metrics.chamfer, 1.0);
-  std::printf("bunny: F1 %.4f precision %.4f recall %.4f chamfer %.5f faces %d\n", metrics.f1,
-              metrics.precision, metrics.recall, metrics.chamfer, report.faces);
+  // Measured: F1 0.906 (precision 0.914, recall 0.898), Chamfer 0.0054 (docs/init.md). The hull
+  // over-estimates the bunny where silhouettes cannot see (concavities) and between the views;
+  // the bounds leave room for sampling and platform noise, and fail for a hull off by a voxel.
+  EXPECT_GT(metrics.f1, 0.88);
+  EXPECT_LT(metrics.chamfer, 0.0065);
 }
 
 }  // namespace
