@@ -23,6 +23,7 @@
 #include "src/geometry/mesh.h"
 #include "src/init/initial_mesh.h"
 #include "src/io/dataset.h"
+#include "src/io/point_cloud_ply.h"
 
 namespace sft {
 namespace {
@@ -158,8 +159,9 @@ Status RunInit(const InitCommandOptions& opts) {
   }
   std::string points_path;
   SFT_RETURN_IF_ERROR(FindPointsFile(opts, scene, &points_path));
-  std::vector<Eigen::Vector3d> points;
-  if (!points_path.empty()) SFT_RETURN_IF_ERROR(ReadPlyPoints(points_path, &points));
+  PointCloud cloud;
+  if (!points_path.empty()) SFT_RETURN_IF_ERROR(ReadPointCloudPly(points_path, &cloud));
+  const std::vector<Eigen::Vector3d>& points = cloud.positions;
 
   std::vector<CarvingView> views;
   SFT_RETURN_IF_ERROR(LoadCarvingViews(dataset, &views));

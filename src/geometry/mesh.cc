@@ -537,10 +537,7 @@ class PlyBodyReader {
   Format format_;
 };
 
-// With `points_only`, a file without faces is accepted and faces are not required (point clouds);
-// a face element that is present is still parsed and checked.
-Status ParsePly(const std::string& path, const std::string& text, ParsedMesh* out,
-                bool points_only = false) {
+Status ParsePly(const std::string& path, const std::string& text, ParsedMesh* out) {
   // Header: lines up to "end_header".
   LineReader reader(text);
   std::string_view line;
@@ -629,7 +626,7 @@ Status ParsePly(const std::string& path, const std::string& text, ParsedMesh* ou
     if (e.name == "face") face_element = &e;
   }
   if (vertex_element == nullptr) return Status::Error(path + ": PLY has no vertex element");
-  if (!points_only && (face_element == nullptr || face_element->count == 0)) {
+  if (face_element == nullptr || face_element->count == 0) {
     return Status::Error(path + ": no faces");
   }
   auto find = [](const PlyElement& e, std::initializer_list<const char*> names, bool list) {
@@ -651,13 +648,11 @@ Status ParsePly(const std::string& path, const std::string& text, ParsedMesh* ou
   const int pu = find(*vertex_element, {"u", "s", "texture_u", "texture_s"}, false);
   const int pv = find(*vertex_element, {"v", "t", "texture_v", "texture_t"}, false);
   const bool vertex_uvs = pu >= 0 && pv >= 0;
-  const int pindices =
-      face_element == nullptr ? -1 : find(*face_element, {"vertex_indices", "vertex_index"}, true);
-  if (face_element != nullptr && pindices < 0) {
+  const int pindices = find(*face_element, {"vertex_indices", "vertex_index"}, true);
+  if (pindices < 0) {
     return Status::Error(path + ": PLY face element lacks a vertex_indices list property");
   }
-  const int ptexcoord =
-      face_element == nullptr ? -1 : find(*face_element, {"texcoord"}, true);  // MeshLab UVs.
+  const int ptexcoord = find(*face_element, {"texcoord"}, true);  // MeshLab per-corner UVs.
 
   PlyBodyReader body(text, body_start, format);
   const long long num_vertices = vertex_element->count;
@@ -1112,19 +1107,6 @@ Status WriteMesh(const std::string& path, const TriMesh& mesh) {
   if (ext == "ply") return WritePly(path, mesh);
   if (ext == "off") return WriteOff(path, mesh);
   return Status::Error(path + ": unknown mesh extension '" + ext + "' (expected obj, ply, off)");
-}
-
-Status ReadPlyPoints(const std::string& path, std::vector<Eigen::Vector3d>* points) {
-  if (FileExtension(path) != "ply") {
-    return Status::Error(path + ": point files must be PLY (extension .ply)");
-  }
-  std::string text;
-  SFT_RETURN_IF_ERROR(ReadTextFile(path, &text));
-  StripUtf8Bom(&text);
-  ParsedMesh parsed;
-  SFT_RETURN_IF_ERROR(ParsePly(path, text, &parsed, /*points_only=*/true));
-  *points = std::move(parsed.positions);
-  return Status::Ok();
 }
 
 void MeshToArrays(const TriMesh& mesh, std::vector<Eigen::Vector3d>* positions,

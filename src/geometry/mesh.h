@@ -38,12 +38,6 @@ struct MeshReport {
 // faces silently). Degenerate faces are counted in `report`, not errors.
 Status ReadMesh(const std::string& path, TriMesh* mesh, MeshReport* report = nullptr);
 
-// Reads the vertex positions of a PLY file (ascii/binary) that may have no faces, e.g. a sparse
-// point cloud (`x`, `y`, `z` of the "vertex" element; other properties ignored). Same checks and
-// one-line errors as ReadMesh (malformed header, truncated data, non-finite coordinates, and face
-// indices out of range when the file does have faces).
-Status ReadPlyPoints(const std::string& path, std::vector<Eigen::Vector3d>* points);
-
 // Writes OBJ, PLY (binary) or OFF by extension, atomically. OBJ includes per-corner UVs when the
 // mesh has halfedge texcoords.
 Status WriteMesh(const std::string& path, const TriMesh& mesh);
