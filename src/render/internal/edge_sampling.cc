@@ -56,6 +56,18 @@ bool EdgeView::Project(const Eigen::Vector3d& y, Eigen::Vector2d* q,
   return true;
 }
 
+bool EdgeView::ClippedImageLength(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double* s0,
+                                  double* s1, double* length) const {
+  const Camera& camera = ctx.view.camera;
+  const Eigen::Vector3d a_cam = ctx.view.cam_from_world * a;
+  const Eigen::Vector3d b_cam = ctx.view.cam_from_world * b;
+  if (!ClipSegment(a_cam, b_cam, frustum, s0, s1)) return false;
+  const Eigen::Vector2d q0 = camera.ImageFromCam(a_cam + *s0 * (b_cam - a_cam));
+  const Eigen::Vector2d q1 = camera.ImageFromCam(a_cam + *s1 * (b_cam - a_cam));
+  *length = (q1 - q0).norm();
+  return true;
+}
+
 void EdgeView::SideDirections(const Eigen::Vector2d& q, const Eigen::Vector2d& m,
                               Eigen::Vector3d dirs[2]) const {
   for (int i = 0; i < 2; ++i) {

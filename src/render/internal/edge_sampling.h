@@ -108,6 +108,10 @@ struct EdgeView {
   // off the image).
   bool Project(const Eigen::Vector3d& y, Eigen::Vector2d* q, Eigen::Matrix<double, 2, 3>* d_q_d_y,
                int* pixel) const;
+  // The part s ∈ [s0, s1] of the world segment a + s(b − a) inside the view frustum and its
+  // length in the image (pixels); false when none of it is in view.
+  bool ClippedImageLength(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double* s0,
+                          double* s1, double* length) const;
   // Directions of the camera rays through the two sides q ∓ εm of an image point q (index 0: −).
   void SideDirections(const Eigen::Vector2d& q, const Eigen::Vector2d& m,
                       Eigen::Vector3d dirs[2]) const;

@@ -119,7 +119,6 @@ Eigen::Vector3d PrimaryJump(const EdgeView& view, const MeshEdge& edge, const Ei
 // Primary edges in view, weighted by projected length (+ 1e-3 px) × PrimaryEdgeImportance.
 std::vector<EdgeCandidate> PrimaryEdgeCandidates(const EdgeView& view) {
   const RenderScene& scene = view.ctx.scene;
-  const Camera& camera = view.ctx.view.camera;
   const auto& positions = scene.positions();
   const auto& edges = scene.edges();
   std::vector<EdgeCandidate> candidates;
@@ -128,14 +127,8 @@ std::vector<EdgeCandidate> PrimaryEdgeCandidates(const EdgeView& view) {
     const Eigen::Vector3d& a = positions[edge.v0];
     const Eigen::Vector3d& b = positions[edge.v1];
     if (a == b || !IsDiscontinuityEdge(scene, edge, view.center, /*creases=*/true)) continue;
-    const Eigen::Vector3d a_cam = view.ctx.view.cam_from_world * a;
-    const Eigen::Vector3d b_cam = view.ctx.view.cam_from_world * b;
-    double s0, s1;
-    if (!ClipSegment(a_cam, b_cam, view.frustum, &s0, &s1)) continue;
-    const Eigen::Vector2d q0 = camera.ImageFromCam(a_cam + s0 * (b_cam - a_cam));
-    const Eigen::Vector2d q1 = camera.ImageFromCam(a_cam + s1 * (b_cam - a_cam));
-    const double length = (q1 - q0).norm();
-    if (!std::isfinite(length)) continue;
+    double s0, s1, length;
+    if (!view.ClippedImageLength(a, b, &s0, &s1, &length) || !std::isfinite(length)) continue;
     candidates.push_back({static_cast<int>(e), s0, s1,
                           (length + 1e-3) * PrimaryEdgeImportance(scene, edge, view.center)});
   }

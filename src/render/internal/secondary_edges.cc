@@ -205,18 +205,6 @@ void SampleMeshEdge(const SecondaryVertex& v, double u_index, double u_point, Sa
                     -m_row);
 }
 
-// The ends of a texel segment in world space.
-void TexelSegmentEnds(const RenderScene& scene, const TexelSegment& segment, Eigen::Vector3d* y0,
-                      Eigen::Vector3d* y1) {
-  const Eigen::Vector3i& corners = scene.faces()[segment.face];
-  y0->setZero();
-  y1->setZero();
-  for (int k = 0; k < 3; ++k) {
-    *y0 += segment.b0[k] * scene.positions()[corners[k]];
-    *y1 += segment.b1[k] * scene.positions()[corners[k]];
-  }
-}
-
 // (C) Texel boundaries on the surfaces a further bounce sees: L_in jumps where the material of
 // the surface hit along ω does. Sampled like (A): kSecondaryCandidates (segment, point) pairs,
 // the segment ∝ 3D length × material jump, the point uniform in its subtended angle, one kept by

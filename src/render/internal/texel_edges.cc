@@ -206,6 +206,17 @@ void AddTexelPointRows(const RenderScene& scene, int face, int other, const Eige
   }
 }
 
+void TexelSegmentEnds(const RenderScene& scene, const TexelSegment& segment, Eigen::Vector3d* y0,
+                      Eigen::Vector3d* y1) {
+  const Eigen::Vector3i& corners = scene.faces()[segment.face];
+  y0->setZero();
+  y1->setZero();
+  for (int k = 0; k < 3; ++k) {
+    *y0 += segment.b0[k] * scene.positions()[corners[k]];
+    *y1 += segment.b1[k] * scene.positions()[corners[k]];
+  }
+}
+
 std::vector<TexelSegment> TexelSegments(const RenderScene& scene, const Material& material,
                                         bool glossy) {
   std::vector<TexelSegment> segments;
@@ -223,7 +234,6 @@ namespace {
 std::vector<TexelCandidate> TexelCandidates(const EdgeView& view) {
   const RenderScene& scene = view.ctx.scene;
   const Material& material = view.ctx.material;
-  const Camera& camera = view.ctx.view.camera;
   const bool glossy = material.specular * view.ctx.specular_scale > 0.0;
   std::vector<TexelCandidate> candidates;
   for (const TexelSegment& segment : TexelSegments(scene, material, glossy)) {
@@ -232,19 +242,11 @@ std::vector<TexelCandidate> TexelCandidates(const EdgeView& view) {
         IsDiscontinuityEdge(scene, scene.edges()[segment.edge], view.center, /*creases=*/true)) {
       continue;
     }
-    const Eigen::Vector3i& corners = scene.faces()[segment.face];
-    Eigen::Vector3d y0 = Eigen::Vector3d::Zero(), y1 = Eigen::Vector3d::Zero();
-    for (int k = 0; k < 3; ++k) {
-      y0 += segment.b0[k] * scene.positions()[corners[k]];
-      y1 += segment.b1[k] * scene.positions()[corners[k]];
-    }
-    const Eigen::Vector3d a_cam = view.ctx.view.cam_from_world * y0;
-    const Eigen::Vector3d b_cam = view.ctx.view.cam_from_world * y1;
-    double s0, s1;
-    if (!ClipSegment(a_cam, b_cam, view.frustum, &s0, &s1)) continue;
-    const Eigen::Vector2d q0 = camera.ImageFromCam(a_cam + s0 * (b_cam - a_cam));
-    const Eigen::Vector2d q1 = camera.ImageFromCam(a_cam + s1 * (b_cam - a_cam));
-    const double weight = (q1 - q0).norm() * segment.size;
+    Eigen::Vector3d y0, y1;
+    TexelSegmentEnds(scene, segment, &y0, &y1);
+    double s0, s1, length;
+    if (!view.ClippedImageLength(y0, y1, &s0, &s1, &length)) continue;
+    const double weight = length * segment.size;
     if (!(weight > 0.0) || !std::isfinite(weight)) continue;
     candidates.push_back({segment.face, segment.other, segment.b0, segment.b1, segment.c0,
                           segment.c1, s0, s1, weight});

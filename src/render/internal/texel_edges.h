@@ -41,6 +41,10 @@ void AddTexelPointRows(const RenderScene& scene, int face, int other, const Eige
 std::vector<TexelSegment> TexelSegments(const RenderScene& scene, const Material& material,
                                         bool glossy);
 
+// The ends Σ_k b0_k·p_k and Σ_k b1_k·p_k of a texel segment, world frame.
+void TexelSegmentEnds(const RenderScene& scene, const TexelSegment& segment, Eigen::Vector3d* y0,
+                      Eigen::Vector3d* y1);
+
 }  // namespace render_internal
 }  // namespace sft
 
