@@ -92,13 +92,22 @@ int RunGradcheckCommand(const GradcheckCommandOptions& opts) {
                         {"projections", projections},
                         {"fd_norm", v.fd_norm},
                         {"adjoint_mismatch", v.adjoint_mismatch},
-                        {"jacobian_entries", v.jacobian_entries}});
+                        {"jacobian_entries", v.jacobian_entries},
+                        {"nonfinite_samples", v.nonfinite_samples},
+                        {"nonfinite_outputs", v.nonfinite_outputs}});
+    if (v.nonfinite_samples > 0 || v.nonfinite_outputs > 0) {
+      std::printf("view %3d: %lld samples dropped as not finite, %lld output values not finite\n",
+                  v.view, static_cast<long long>(v.nonfinite_samples),
+                  static_cast<long long>(v.nonfinite_outputs));
+    }
   }
   report["views"] = per_view;
   report["relative_error"] = result.relative_error;
   report["pixel_relative_error"] = result.pixel_relative_error;
   report["projection_error"] = result.projection_error;
   report["passed"] = result.passed;
+  report["nonfinite_samples"] = result.nonfinite_samples;
+  report["nonfinite_outputs"] = result.nonfinite_outputs;
   if (blocks) {
     std::printf(
         "gradcheck %s: relative error %.3e on %dx%d blocks (pixels %.3e, projections %.3e) over "

@@ -242,7 +242,14 @@ Status RunRender(const RenderCommandOptions& opts) {
                             {"seconds", stats.seconds},
                             {"camera_rays", stats.camera_rays},
                             {"shadow_rays", stats.shadow_rays},
-                            {"bounce_rays", stats.bounce_rays}};
+                            {"bounce_rays", stats.bounce_rays},
+                            {"nonfinite_samples", stats.nonfinite_samples},
+                            {"nonfinite_outputs", stats.nonfinite_outputs}};
+    if (stats.NonFinite() > 0) {
+      progress.Warn("view " + std::to_string(v) + ": " + std::to_string(stats.nonfinite_samples) +
+                    " samples dropped as not finite, " + std::to_string(stats.nonfinite_outputs) +
+                    " pixel values not finite");
+    }
     if (!opts.no_report) {
       const ViewComparison c = CompareWithTarget(dataset, v, image, colour_pass);
       entry["target"] = dataset.views[v].image;

@@ -279,6 +279,7 @@ Status RunGradcheck(const Dataset& dataset, const TriMesh& mesh, const Material&
   result->block = block;
   result->step = step;
   result->views.clear();
+  result->nonfinite_samples = result->nonfinite_outputs = 0;
   double total_err2 = 0.0, total_ref2 = 0.0;              // block sums.
   double total_pixel_err2 = 0.0, total_pixel_ref2 = 0.0;  // pixels.
   double total_proj_err2 = 0.0, total_proj_ref2 = 0.0;    // projections.
@@ -290,12 +291,13 @@ Status RunGradcheck(const Dataset& dataset, const TriMesh& mesh, const Material&
     request.adjoint_weights = &weights;
     Image image, plus, minus;
     DerivativeOutput out;
+    RenderStats stats[3];
     RenderViewWithDerivatives(scene, material, view, render, request,
-                              static_cast<int>(dataset.lights.size()), &image, &out);
+                              static_cast<int>(dataset.lights.size()), &image, &out, &stats[0]);
     RenderView(vertices ? *plus_scene : scene, plus_material,
-               PerturbView(view, layout, delta, step), render, &plus);
+               PerturbView(view, layout, delta, step), render, &plus, &stats[1]);
     RenderView(vertices ? *minus_scene : scene, minus_material,
-               PerturbView(view, layout, delta, -step), render, &minus);
+               PerturbView(view, layout, delta, -step), render, &minus, &stats[2]);
 
     // The directional derivative images, RGB per pixel.
     const size_t pixels = static_cast<size_t>(width) * height;
@@ -360,6 +362,12 @@ Status RunGradcheck(const Dataset& dataset, const TriMesh& mesh, const Material&
     view_result.adjoint_mismatch =
         weighted_abs > 0 ? std::abs(adjoint - weighted) / weighted_abs : 0.0;
     view_result.jacobian_entries = out.rows.entries.size();
+    for (const RenderStats& s : stats) {
+      view_result.nonfinite_samples += s.nonfinite_samples;
+      view_result.nonfinite_outputs += s.nonfinite_outputs;
+    }
+    result->nonfinite_samples += view_result.nonfinite_samples;
+    result->nonfinite_outputs += view_result.nonfinite_outputs;
     result->views.push_back(view_result);
     total_err2 += err2;
     total_ref2 += ref2;

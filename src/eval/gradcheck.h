@@ -99,6 +99,9 @@ struct GradcheckViewResult {
   double fd_norm = 0.0;           // ‖fd‖₂ per pixel.
   double adjoint_mismatch = 0.0;  // |δ·Jᵀw − Σ w·(Jδ)| / Σ|w·(Jδ)| for a random w.
   size_t jacobian_entries = 0;
+  // Of the derivative render and the two finite-difference renders (RenderStats).
+  int64_t nonfinite_samples = 0;
+  int64_t nonfinite_outputs = 0;
 };
 
 struct GradcheckResult {
@@ -109,6 +112,8 @@ struct GradcheckResult {
   double relative_error = 0.0;        // over all views (block sums).
   double pixel_relative_error = 0.0;  // over all views, per pixel.
   double projection_error = 0.0;      // over all views' projections.
+  int64_t nonfinite_samples = 0;      // over all views (RenderStats).
+  int64_t nonfinite_outputs = 0;
   bool passed = false;
 };
 

@@ -141,15 +141,20 @@ void RenderCache::Render(bool rows) {
     const auto start = std::chrono::steady_clock::now();
     Image image;
     const ViewSetup view = ScaledView(v);
+    // Samples or outputs lost to non-finite values make the evaluation fail (finite_), so that
+    // the solver rejects the step instead of fitting to a biased or infinite render.
+    RenderStats stats;
     if (rows && active_.Any()) {
       DerivativeOutput output;
       RenderViewWithDerivatives(*scene_, material_, view, render, request, num_lights, &image,
-                                &output);
+                                &output, &stats);
       render_seconds_ += Seconds(start);
+      non_finite_ += stats.NonFinite();
       StoreRender(v, image, &output.rows);
     } else {
-      RenderView(*scene_, material_, view, render, &image);
+      RenderView(*scene_, material_, view, render, &image, &stats);
       render_seconds_ += Seconds(start);
+      non_finite_ += stats.NonFinite();
       StoreRender(v, image, nullptr);
     }
     ++renders_;
@@ -160,7 +165,6 @@ void RenderCache::Render(bool rows) {
 void RenderCache::StoreRender(int v, const Image& image, const JacobianRows* rows) {
   const auto start = std::chrono::steady_clock::now();
   std::vector<Image> pyramid = BuildPyramid(ToRgb(image), num_levels(v));
-  for (float value : pyramid[0].data) non_finite_ += !std::isfinite(value);
   LevelRows level_rows;
   if (rows != nullptr) {
     level_rows = RowsFromRenderer(*rows);
@@ -172,7 +176,7 @@ void RenderCache::StoreRender(int v, const Image& image, const JacobianRows* row
         const double scale = params_->LightScale(e.param - layout.LightOffset());
         for (double& d : e.d) d /= scale;
       }
-      for (double d : e.d) non_finite_ += !std::isfinite(d);
+      for (double d : e.d) non_finite_ += !std::isfinite(d);  // a light-scale division.
     }
   }
   for (int l = 0; l < num_levels(v); ++l) {
@@ -274,12 +278,13 @@ bool RenderCache::AddAdjointGradient(int v, const Image& weights, std::vector<do
   const auto start = std::chrono::steady_clock::now();
   Image image;
   DerivativeOutput output;
+  RenderStats stats;
   RenderViewWithDerivatives(*scene_, material_, ScaledView(v), render, request,
-                            params_->layout().num_lights, &image, &output);
+                            params_->layout().num_lights, &image, &output, &stats);
   render_seconds_ += Seconds(start);
   ++renders_;
   const ParameterLayout& layout = params_->layout();
-  bool finite = true;
+  bool finite = stats.NonFinite() == 0;
   for (int i = 0; i < layout.size(); ++i) {
     double g = output.gradient[i];
     if (i >= layout.LightOffset()) g /= params_->LightScale(i - layout.LightOffset());

@@ -70,9 +70,11 @@ class RenderCache : public ceres::EvaluationCallback {
   int num_levels(int v) const { return static_cast<int>(levels_[v].size()); }
   const LevelCache& level(int v, int l) const { return *levels_[v][l]; }
   const ViewTargets& targets(int v) const { return targets_[v]; }
-  // Whether the last render (image and rows) was finite everywhere.
+  // Whether the last render (image and rows) was finite everywhere, with no sample dropped as
+  // not finite (RenderStats::NonFinite); the cost functions fail (reject the step) otherwise.
   const bool* finite() const { return &finite_; }
-  // Number of non-finite values in the last render (pixels and row entries).
+  // Number of non-finite values in the last render: RenderStats' dropped samples and non-finite
+  // outputs, plus row entries made non-finite by light-scale division.
   int64_t non_finite_values() const { return non_finite_; }
 
   // ½ Σ r² of the image residuals over the active pixels of every level, at the last render.
@@ -98,7 +100,8 @@ class RenderCache : public ceres::EvaluationCallback {
   // over active pixels (D_lᵀ the adjoint of the pyramid's downsampling chain), as RGB.
   Image AdjointWeights(int v) const;
   // Renders view v at the current parameters with the adjoint gradient for `weights`
-  // (no rows stored); adds it to *gradient (layout size). Returns false on non-finite output.
+  // (no rows stored); adds it to *gradient (layout size). Returns false on non-finite output or
+  // samples dropped as not finite (RenderStats::NonFinite).
   bool AddAdjointGradient(int v, const Image& weights, std::vector<double>* gradient);
 
  private:

@@ -44,8 +44,9 @@ Eigen::Vector3d SampleGgxVisibleNormal(const Eigen::Vector3d& wo, double alpha, 
   return Eigen::Vector3d(alpha * nh.x(), alpha * nh.y(), std::max(1e-12, nh.z())).normalized();
 }
 
-// The glossy term as a function of (n, wo, wi), templated so that ceres::Jet gives its exact
-// gradient; the same formulas as GgxD, GgxG1, SchlickFresnel and EvalBsdf below.
+// The glossy term g of f = albedo/π + g as a function of (n, wo, wi), templated so that
+// ceres::Jet gives its exact gradient (EvalGlossyWithGradient) and T = double its value
+// (EvalBsdf). Zero below the surface, for specular ≤ 0, and for wi = −wo.
 template <typename T>
 T GlossyTerm(const Eigen::Matrix<T, 3, 1>& n, const Eigen::Vector3d& wo,
              const Eigen::Matrix<T, 3, 1>& wi, double alpha, double specular, FresnelMode mode) {
@@ -57,29 +58,10 @@ T GlossyTerm(const Eigen::Matrix<T, 3, 1>& n, const Eigen::Vector3d& wo,
   const T len = sqrt(sum.squaredNorm());
   if (!(len > 1e-12)) return T(0.0);
   const Eigen::Matrix<T, 3, 1> h = sum / len;
-  T fresnel(specular);
-  if (mode == FresnelMode::kSchlick) {
-    T m = 1.0 - wi.dot(h);
-    if (m < 0.0) m = T(0.0);
-    if (m > 1.0) m = T(1.0);
-    const T m2 = m * m;
-    fresnel = specular + (1.0 - specular) * m2 * m2 * m;
-  }
-  const T cos_h = n.dot(h);
-  if (cos_h <= 0.0) return T(0.0);
-  const double a2 = alpha * alpha;
-  const T cos2_h = cos_h * cos_h;
-  T sin2_h = 1.0 - cos2_h;
-  if (sin2_h < 0.0) sin2_h = T(0.0);
-  const T q = sin2_h + cos2_h * a2;
-  const T d = a2 / (kPi * q * q);
-  auto g1 = [a2](const T& c) {
-    const T c2 = c * c;
-    T s2 = 1.0 - c2;
-    if (s2 < 0.0) s2 = T(0.0);
-    return 2.0 / (1.0 + sqrt(1.0 + a2 * s2 / c2));
-  };
-  return fresnel * d * g1(cos_i) * g1(cos_o) / (4.0 * cos_i * cos_o);
+  const T fresnel =
+      mode == FresnelMode::kSchlick ? SchlickFresnel<T>(specular, wi.dot(h)) : T(specular);
+  return fresnel * GgxD<T>(n.dot(h), alpha) * GgxG1<T>(cos_i, alpha) * GgxG1<T>(cos_o, alpha) /
+         (4.0 * cos_i * cos_o);
 }
 
 double Luminance(const Eigen::Vector3d& c) { return (c.x() + c.y() + c.z()) / 3.0; }
@@ -87,28 +69,6 @@ double Luminance(const Eigen::Vector3d& c) { return (c.x() + c.y() + c.z()) / 3.
 }  // namespace
 
 double BsdfParams::Alpha() const { return std::max(kMinGgxAlpha, roughness * roughness); }
-
-double GgxD(double cos_h, double alpha) {
-  if (cos_h <= 0.0) return 0.0;
-  const double a2 = alpha * alpha;
-  const double cos2 = cos_h * cos_h;
-  // 1 + cos²(α² − 1) written as sin² + cos²·α² so it stays accurate for tiny α.
-  const double denom = std::max(0.0, 1.0 - cos2) + cos2 * a2;
-  return a2 / (kPi * denom * denom);
-}
-
-double GgxG1(double cos_w, double alpha) {
-  if (cos_w <= 0.0) return 0.0;
-  const double cos2 = cos_w * cos_w;
-  const double tan2 = std::max(0.0, 1.0 - cos2) / cos2;
-  return 2.0 / (1.0 + std::sqrt(1.0 + alpha * alpha * tan2));
-}
-
-double SchlickFresnel(double f0, double cos_d) {
-  const double m = std::clamp(1.0 - cos_d, 0.0, 1.0);
-  const double m2 = m * m;
-  return f0 + (1.0 - f0) * m2 * m2 * m;
-}
 
 double GlossySelectionProbability(const BsdfParams& params) {
   const double diffuse = std::max(0.0, Luminance(params.albedo));
@@ -126,18 +86,7 @@ Eigen::Vector3d EvalBsdf(const BsdfParams& params, const Eigen::Vector3d& n,
   if (cos_o <= 0.0 || cos_i <= 0.0) return Eigen::Vector3d::Zero();
   Eigen::Vector3d f = params.albedo / kPi;
   if (params.specular > 0.0) {
-    const Eigen::Vector3d sum = wi + wo;
-    const double len = sum.norm();
-    if (len > 1e-12) {
-      const Eigen::Vector3d h = sum / len;
-      const double alpha = params.Alpha();
-      const double fresnel = params.fresnel == FresnelMode::kSchlick
-                                 ? SchlickFresnel(params.specular, wi.dot(h))
-                                 : params.specular;
-      const double glossy = fresnel * GgxD(n.dot(h), alpha) * GgxG1(cos_i, alpha) *
-                            GgxG1(cos_o, alpha) / (4.0 * cos_i * cos_o);
-      f.array() += glossy;
-    }
+    f.array() += GlossyTerm<double>(n, wo, wi, params.Alpha(), params.specular, params.fresnel);
   }
   return f;
 }

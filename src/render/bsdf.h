@@ -17,6 +17,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <cmath>
 
 #include "src/geometry/material.h"
 
@@ -35,12 +36,49 @@ struct BsdfParams {
   double Alpha() const;
 };
 
+// The lobe's factors, templated on the scalar so that one definition serves the values (T =
+// double) and, with T = ceres::Jet, their exact gradients with respect to the directions
+// (EvalGlossyWithGradient). Comparisons use the scalar part.
+
+// max(0, x), with max(0, NaN) = 0 as std::max(0.0, x).
+template <typename T>
+T ClampNonNegative(const T& x) {
+  return 0.0 < x ? x : T(0.0);
+}
+
 // GGX normal distribution D(h) with cos_h = n·h, α as above; 0 for cos_h ≤ 0.
-double GgxD(double cos_h, double alpha);
+template <typename T>
+T GgxD(const T& cos_h, double alpha) {
+  if (cos_h <= 0.0) return T(0.0);
+  const double a2 = alpha * alpha;
+  const T cos2 = cos_h * cos_h;
+  // 1 + cos²(α² − 1) written as sin² + cos²·α² so it stays accurate for tiny α.
+  const T denom = ClampNonNegative<T>(1.0 - cos2) + cos2 * a2;
+  return a2 / (M_PI * denom * denom);
+}
+
 // Smith G1 for GGX of a direction with cosine `cos_w` to the normal.
-double GgxG1(double cos_w, double alpha);
+template <typename T>
+T GgxG1(const T& cos_w, double alpha) {
+  if (cos_w <= 0.0) return T(0.0);
+  using std::sqrt;
+  const T cos2 = cos_w * cos_w;
+  const T tan2 = ClampNonNegative<T>(1.0 - cos2) / cos2;
+  return 2.0 / (1.0 + sqrt(1.0 + alpha * alpha * tan2));
+}
+
 // Schlick's Fresnel with F0 = f0 at cos_d = wi·h.
-double SchlickFresnel(double f0, double cos_d);
+template <typename T>
+T SchlickFresnel(double f0, const T& cos_d) {
+  T m = 1.0 - cos_d;  // clamped to [0, 1] as std::clamp.
+  if (m < 0.0) {
+    m = T(0.0);
+  } else if (1.0 < m) {
+    m = T(1.0);
+  }
+  const T m2 = m * m;
+  return f0 + (1.0 - f0) * m2 * m2 * m;
+}
 
 // f(wo, wi) (no cosine factor). Returns zero for directions below the surface.
 Eigen::Vector3d EvalBsdf(const BsdfParams& params, const Eigen::Vector3d& n,

@@ -16,7 +16,7 @@
 //   vertices, interior terms (geometry_derivatives.h): through every path vertex's face normal
 //     (BSDF, cosines) and, for point lights, its position (light direction and 1/d²), chained
 //     through the hit points of earlier bounces; all effects;
-//   vertices, boundary terms (edge sampling, render.cc): see the table.
+//   vertices, boundary terms (edge sampling, src/render/internal/*_edges.cc): see the table.
 //
 // Vertex derivative terms present per Effects setting (✓ present, — not needed):
 //   effect on      interior  primary edges     texel boundaries  point-light shadow  secondary (A)
@@ -28,7 +28,7 @@
 //                                                                                      (with
 //                                                                                      shadows)
 //   + specular     ✓         ✓                 as above          as above            as above
-// Secondary edges (render.cc, AddSecondaryEdgeSamples; secondary_edge_samples per path vertex):
+// Secondary edges (internal/secondary_edges.cc; secondary_edge_samples per path vertex):
 // (A) mesh edges seen from a path vertex — silhouettes against the environment (when it is lit
 // with shadows) or against farther surfaces, and creases, when a further bounce is traced;
 // (B) point-light shadow boundaries on the surface a bounce reaches; (C) texel boundaries on the
@@ -136,11 +136,8 @@ struct DerivativeRequest {
   // see the boundary's face, two paths. Only boundaries whose two texels differ visibly are
   // candidates (albedo; roughness when the glossy lobe is on), so constant materials cost
   // nothing. Default 1/8: with the jump size in the sampling weight and the samples stratified
-  // along the lines the term converges fast. On the textured spot dataset (r = 8, 128², 256 spp,
-  // one segment) its difference from a ratio-8 reference was, already at 1/16, as small as the
-  // seed-to-seed scatter of the other terms (8×8 blocks 0.2–0.3%, pixels 1.0%, per-vertex sums
-  // 2.9%), while 1/8 adds ~10–20% to the derivative render's time and 1/2 ~60%; 1/8 keeps a 2×
-  // margin for harsher textures.
+  // along the lines the term converges fast (measurements: docs/design-notes.md, "Texel
+  // boundaries").
   double texel_edge_ratio = 0.125;
 
   // True when valid; else *why names the field.

@@ -85,13 +85,30 @@ struct ViewSetup {
   uint64_t view_index = 0;                      // part of the sample seed.
 };
 
-// Counters of one render, for throughput measurements.
+// Counters of one render: rays (for throughput measurements) and values lost to overflow.
 struct RenderStats {
   int64_t camera_rays = 0;
   int64_t shadow_rays = 0;
   int64_t bounce_rays = 0;
+  // Samples dropped because a value was not finite: a camera sample whose radiance or any of its
+  // derivative terms (interior or secondary-edge) is not finite — its radiance and all its terms
+  // are left out of the pixel — and edge samples whose jump or entries are not finite.
+  int64_t nonfinite_samples = 0;
+  // Output values that are not finite as floats: image pixel values (written as they are) and
+  // Jacobian row / adjoint entries (dropped). Non-zero means the render cannot be trusted, e.g.
+  // the reconstruction rejects the step.
+  int64_t nonfinite_outputs = 0;
   double seconds = 0.0;
   int64_t TotalRays() const { return camera_rays + shadow_rays + bounce_rays; }
+  int64_t NonFinite() const { return nonfinite_samples + nonfinite_outputs; }
+  // Adds the other's counters (not its seconds).
+  void AddCounts(const RenderStats& other) {
+    camera_rays += other.camera_rays;
+    shadow_rays += other.shadow_rays;
+    bounce_rays += other.bounce_rays;
+    nonfinite_samples += other.nonfinite_samples;
+    nonfinite_outputs += other.nonfinite_outputs;
+  }
 };
 
 // Renders one view into `image` (width × height × 4: RGB of the pass, alpha = pixel coverage,

@@ -6,6 +6,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <random>
 
 #include "cost_functions/pyramid_pixel.h"
@@ -95,6 +96,31 @@ std::vector<double> RandomDirection(const SceneParameters& params, ParameterKind
     if (params.layout().KindOf(i) == kind) delta[i] = u(rng);
   }
   return delta;
+}
+
+// A light scale whose renders overflow (samples of infinite radiance are dropped, pixel values
+// overflow float): the render reports it (RenderStats), the cache is not finite and counts the
+// values, and the adjoint gradient fails, so the solver rejects such a step.
+TEST_F(ReconstructTest, NonFiniteRenderFailsTheEvaluation) {
+  FitSetup s;
+  ActiveParameters active;
+  active.albedo = true;
+  MakeSetup(dataset_, mesh_, truth_, options_.cache, active, &s);
+  s.cache->Render(true);
+  ASSERT_TRUE(*s.cache->finite());
+  EXPECT_EQ(s.cache->non_finite_values(), 0);
+  const int light = s.params.layout().LightOffset();
+  for (double scale : {1e300, std::numeric_limits<double>::infinity()}) {
+    s.params.values()[light] = scale;
+    s.cache->Render(true);
+    EXPECT_FALSE(*s.cache->finite()) << scale;
+    EXPECT_GT(s.cache->non_finite_values(), 0) << scale;
+    std::vector<double> gradient(s.params.layout().size(), 0.0);
+    EXPECT_FALSE(s.cache->AddAdjointGradient(0, s.cache->AdjointWeights(0), &gradient)) << scale;
+  }
+  s.params.values()[light] = 1.0;
+  s.cache->Render(true);
+  EXPECT_TRUE(*s.cache->finite());
 }
 
 // Every level's rows applied to δ equal the central difference of that level's image along δ

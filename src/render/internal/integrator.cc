@@ -1,0 +1,294 @@
+#include "src/render/internal/integrator.h"
+
+#include <cmath>
+
+#include "src/render/bsdf.h"
+#include "src/render/internal/path_derivatives.h"
+#include "src/render/internal/secondary_edges.h"
+
+namespace sft {
+namespace render_internal {
+namespace {
+
+// The shading frame of a path vertex at ray hit `hit` of the ray along `dir`.
+struct ShadingPoint {
+  Eigen::Vector3d p;
+  Eigen::Vector3d n;  // unit face normal flipped to the side of wo (two-sided shading).
+  Eigen::Vector3d wo;
+  double sign = 1.0;  // n = sign·(face normal).
+};
+
+// False for a degenerate triangle (no defined surface).
+bool Shade(const Context& ctx, const Eigen::Vector3d& dir, const RayHit& hit, ShadingPoint* sp) {
+  sp->p = ctx.scene.Point(hit.face, hit.u, hit.v);
+  sp->n = ctx.scene.FaceNormal(hit.face);
+  sp->wo = -dir;
+  sp->sign = sp->n.dot(sp->wo) < 0.0 ? -1.0 : 1.0;
+  sp->n *= sp->sign;
+  return !sp->n.isZero();
+}
+
+// The light term (and its geometric derivatives when `derivatives`) of a point-light sample.
+LightTerm PointLightTerm(const PointLightSample& ls, const PointLight& light,
+                         const Eigen::Vector3d& n, bool derivatives) {
+  LightTerm term;
+  term.q = light.intensity;
+  term.c = ls.cos_i / (ls.dist * ls.dist);
+  if (derivatives) {
+    const double dist2 = ls.dist * ls.dist;
+    term.dc_dn = ls.wi / dist2;
+    term.follows_point = true;
+    term.dc_dx = (3.0 * ls.cos_i * ls.wi - n) / (dist2 * ls.dist);
+    term.dwi_dx = -(Eigen::Matrix3d::Identity() - ls.wi * ls.wi.transpose()) / ls.dist;
+  }
+  return term;
+}
+
+// One vertex of a path being traced, and the path's running sums.
+struct PathVertex {
+  int depth = 0;
+  int face = -1;
+  ShadingPoint sp;
+  SurfaceMaterial surface;
+  BsdfParams sampling;  // the sampling material's parameters (detached sampling).
+  double offset = 0.0;  // ray offset at p.
+  bool lit = false;     // light reaching this vertex directly counts.
+};
+struct PathState {
+  Eigen::Vector3d radiance = Eigen::Vector3d::Zero();
+  Eigen::Vector3d throughput = Eigen::Vector3d::Ones();
+  PathDerivatives* path = nullptr;
+  RenderStats* stats = nullptr;
+};
+
+// Adds throughput ⊙ f ⊙ (q·c) to the radiance (and its derivatives).
+void Contribute(const PathVertex& v, const Eigen::Vector3d& wi, const Eigen::Vector3d& f,
+                const LightTerm& light, int light_index, PathState* state) {
+  state->radiance += state->throughput.cwiseProduct(f).cwiseProduct(light.q) * light.c;
+  if (state->path) {
+    state->path->AddContribution(state->throughput, v.surface, v.sp.n, v.sp.wo, wi, f, light,
+                                 light_index);
+  }
+}
+
+void AddPointLights(const Context& ctx, const PathVertex& v, PathState* state) {
+  for (const PointLight& light : ctx.view.point_lights) {
+    PointLightSample ls;
+    if (!SamplePointLightVisible(ctx, light, v.face, v.sp.p, v.sp.n, v.sp.wo, v.surface.params,
+                                 v.offset, ctx.options.effects.shadows,
+                                 /*skip_black=*/state->path == nullptr, state->stats, &ls)) {
+      continue;
+    }
+    Contribute(v, ls.wi, ls.f, PointLightTerm(ls, light, v.sp.n, state->path != nullptr),
+               light.light_index, state);
+  }
+}
+
+// Light-sampled environment term (MIS against BSDF sampling when shadows are on).
+void AddEnvironmentLight(const Context& ctx, const PathVertex& v, Sampler* sampler,
+                         PathState* state) {
+  Eigen::Vector3d wi, le;
+  double pdf_light = 0.0;
+  double u1, u2;
+  sampler->Next2D(&u1, &u2);
+  if (!ctx.environment->Sample(u1, u2, &wi, &le, &pdf_light)) return;
+  const Eigen::Vector3d& n = v.sp.n;
+  const double cos_i = n.dot(wi);
+  if (!(cos_i > 0.0)) return;
+  const Eigen::Vector3d f = EvalBsdf(v.surface.params, n, v.sp.wo, wi);
+  bool visible = !f.isZero() || state->path != nullptr;
+  if (visible && ctx.options.effects.shadows) {
+    ++state->stats->shadow_rays;
+    visible = !ctx.scene.Occluded(v.sp.p, wi, v.offset, kInfinity);
+  }
+  if (!visible) return;
+  // Without shadows the BSDF-sampled rays cannot tell whether the light is seen, so the
+  // environment is lit by light sampling alone (weight 1).
+  const double weight = ctx.options.effects.shadows
+                            ? PowerHeuristic(pdf_light, BsdfPdf(v.sampling, n, v.sp.wo, wi))
+                            : 1.0;
+  LightTerm term;
+  term.q = le * (ctx.view.environment_scale * weight / pdf_light);
+  term.c = cos_i;
+  term.dc_dn = wi;
+  Contribute(v, wi, f, term, ctx.view.environment_light_index, state);
+}
+
+// Samples the BSDF at v: adds the environment seen along the sample (MIS) and, when the path
+// continues, advances *dir and *hit and the throughput. False when the path ends.
+bool Scatter(const Context& ctx, const PathVertex& v, Sampler* sampler, PathState* state,
+             Eigen::Vector3d* dir, RayHit* hit) {
+  const bool detached = &ctx.sampling_material != &ctx.material;
+  const bool continue_path = v.depth + 1 < ctx.max_segments;
+  const bool bsdf_lights_environment =
+      ctx.environment != nullptr && v.lit && ctx.options.effects.shadows;
+  if (!continue_path && !bsdf_lights_environment) return false;
+  const Eigen::Vector3d& n = v.sp.n;
+  const Eigen::Vector3d& wo = v.sp.wo;
+  BsdfSample sample;
+  Eigen::Vector3d u;
+  u.x() = sampler->Next1D();  // lobe choice
+  sampler->Next2D(&u.y(), &u.z());
+  if (!SampleBsdf(v.sampling, n, wo, u, &sample)) return false;
+  const Eigen::Vector3d wi = sample.wi;
+  const Eigen::Vector3d f = detached ? EvalBsdf(v.surface.params, n, wo, wi) : sample.f;
+  const double cos_over_pdf = n.dot(wi) / sample.pdf;
+  if (!std::isfinite(cos_over_pdf)) return false;
+  const Eigen::Vector3d p_off = v.sp.p + v.offset * n;
+  const RayHit next = ctx.scene.Intersect(p_off, wi, 0.0, kInfinity);
+  ++state->stats->bounce_rays;
+  if (!next.hit) {
+    if (bsdf_lights_environment) {
+      const double weight = PowerHeuristic(sample.pdf, ctx.environment->Pdf(wi));
+      LightTerm term;
+      term.q = ctx.environment->Radiance(wi) * (ctx.view.environment_scale * weight / sample.pdf);
+      term.c = n.dot(wi);
+      term.dc_dn = wi;
+      Contribute(v, wi, f, term, ctx.view.environment_light_index, state);
+    }
+    return false;
+  }
+  if (!continue_path) return false;
+  const Eigen::Vector3d scatter = f * cos_over_pdf;
+  if (state->path) state->path->AddScatter(state->throughput, v.surface, n, wo, wi, f, sample.pdf);
+  state->throughput = state->throughput.cwiseProduct(scatter);
+  *dir = wi;
+  *hit = next;
+  return true;
+}
+
+// The environment seen by a camera ray that misses the mesh (zero unless it is the background).
+Eigen::Vector3d Background(const Context& ctx, const Eigen::Vector3d& dir, PathDerivatives* path) {
+  if (ctx.environment == nullptr || !ctx.view.environment_background) {
+    return Eigen::Vector3d::Zero();
+  }
+  const Eigen::Vector3d radiance = ctx.view.environment_scale * ctx.environment->Radiance(dir);
+  if (path != nullptr && ctx.request->params.lights && ctx.view.environment_light_index >= 0) {
+    path->Add(ctx.layout->LightOffset() + ctx.view.environment_light_index, radiance);
+  }
+  return radiance;
+}
+
+}  // namespace
+
+double PowerHeuristic(double pdf_a, double pdf_b) {
+  const double a2 = pdf_a * pdf_a;
+  const double b2 = pdf_b * pdf_b;
+  if (!(a2 + b2 > 0.0) || !std::isfinite(a2 + b2)) return pdf_a >= pdf_b ? 1.0 : 0.0;
+  return a2 / (a2 + b2);
+}
+
+SurfaceMaterial LookUpMaterial(const Context& ctx, const Material& material, int face, double u,
+                               double v) {
+  SurfaceMaterial m;
+  m.albedo_texel = material.albedo.TexelIndex(face, u, v);
+  m.roughness_texel = material.roughness.TexelIndex(face, u, v);
+  const double* albedo = material.albedo.texel(m.albedo_texel);
+  m.params.albedo = Eigen::Vector3d(albedo[0], albedo[1], albedo[2]);
+  m.params.roughness = *material.roughness.texel(m.roughness_texel);
+  m.params.specular = material.specular * ctx.specular_scale;
+  m.params.fresnel = material.fresnel;
+  return m;
+}
+
+bool SamplePointLightVisible(const Context& ctx, const PointLight& light, int face,
+                             const Eigen::Vector3d& p, const Eigen::Vector3d& n,
+                             const Eigen::Vector3d& wo, const BsdfParams& params, double offset,
+                             bool shadows, bool skip_black, RenderStats* stats,
+                             PointLightSample* sample) {
+  const Eigen::Vector3d to_light = light.position - p;
+  const double dist2 = to_light.squaredNorm();
+  const double min_dist = kMinRelativeLightDistance * SurfaceScale(ctx.scene, face, p);
+  if (!(dist2 > min_dist * min_dist)) return false;
+  sample->dist = std::sqrt(dist2);
+  sample->wi = to_light / sample->dist;
+  sample->cos_i = n.dot(sample->wi);
+  if (sample->cos_i <= 0.0) return false;
+  sample->f = EvalBsdf(params, n, wo, sample->wi);
+  if (skip_black && sample->f.isZero()) return false;
+  if (!shadows) return true;
+  ++stats->shadow_rays;
+  return !ctx.scene.Occluded(p, sample->wi, offset, sample->dist - offset);
+}
+
+bool DirectAtReceiver(const Context& ctx, const PointLight& light, const Eigen::Vector3d& origin,
+                      const Eigen::Vector3d& dir, double t_near, int receiver, RenderStats* stats,
+                      Eigen::Vector3d* radiance) {
+  const RayHit hit = ctx.scene.Intersect(origin, dir, t_near, kInfinity);
+  ++stats->bounce_rays;
+  if (!hit.hit || hit.face != receiver) return false;
+  radiance->setZero();
+  ShadingPoint sp;
+  Shade(ctx, dir, hit, &sp);  // a degenerate face has n = 0: the light sample fails below.
+  const BsdfParams params = LookUpMaterial(ctx, ctx.material, hit.face, hit.u, hit.v).params;
+  PointLightSample ls;
+  if (!SamplePointLightVisible(ctx, light, hit.face, sp.p, sp.n, sp.wo, params,
+                               RayOffset(ctx, hit.face, sp.p), /*shadows=*/true,
+                               /*skip_black=*/false, stats, &ls)) {
+    return true;
+  }
+  const LightTerm term = PointLightTerm(ls, light, sp.n, /*derivatives=*/false);
+  *radiance = ls.f.cwiseProduct(term.q) * term.c;
+  return true;
+}
+
+Eigen::Vector3d TraceRadiance(const Context& ctx, Sampler* sampler, Eigen::Vector3d dir, RayHit hit,
+                              RenderStats* stats, PathDerivatives* path, int first_depth) {
+  if (!hit.hit) return Background(ctx, dir, path);
+  const bool detached = &ctx.sampling_material != &ctx.material;
+  PathState state;
+  state.path = path;
+  state.stats = stats;
+  for (int depth = first_depth;; ++depth) {
+    PathVertex v;
+    v.depth = depth;
+    v.face = hit.face;
+    if (!Shade(ctx, dir, hit, &v.sp)) break;  // degenerate triangle: nothing reflected.
+    if (path) {
+      path->SetVertex(hit.face, Eigen::Vector3d(1.0 - hit.u - hit.v, hit.u, hit.v), dir, v.sp.sign,
+                      !ctx.view.point_lights.empty() || ctx.secondary != nullptr);
+    }
+    v.surface = LookUpMaterial(ctx, ctx.material, hit.face, hit.u, hit.v);
+    v.sampling = detached
+                     ? LookUpMaterial(ctx, ctx.sampling_material, hit.face, hit.u, hit.v).params
+                     : v.surface.params;
+    v.offset = RayOffset(ctx, hit.face, v.sp.p);
+    v.lit = depth > 0 || ctx.options.effects.direct;
+    if (v.lit) {
+      AddPointLights(ctx, v, &state);
+      if (ctx.environment != nullptr) AddEnvironmentLight(ctx, v, sampler, &state);
+    }
+    if (path != nullptr && ctx.secondary != nullptr) {
+      AddSecondaryEdgeSamples(ctx, *sampler, depth, hit.face, state.throughput, v.sp.p, v.sp.n,
+                              v.sp.wo, v.surface.params, path, stats);
+    }
+    if (!Scatter(ctx, v, sampler, &state, &dir, &hit)) break;
+  }
+  return state.radiance;
+}
+
+Eigen::Vector3d TraceAuxiliary(const Context& ctx, const Eigen::Vector3d& dir, const RayHit& hit) {
+  if (!hit.hit) return Eigen::Vector3d::Zero();
+  const BsdfParams params = LookUpMaterial(ctx, ctx.material, hit.face, hit.u, hit.v).params;
+  switch (ctx.options.pass) {
+    case RenderPass::kAlbedo:
+      return params.albedo;
+    case RenderPass::kRoughness:
+      return Eigen::Vector3d::Constant(params.roughness);
+    case RenderPass::kNormal: {
+      Eigen::Vector3d n = ctx.scene.FaceNormal(hit.face);
+      if (n.dot(dir) > 0.0) n = -n;
+      return n;
+    }
+    case RenderPass::kDepth: {
+      const Eigen::Vector3d p = ctx.scene.Point(hit.face, hit.u, hit.v);
+      return Eigen::Vector3d::Constant((ctx.view.cam_from_world * p).z());
+    }
+    case RenderPass::kColor:
+      break;
+  }
+  return Eigen::Vector3d::Zero();
+}
+
+}  // namespace render_internal
+}  // namespace sft

@@ -1,0 +1,122 @@
+#include "src/render/internal/path_derivatives.h"
+
+namespace sft {
+namespace render_internal {
+
+void PathDerivatives::SetVertex(int face, const Eigen::Vector3d& barycentrics,
+                                const Eigen::Vector3d& dir, double sign, bool track_point) {
+  if (!vertices_) return;
+  const Eigen::Vector3i& corners = ctx_.scene.faces()[face];
+  const auto& p = ctx_.scene.positions();
+  corners_ = corners;
+  normal_ = NormalChain(p[corners[0]], p[corners[1]], p[corners[2]], sign);
+  if (track_point) point_.Advance(count_ == 0, dir, normal_.unit_normal(), barycentrics, corners);
+}
+
+void PathDerivatives::AddContribution(const Eigen::Vector3d& prefix, const SurfaceMaterial& surface,
+                                      const Eigen::Vector3d& n, const Eigen::Vector3d& wo,
+                                      const Eigen::Vector3d& wi, const Eigen::Vector3d& f,
+                                      const LightTerm& light, int light_index) {
+  const Eigen::Vector3d q = light.q * light.c;
+  const Eigen::Vector3d contribution = prefix.cwiseProduct(f).cwiseProduct(q);
+  const bool material = ctx_.request->params.albedo || ctx_.request->params.roughness ||
+                        ctx_.request->params.specular;
+  const Eigen::Vector3d f_q = f.cwiseProduct(q);
+  if (material) {
+    AddMaterial(surface, EvalBsdfDerivatives(surface.params, n, wo, wi, ctx_.specular_scale),
+                prefix.cwiseProduct(q));
+    for (int j = 0; j < count_; ++j) {
+      AddMaterial(scatters_[j].surface, scatters_[j].d_s, excluded_[j].cwiseProduct(f_q));
+    }
+  }
+  if (ctx_.request->params.lights && light_index >= 0) {
+    Add(ctx_.layout->LightOffset() + light_index, contribution);
+  }
+  if (!vertices_) return;
+  // ∂(f ⊙ q·c) = (f ⊙ q)·∂c + c·q·∂g, g the glossy term (the diffuse term is constant).
+  Eigen::Vector3d dg_dn, dg_dwi;
+  EvalGlossyWithGradient(surface.params, n, wo, wi, &dg_dn, &dg_dwi);
+  const Eigen::Vector3d base = prefix.cwiseProduct(light.q);
+  const Eigen::Vector3d base_f = base.cwiseProduct(f);
+  const Eigen::Matrix3d d_n = base_f * light.dc_dn.transpose() + light.c * base * dg_dn.transpose();
+  AddFace(corners_, normal_.Map(d_n));
+  if (light.follows_point && point_.valid) {
+    const Eigen::Matrix3d d_x =
+        base_f * light.dc_dx.transpose() + light.c * base * (dg_dwi.transpose() * light.dwi_dx);
+    for (int e = 0; e < point_.count; ++e) {
+      const Eigen::Matrix3d g = d_x * point_.m[e];
+      for (int k = 0; k < 3; ++k) Emit(3 * point_.vertex[e] + k, g.col(k));
+    }
+  }
+  for (int j = 0; j < count_; ++j) {
+    const Eigen::Vector3d w = excluded_[j].cwiseProduct(f_q);
+    AddFace(scatters_[j].corners, w.asDiagonal() * scatters_[j].ds_dcorners);
+  }
+}
+
+void PathDerivatives::AddBoundary(const Eigen::Vector3d& weight, const int* vertices,
+                                  const Eigen::Vector3d* rows, int count,
+                                  const Eigen::Vector3d& x_row) {
+  if (!vertices_) return;
+  if (!weight.allFinite()) {
+    Add(count > 0 ? 3 * vertices[0] : 0, weight);  // marks the path not finite.
+    return;
+  }
+  for (int j = 0; j < count; ++j) {
+    for (int k = 0; k < 3; ++k) Emit(3 * vertices[j] + k, weight * rows[j][k]);
+  }
+  if (!point_.valid) return;
+  for (int e = 0; e < point_.count; ++e) {
+    const Eigen::RowVector3d g = x_row.transpose() * point_.m[e];
+    for (int k = 0; k < 3; ++k) Emit(3 * point_.vertex[e] + k, weight * g[k]);
+  }
+}
+
+void PathDerivatives::AddScatter(const Eigen::Vector3d& prefix, const SurfaceMaterial& surface,
+                                 const Eigen::Vector3d& n, const Eigen::Vector3d& wo,
+                                 const Eigen::Vector3d& wi, const Eigen::Vector3d& f, double pdf) {
+  CHECK_LT(count_, kMaxScatters);
+  const double cos_over_pdf = n.dot(wi) / pdf;
+  const Eigen::Vector3d s = f * cos_over_pdf;
+  for (int j = 0; j < count_; ++j) excluded_[j] = excluded_[j].cwiseProduct(s);
+  excluded_[count_] = prefix;
+  Scatter& scatter = scatters_[count_];
+  scatter.surface = surface;
+  scatter.d_s = EvalBsdfDerivatives(surface.params, n, wo, wi, ctx_.specular_scale);
+  scatter.d_s.d_albedo *= cos_over_pdf;
+  scatter.d_s.d_roughness *= cos_over_pdf;
+  scatter.d_s.d_specular *= cos_over_pdf;
+  if (vertices_) {
+    // ∂s/∂n = (f·wiᵀ + (n·wi)·1·∂g/∂nᵀ)/pdf.
+    Eigen::Vector3d dg_dn, dg_dwi;
+    EvalGlossyWithGradient(surface.params, n, wo, wi, &dg_dn, &dg_dwi);
+    const Eigen::Matrix3d ds_dn =
+        (f * wi.transpose() + n.dot(wi) * Eigen::Vector3d::Ones() * dg_dn.transpose()) / pdf;
+    scatter.corners = corners_;
+    scatter.ds_dcorners = normal_.Map(ds_dn);
+  }
+  ++count_;
+}
+
+void PathDerivatives::AddMaterial(const SurfaceMaterial& surface, const BsdfDerivatives& d,
+                                  const Eigen::Vector3d& base) {
+  const ParameterSelection& sel = ctx_.request->params;
+  const ParameterLayout& layout = *ctx_.layout;
+  if (sel.albedo && d.d_albedo != 0.0) {
+    const int first = layout.AlbedoOffset() + 3 * surface.albedo_texel;
+    for (int c = 0; c < 3; ++c) {
+      Eigen::Vector3d v = Eigen::Vector3d::Zero();
+      v[c] = base[c] * d.d_albedo;
+      Add(first + c, v);
+    }
+  }
+  if (sel.roughness && d.d_roughness != 0.0) {
+    Add(layout.RoughnessOffset() + surface.roughness_texel, base * d.d_roughness);
+  }
+  if (sel.specular && d.d_specular != 0.0) {
+    Add(layout.SpecularIndex(), base * d.d_specular);
+  }
+}
+
+}  // namespace render_internal
+}  // namespace sft

@@ -1,0 +1,218 @@
+// Internal to src/render: the per-path bookkeeping of parameter derivatives (DESIGN.md §2.3,
+// the "interior" terms of derivatives.h) and the per-pixel accumulator that sums them.
+#ifndef SFT_RENDER_INTERNAL_PATH_DERIVATIVES_H_
+#define SFT_RENDER_INTERNAL_PATH_DERIVATIVES_H_
+
+#include <glog/logging.h>
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+#include "src/render/bsdf.h"
+#include "src/render/derivatives.h"
+#include "src/render/geometry_derivatives.h"
+#include "src/render/internal/context.h"
+
+namespace sft {
+namespace render_internal {
+
+// (parameter, ∂RGB) pairs, in arrival order (edge terms of one pixel).
+using DerivativeList = std::vector<std::pair<int, Eigen::Vector3d>>;
+
+// One pixel's derivatives, summed per parameter as they arrive: an open-addressing hash table
+// (linear probing, load ≤ 1/2) over the parameters touched so far. A pixel's paths touch the same
+// few faces and texels over and over (every contribution re-emits the corners of the faces behind
+// it), so summing on arrival keeps the work per entry O(1) and sorts only the distinct parameters.
+class RowAccumulator {
+ public:
+  RowAccumulator() { Resize(64); }
+
+  void Add(int param, const Eigen::Vector3d& d) {
+    uint32_t slot = Hash(param) & mask_;
+    while (true) {
+      const int key = keys_[slot];
+      if (key == param) {
+        values_[slot] += d;
+        return;
+      }
+      if (key < 0) break;
+      slot = (slot + 1) & mask_;
+    }
+    keys_[slot] = param;
+    values_[slot] = d;
+    used_.push_back(slot);
+    if (2 * used_.size() > keys_.size()) Grow();
+  }
+
+  // Writes the sums times `scale`, sorted by parameter, and empties the table. A sum that is not
+  // finite or whose product with `scale` overflows float is dropped and counted in
+  // *dropped.
+  void Flush(double scale, std::vector<JacobianEntry>* merged, int64_t* dropped) {
+    merged->clear();
+    std::sort(used_.begin(), used_.end(),
+              [this](uint32_t a, uint32_t b) { return keys_[a] < keys_[b]; });
+    for (const uint32_t slot : used_) {
+      const Eigen::Vector3d& sum = values_[slot];
+      const JacobianEntry entry{
+          keys_[slot],
+          {static_cast<float>(sum[0] * scale), static_cast<float>(sum[1] * scale),
+           static_cast<float>(sum[2] * scale)}};
+      if (std::isfinite(entry.d[0]) && std::isfinite(entry.d[1]) && std::isfinite(entry.d[2])) {
+        merged->push_back(entry);
+      } else {
+        ++*dropped;
+      }
+      keys_[slot] = -1;
+    }
+    used_.clear();
+  }
+
+ private:
+  static uint32_t Hash(int param) { return static_cast<uint32_t>(param) * 2654435761u; }
+
+  void Resize(size_t capacity) {
+    keys_.assign(capacity, -1);
+    values_.resize(capacity);
+    mask_ = static_cast<uint32_t>(capacity - 1);
+  }
+
+  void Grow() {
+    std::vector<std::pair<int, Eigen::Vector3d>> entries;
+    entries.reserve(used_.size());
+    for (const uint32_t slot : used_) entries.emplace_back(keys_[slot], values_[slot]);
+    used_.clear();
+    Resize(2 * keys_.size());
+    for (const auto& [param, d] : entries) Add(param, d);
+  }
+
+  std::vector<int> keys_;  // −1: empty.
+  std::vector<Eigen::Vector3d> values_;
+  std::vector<uint32_t> used_;  // occupied slots, in insertion order.
+  uint32_t mask_ = 0;
+};
+
+// The light term Q of a contribution, split as Q = q·c with c the part that depends on the
+// geometry of the shading point: point light q = I, c = (n·wi)/d² (wi and d follow the point x);
+// environment (light- or BSDF-sampled, direction fixed) q = L·scale·w_MIS/pdf, c = n·wi.
+struct LightTerm {
+  Eigen::Vector3d q;
+  double c = 0.0;
+  Eigen::Vector3d dc_dn = Eigen::Vector3d::Zero();
+  bool follows_point = false;                        // point light: the next three are set.
+  Eigen::Vector3d dc_dx = Eigen::Vector3d::Zero();   // ∂c/∂x = (3(n·wi)wi − n)/d³.
+  Eigen::Matrix3d dwi_dx = Eigen::Matrix3d::Zero();  // ∂wi/∂x = −(I − wi wiᵀ)/d.
+};
+
+// Bookkeeping of one path's derivatives. A path's light contributions have the form
+//   C = (s_0 ⊙ … ⊙ s_{i−1}) ⊙ f_i(wo_i, wi) ⊙ Q,
+// with s_k = f_k(wo_k, wi_k)·|n·wi_k|/pdf_k the scatter factor of vertex k (pdf detached) and Q
+// the light term. ∂C/∂θ for a parameter of vertex j < i replaces s_j by ∂s_j/∂θ; for vertex i it
+// replaces f_i by ∂f_i/∂θ. `excluded_[j]` keeps Π_{k<i, k≠j} s_k so that no division by a
+// possibly zero factor is needed.
+//
+// Vertex coordinates enter (directions detached, so wo and sampled wi stay fixed) through the
+// normal n_k of every vertex's face — s_k, f_i and c depend on it — and, for point lights,
+// through the position x_i (wi = (L − x_i)/d, c), which moves with the faces hit before
+// (PointJacobian). Texel lookups are piecewise constant and contribute nothing.
+class PathDerivatives {
+ public:
+  explicit PathDerivatives(const Context& ctx)
+      : ctx_(ctx), vertices_(ctx.request->params.vertices) {}
+
+  // Starts a new path (camera sample) whose derivatives go to `out` once committed. (One object
+  // serves many paths: its per-scatter storage is large and needs no initialization.)
+  void Reset(RowAccumulator* out) {
+    out_ = out;
+    pending_.clear();
+    count_ = 0;
+    point_.count = 0;
+    point_.valid = true;
+  }
+
+  // Adds one derivative term of the path: ∂(path's radiance)/∂(parameter `param`).
+  void Add(int param, const Eigen::Vector3d& d) { pending_.emplace_back(param, d); }
+
+  // Whether every term added since Reset is finite.
+  bool Finite() const {
+    for (const auto& term : pending_) {
+      if (!term.second.allFinite()) return false;
+    }
+    return true;
+  }
+  // Adds the path's terms to the accumulator, in the order they were added (so the sums are
+  // the same as if they had been added directly).
+  void Commit() {
+    for (const auto& [param, d] : pending_) out_->Add(param, d);
+    pending_.clear();
+  }
+
+  // The path reached a new vertex on face `face` (hit barycentrics `barycentrics`, ray direction
+  // `dir`), shaded with normal sign·n̂. `track_point`: keep x's Jacobian (point lights exist).
+  void SetVertex(int face, const Eigen::Vector3d& barycentrics, const Eigen::Vector3d& dir,
+                 double sign, bool track_point);
+
+  // A light contribution f ⊙ (q·c) at the current vertex (index = number of scatters so far),
+  // with shading normal n and directions wo, wi.
+  void AddContribution(const Eigen::Vector3d& prefix, const SurfaceMaterial& surface,
+                       const Eigen::Vector3d& n, const Eigen::Vector3d& wo,
+                       const Eigen::Vector3d& wi, const Eigen::Vector3d& f, const LightTerm& light,
+                       int light_index);
+
+  // A boundary (edge) term at the current vertex: Σ_j weight·(rows_j·∂y/∂p_{vertices_j}) for
+  // the vertices that move the curve point, plus weight·(x_row·∂x/∂θ) for the motion of the
+  // vertex itself (chained to the faces hit before; left out when that chain is undefined after
+  // a grazing hit). Non-finite values are added as such (the sample is then dropped).
+  void AddBoundary(const Eigen::Vector3d& weight, const int* vertices, const Eigen::Vector3d* rows,
+                   int count, const Eigen::Vector3d& x_row);
+
+  // The path continues from the current vertex with scatter factor s = f·(n·wi)/pdf.
+  void AddScatter(const Eigen::Vector3d& prefix, const SurfaceMaterial& surface,
+                  const Eigen::Vector3d& n, const Eigen::Vector3d& wo, const Eigen::Vector3d& wi,
+                  const Eigen::Vector3d& f, double pdf);
+
+ private:
+  struct Scatter {
+    SurfaceMaterial surface;
+    BsdfDerivatives d_s;
+    Eigen::Vector3i corners;
+    Eigen::Matrix<double, 3, 9> ds_dcorners;  // ∂s/∂(corner coordinates), rows = channels.
+  };
+
+  void Emit(int param, const Eigen::Vector3d& d) {
+    if (d[0] != 0.0 || d[1] != 0.0 || d[2] != 0.0) Add(param, d);
+  }
+  void AddFace(const Eigen::Vector3i& corners, const Eigen::Matrix<double, 3, 9>& g) {
+    for (int j = 0; j < 3; ++j) {
+      for (int k = 0; k < 3; ++k) Emit(3 * corners[j] + k, g.col(3 * j + k));
+    }
+  }
+
+  // Adds base ⊙ ∂(factor)/∂θ for the material parameters of `surface`, where ∂factor/∂θ is
+  // described by `d` (albedo: own channel only; roughness and specular: all channels).
+  void AddMaterial(const SurfaceMaterial& surface, const BsdfDerivatives& d,
+                   const Eigen::Vector3d& base);
+
+  // A path scatters at most bounces − 1 ≤ 15 times (RenderOptions::Check caps bounces at 16).
+  static constexpr int kMaxScatters = 16;
+  const Context& ctx_;
+  RowAccumulator* out_ = nullptr;
+  DerivativeList pending_;  // the current path's terms, until Commit.
+  const bool vertices_;
+  int count_ = 0;
+  Scatter scatters_[kMaxScatters];
+  std::array<Eigen::Vector3d, kMaxScatters> excluded_;
+  // The current vertex's face and normal chain, and its position's Jacobian.
+  Eigen::Vector3i corners_ = Eigen::Vector3i::Zero();
+  NormalChain normal_;
+  PointJacobian point_;
+};
+
+}  // namespace render_internal
+}  // namespace sft
+
+#endif  // SFT_RENDER_INTERNAL_PATH_DERIVATIVES_H_

@@ -1,0 +1,367 @@
+#include "src/render/internal/secondary_edges.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "src/render/bsdf.h"
+#include "src/render/internal/integrator.h"
+#include "src/render/internal/path_derivatives.h"
+#include "src/render/internal/shadow_edges.h"
+
+namespace sft {
+namespace render_internal {
+namespace {
+
+// Directions closer than this (relative to extent/r) to a curve on the sphere are its sides.
+constexpr double kSecondarySideOffset = 1e-5;
+constexpr uint64_t kSecondaryEdgeKey = 0x5EC0DE0000000000ull;
+// (Edge, point) pairs drawn per secondary sample before one is kept (resampled importance
+// sampling); see docs/design-notes.md for the measured choice.
+constexpr int kSecondaryCandidates = 16;
+// Probability that a secondary sample also samples a texel boundary (C) (weighted by its
+// inverse): (C) traces two paths where it is seen, and the indirect light's texel jumps are
+// usually a small part of the derivative (docs/design-notes.md).
+constexpr double kSecondaryTexelProbability = 0.25;
+
+// Texel boundaries with a positive weight (3D length × material jump), and the weights.
+void AddSecondaryTexels(const RenderScene& scene, const Material& material, bool glossy,
+                        SecondaryEdges* out) {
+  std::vector<double> weights;
+  for (const TexelSegment& segment : TexelSegments(scene, material, glossy)) {
+    const Eigen::Vector3i& corners = scene.faces()[segment.face];
+    Eigen::Vector3d along = Eigen::Vector3d::Zero();
+    for (int k = 0; k < 3; ++k) {
+      along += (segment.b1[k] - segment.b0[k]) * scene.positions()[corners[k]];
+    }
+    const double weight = along.norm() * segment.size;
+    if (!(weight > 0.0) || !std::isfinite(weight)) continue;
+    out->texels.push_back(segment);
+    weights.push_back(weight);
+  }
+  if (!out->texels.empty()) out->texels_by_weight = DiscreteDistribution(weights);
+}
+
+// Mesh edges that can be a silhouette or crease from some viewpoint, ∝ length.
+void AddSecondaryMeshEdges(const RenderScene& scene, SecondaryEdges* out) {
+  std::vector<double> lengths;
+  for (size_t e = 0; e < scene.edges().size(); ++e) {
+    const MeshEdge& edge = scene.edges()[e];
+    const double length = (scene.positions()[edge.v1] - scene.positions()[edge.v0]).norm();
+    if (!(length > 0.0) || !std::isfinite(length)) continue;
+    if (edge.num_faces == 2) {
+      Eigen::Vector3d n0, n1;
+      ConsistentEdgeNormals(scene, edge, &n0, &n1);
+      // Coplanar neighbours (consistently oriented): never a silhouette nor a crease.
+      if (!n0.isZero() && !n1.isZero() && n0.dot(n1) > 1.0 - 1e-12) continue;
+    }
+    out->edges.push_back(static_cast<int>(e));
+    lengths.push_back(length);
+  }
+  if (!out->edges.empty()) out->by_length = DiscreteDistribution(lengths);
+}
+
+// A path vertex x where secondary edges are sampled, and what its samples share.
+struct SecondaryVertex {
+  const Context& ctx;
+  int depth;
+  int face;
+  const Eigen::Vector3d& throughput;
+  const Eigen::Vector3d& x;
+  const Eigen::Vector3d& n;
+  const Eigen::Vector3d& wo;
+  const BsdfParams& params;
+  bool environment;    // the environment is lit at x with visibility.
+  bool indirect;       // a further bounce is traced from x.
+  double offset;       // ray offset at x.
+  double num_samples;  // expected samples per vertex (each weighted by its inverse).
+
+  // g(ω) = f·(n·ω)·L_in for the incoming radiance `l_in` along ω (0 below the horizon).
+  Eigen::Vector3d Integrand(const Eigen::Vector3d& omega, const Eigen::Vector3d& l_in) const {
+    const double cosine = n.dot(omega);
+    if (!(cosine > 0.0)) return Eigen::Vector3d::Zero().eval();
+    return (EvalBsdf(params, n, wo, omega).cwiseProduct(l_in) * cosine).eval();
+  }
+  // The resampling target: the BSDF·cosine towards ω.
+  double BsdfCosine(const Eigen::Vector3d& omega) const {
+    return Integrand(omega, Eigen::Vector3d::Ones()).sum();
+  }
+};
+
+// A point y of a curve on x's sphere of directions: ω = (y − x)/r, the curve's unit normal m
+// there and the side directions ω ∓ εm (index 0: −); speed = |dω/ds|.
+struct SphereCurvePoint {
+  Eigen::Vector3d omega, m, sides[2];
+  double r = 0.0, speed = 0.0;
+};
+
+// The two side directions ω ∓ εm of a curve point in direction ω (unit) at distance r from x,
+// and the curve's unit normal m given its tangent dω/ds (false when degenerate).
+bool SphereSides(const Eigen::Vector3d& omega, const Eigen::Vector3d& d_omega_ds, double r,
+                 double extent, Eigen::Vector3d* m, Eigen::Vector3d sides[2], double* speed) {
+  *speed = d_omega_ds.norm();
+  if (!(*speed > 0.0) || !std::isfinite(*speed)) return false;
+  *m = omega.cross(d_omega_ds / *speed);
+  const double eps = kSecondarySideOffset * extent / r;
+  if (!std::isfinite(eps)) return false;
+  sides[0] = (omega - eps * *m).normalized();
+  sides[1] = (omega + eps * *m).normalized();
+  return true;
+}
+
+// The curve point at to_y = y − x, whose motion dω/ds = `tangent`((I − ωωᵀ)/r) (the projection
+// of dy/ds onto the sphere). False when y is not above x's surface, too close, or degenerate.
+template <typename Tangent>
+bool SphereCurveAt(const SecondaryVertex& v, const Eigen::Vector3d& to_y, const Tangent& tangent,
+                   SphereCurvePoint* out) {
+  out->r = to_y.norm();
+  out->omega = to_y / out->r;
+  if (!(out->r > v.offset) || !(v.n.dot(out->omega) > 0.0)) return false;
+  const Eigen::Matrix3d tangent_projection =
+      (Eigen::Matrix3d::Identity() - out->omega * out->omega.transpose()) / out->r;
+  return SphereSides(out->omega, tangent(tangent_projection), out->r, v.ctx.scene.extent(), &out->m,
+                     out->sides, &out->speed);
+}
+
+// (A), (C): "two sides, two rays, two paths, jump". Traces the rays from x along both sides of
+// the curve point; when `accept`(hits) (the two sides see the curve's jump), *jump = g(ω⁻) −
+// g(ω⁺) with L_in the environment where a side misses (when lit) and the path continued with a
+// copy of `sampler` where it hits (when a further bounce is traced). False when rejected or the
+// jump is zero (a jump that is not finite is returned: it drops the path's sample).
+template <typename Accept>
+bool TwoSidedJump(const SecondaryVertex& v, const SphereCurvePoint& point, const Sampler& sampler,
+                  const Accept& accept, RenderStats* stats, Eigen::Vector3d* jump) {
+  const Context& ctx = v.ctx;
+  RayHit hits[2];
+  for (int k = 0; k < 2; ++k) {
+    hits[k] = ctx.scene.Intersect(v.x, point.sides[k], v.offset, kInfinity);
+  }
+  stats->bounce_rays += 2;
+  if (!accept(hits)) return false;
+  Eigen::Vector3d g[2];
+  for (int k = 0; k < 2; ++k) {
+    Eigen::Vector3d l_in = Eigen::Vector3d::Zero();
+    if (!hits[k].hit) {
+      if (v.environment) {
+        l_in = ctx.view.environment_scale * ctx.environment->Radiance(point.sides[k]);
+      }
+    } else if (v.indirect) {
+      Sampler copy = sampler;
+      l_in = TraceRadiance(ctx, &copy, point.sides[k], hits[k], stats, nullptr, v.depth + 1);
+    }
+    g[k] = v.Integrand(point.sides[k], l_in);
+  }
+  *jump = g[0] - g[1];
+  return !jump->isZero();
+}
+
+// (A) Silhouettes (and creases) of mesh edges seen from x. The (edge, point) pair is chosen by
+// resampled importance sampling (Talbot et al. 2005): kSecondaryCandidates pairs are drawn, the
+// edge ∝ length (pdf p_k) and the point uniformly in the angle Θ_k the edge subtends at x (not
+// uniformly in s: the sphere arc length |dω/ds| ds is then Θ_k·dξ, where uniform s would weight
+// points near x by 1/r — infinite variance for edges touching x's face). Each pair gets the
+// target p̂_k = Σ_rgb f·(n·ω_k) at its direction where the edge can be a jump seen from x
+// (silhouette or crease test) and 0 elsewhere, the weight w_k = p̂_k·Θ_k/p_k, and one is kept
+// ∝ w_k. The estimate g_jump·Θ/(p̂·Θ)·(1/K)Σ_k w_k is unbiased because p̂ > 0 wherever the
+// integrand g = f·(n·ω)·L can be non-zero. The BSDF factor in p̂ matters for glossy lobes:
+// without it, the few points that land in a narrow lobe carry heavy-tailed weights.
+void SampleMeshEdge(const SecondaryVertex& v, double u_index, double u_point, Sampler* sampler,
+                    PathDerivatives* path, RenderStats* stats) {
+  const SecondaryEdges& secondary = *v.ctx.secondary;
+  const RenderScene& scene = v.ctx.scene;
+  const auto& positions = scene.positions();
+  if (secondary.edges.empty()) return;
+  auto edge_ends = [&](int c, Eigen::Vector3d* a, Eigen::Vector3d* b) {
+    const MeshEdge& edge = scene.edges()[secondary.edges[c]];
+    if (edge.f0 == v.face || edge.f1 == v.face) return false;
+    *a = positions[edge.v0];
+    *b = positions[edge.v1];
+    if (!(std::max(v.n.dot(*a - v.x), v.n.dot(*b - v.x)) > 0.0)) return false;
+    return IsDiscontinuityEdge(scene, edge, v.x, /*creases=*/v.indirect);
+  };
+  const ResampledPoint kept = ResampleSegmentPoint(
+      secondary.by_length, kSecondaryCandidates, v.x, u_index, u_point, sampler, edge_ends,
+      [&](const Eigen::Vector3d& omega) { return v.BsdfCosine(omega); });
+  if (kept.index < 0) return;
+  const MeshEdge& edge = scene.edges()[secondary.edges[kept.index]];
+  const Eigen::Vector3d& a = positions[edge.v0];
+  const Eigen::Vector3d& b = positions[edge.v1];
+  const Eigen::Vector3d y = a + kept.s * (b - a);
+  SphereCurvePoint point;
+  if (!SphereCurveAt(
+          v, y - v.x, [&](const Eigen::Matrix3d& t) { return (t * (b - a)).eval(); }, &point)) {
+    return;
+  }
+  auto accept = [&](const RayHit hits[2]) {
+    const bool same = hits[0].hit == hits[1].hit && (!hits[0].hit || hits[0].face == hits[1].face);
+    return !same && (v.indirect || !hits[0].hit || !hits[1].hit);
+  };
+  Eigen::Vector3d jump;
+  if (!TwoSidedJump(v, point, *sampler, accept, stats, &jump)) return;
+  const double inv_pdf = kept.inv_pdf / v.num_samples;
+  const Eigen::Vector3d m_row = point.m / point.r;  // m·∂ω/∂y.
+  BoundaryRows rows;
+  AddEdgePointRows(scene, edge, kept.s, m_row, &rows);
+  path->AddBoundary(v.throughput.cwiseProduct(jump) * inv_pdf, rows.vertices, rows.rows, rows.count,
+                    -m_row);
+}
+
+// (C) Texel boundaries on the surfaces a further bounce sees: L_in jumps where the material of
+// the surface hit along ω does. Sampled like (A): kSecondaryCandidates (segment, point) pairs,
+// the segment ∝ 3D length × material jump, the point uniform in its subtended angle, one kept by
+// resampling with target f·(n·ω); the jump counts only where the two side rays see the
+// segment's faces (one each; both the same face for a grid line inside a face).
+void SampleTexelBoundary(const SecondaryVertex& v, Sampler* texel_sampler, PathDerivatives* path,
+                         RenderStats* stats) {
+  const SecondaryEdges& secondary = *v.ctx.secondary;
+  const RenderScene& scene = v.ctx.scene;
+  auto texel_ends = [&](int c, Eigen::Vector3d* y0, Eigen::Vector3d* y1) {
+    const TexelSegment& segment = secondary.texels[c];
+    if (segment.face == v.face || segment.other == v.face) return false;  // x's plane: cos = 0.
+    TexelSegmentEnds(scene, segment, y0, y1);
+    return std::max(v.n.dot(*y0 - v.x), v.n.dot(*y1 - v.x)) > 0.0;
+  };
+  const double u_index = texel_sampler->Next1D(), u_point = texel_sampler->Next1D();
+  const ResampledPoint kept = ResampleSegmentPoint(
+      secondary.texels_by_weight, kSecondaryCandidates, v.x, u_index, u_point, texel_sampler,
+      texel_ends, [&](const Eigen::Vector3d& omega) { return v.BsdfCosine(omega); });
+  if (kept.index < 0) return;
+  const TexelSegment& segment = secondary.texels[kept.index];
+  Eigen::Vector3d y0, y1;
+  TexelSegmentEnds(scene, segment, &y0, &y1);
+  SphereCurvePoint point;
+  if (!SphereCurveAt(
+          v, y0 + kept.s * (y1 - y0) - v.x,
+          [&](const Eigen::Matrix3d& t) { return (t * (y1 - y0)).eval(); }, &point)) {
+    return;
+  }
+  auto accept = [&](const RayHit hits[2]) {
+    return hits[0].hit && hits[1].hit &&
+           ((hits[0].face == segment.face && hits[1].face == segment.other) ||
+            (hits[0].face == segment.other && hits[1].face == segment.face));
+  };
+  Eigen::Vector3d jump;
+  if (!TwoSidedJump(v, point, *texel_sampler, accept, stats, &jump)) return;
+  const double inv_pdf = kept.inv_pdf / (v.num_samples * kSecondaryTexelProbability);
+  const Eigen::Vector3d m_row = point.m / point.r;  // m·∂ω/∂y; ∂y/∂p_k = b_k·I.
+  const Eigen::Vector3d b = segment.b0 + kept.s * (segment.b1 - segment.b0);
+  const Eigen::Vector3d c = segment.c0 + kept.s * (segment.c1 - segment.c0);
+  BoundaryRows rows;
+  AddTexelPointRows(scene, segment.face, segment.other, b, c, m_row, &rows);
+  path->AddBoundary(v.throughput.cwiseProduct(jump) * inv_pdf, rows.vertices, rows.rows, rows.count,
+                    -m_row);
+}
+
+// (B) Point-light shadow boundaries on the surfaces a further bounce sees: a light uniformly
+// (u_light), a shadow-casting edge ∝ its angle at the light (the rest of u_light's slot), the
+// edge point uniform in s = u_point.
+void SampleShadowBoundary(const SecondaryVertex& v, double u_light, double u_point,
+                          PathDerivatives* path, RenderStats* stats) {
+  const SecondaryEdges& secondary = *v.ctx.secondary;
+  const RenderScene& scene = v.ctx.scene;
+  const int num_lights = static_cast<int>(secondary.shadow_candidates.size());
+  const int l = std::min(static_cast<int>(u_light * num_lights), num_lights - 1);
+  const DiscreteDistribution& by_angle = secondary.shadow_by_angle[l];
+  if (by_angle.empty()) return;
+  const int c = by_angle.SampleInverse(u_light * num_lights - l);
+  const EdgeCandidate& candidate = secondary.shadow_candidates[l][c];
+  const MeshEdge& edge = scene.edges()[candidate.edge];
+  const PointLight& light = v.ctx.view.point_lights[l];
+  ShadowPoint shadow;
+  if (!CastShadowPoint(v.ctx, light.position, edge, u_point, stats, &shadow)) return;
+  if (shadow.receiver == v.face) return;
+  const Eigen::Vector3d edge_direction = scene.positions()[edge.v1] - scene.positions()[edge.v0];
+  SphereCurvePoint point;
+  if (!SphereCurveAt(
+          v, shadow.y - v.x,
+          [&](const Eigen::Matrix3d& t) {
+            return (t * shadow.d_y_d_point * edge_direction).eval();
+          },
+          &point)) {
+    return;
+  }
+  Eigen::Vector3d direct[2];
+  for (int k = 0; k < 2; ++k) {
+    if (!DirectAtReceiver(v.ctx, light, v.x, point.sides[k], v.offset, shadow.receiver, stats,
+                          &direct[k])) {
+      return;
+    }
+  }
+  const Eigen::Vector3d jump =
+      v.Integrand(point.sides[0], direct[0]) - v.Integrand(point.sides[1], direct[1]);
+  if (jump.isZero()) return;
+  const double inv_pdf = num_lights * by_angle.total() / candidate.weight / v.num_samples;
+  const Eigen::Vector3d m_row = point.m / point.r;
+  BoundaryRows rows;
+  ShadowPointRows(shadow, scene, edge, u_point, m_row, &rows);
+  path->AddBoundary(v.throughput.cwiseProduct(jump) * (point.speed * inv_pdf), rows.vertices,
+                    rows.rows, rows.count, -m_row);
+}
+
+}  // namespace
+
+SecondaryEdges BuildSecondaryEdges(const RenderScene& scene, const Material& material,
+                                   const ViewSetup& view, const RenderOptions& options,
+                                   bool environment, int max_segments) {
+  SecondaryEdges out;
+  if (max_segments > 1) {
+    AddSecondaryTexels(scene, material, options.effects.specular && material.specular > 0.0, &out);
+  }
+  out.environment = environment && options.effects.shadows;
+  AddSecondaryMeshEdges(scene, &out);
+  if (options.effects.shadows && max_segments > 1) {
+    for (const PointLight& light : view.point_lights) {
+      std::vector<EdgeCandidate> candidates = ShadowEdgeCandidates(scene, light.position);
+      std::vector<double> angles;
+      for (const EdgeCandidate& c : candidates) angles.push_back(c.weight);
+      out.shadow_candidates.push_back(std::move(candidates));
+      out.shadow_by_angle.emplace_back(angles);
+    }
+  }
+  return out;
+}
+
+void AddSecondaryEdgeSamples(const Context& ctx, const Sampler& path_sampler, int depth, int face,
+                             const Eigen::Vector3d& throughput, const Eigen::Vector3d& x,
+                             const Eigen::Vector3d& n, const Eigen::Vector3d& wo,
+                             const BsdfParams& params, PathDerivatives* path, RenderStats* stats) {
+  const SecondaryEdges& secondary = *ctx.secondary;
+  const bool lit_here = depth > 0 || ctx.options.effects.direct;
+  const SecondaryVertex v{ctx,
+                          depth,
+                          face,
+                          throughput,
+                          x,
+                          n,
+                          wo,
+                          params,
+                          secondary.environment && lit_here && ctx.environment != nullptr,
+                          depth + 1 < ctx.max_segments,
+                          RayOffset(ctx, face, x),
+                          ctx.request->secondary_edge_samples};
+  if (!v.environment && !v.indirect) return;
+  // secondary_edge_samples = r samples per vertex on average: ⌊r⌋, plus one more with
+  // probability r − ⌊r⌋, each weighted 1/r (unbiased: the expected count is r).
+  int count = static_cast<int>(v.num_samples);
+  if (count < v.num_samples &&
+      path_sampler.Fork(kSecondaryEdgeKey - 1).Next1D() < v.num_samples - count) {
+    ++count;
+  }
+  for (int i = 0; i < count; ++i) {
+    Sampler sampler = path_sampler.Fork(kSecondaryEdgeKey + 64 * static_cast<uint64_t>(depth) + i);
+    double u1, u2, u3, u4;
+    sampler.Next2D(&u1, &u2);
+    sampler.Next2D(&u3, &u4);
+    SampleMeshEdge(v, u1, u2, &sampler, path, stats);  // (A)
+    Sampler texel_sampler = sampler.Fork(1);
+    if (v.indirect && !secondary.texels.empty() &&
+        texel_sampler.Next1D() < kSecondaryTexelProbability) {
+      SampleTexelBoundary(v, &texel_sampler, path, stats);  // (C)
+    }
+    if (v.indirect && !secondary.shadow_candidates.empty()) {
+      SampleShadowBoundary(v, u3, u4, path, stats);  // (B)
+    }
+  }
+}
+
+}  // namespace render_internal
+}  // namespace sft

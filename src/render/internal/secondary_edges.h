@@ -1,0 +1,71 @@
+// Internal to src/render: secondary edges (Li et al. 2018 §5), the boundary terms of the
+// hemisphere integrals at path vertices.
+// Secondary edges (Li et al. 2018 §5). A path vertex x estimates the hemisphere integral
+//   H(x) = ∫ f(wo, ω)·(n·ω)·L_in(x, ω) dω,
+// and L_in jumps along curves on x's sphere of directions that move with the vertices:
+//   (A) the directions of mesh edges that are silhouettes seen from x (behind them: the
+//       environment, when it is lit with shadows, or a farther surface, when a further bounce
+//       is traced) and, when a further bounce is traced, creases (flat shading);
+//   (B) when a further bounce is traced with shadows, the directions of the shadow points that
+//       point lights' silhouette edges cast (the next vertex's direct term jumps there);
+//   (C) when a further bounce is traced, the directions of texel boundaries (TexelSegments) on
+//       the surfaces seen (the material, hence the radiance leaving them, jumps there).
+// Boundary term: ∂H/∂θ += ∫_curve (g(ω⁻) − g(ω⁺))·(m·∂ω/∂θ) dl, g = f·(n·ω)·L_in, m the unit
+// normal of the curve on the sphere and ω± = normalize(ω ± εm). For a curve point y seen from x,
+// ω = (y − x)/r and m·∂ω/∂θ = mᵀ(∂y/∂θ − ∂x/∂θ)/r; dl = |dω/ds| ds along the curve parameter s.
+// Estimator per sample: (A) an edge chosen by resampling among length-proportional candidates,
+// a point uniform in the angle it subtends at x (see the loop below); (B) a light uniformly, a
+// shadow-casting edge ∝ its angle at the light, s uniform; weight (g⁻ − g⁺)·(arc length)/pdf,
+// times the path throughput, credited to the path's pixel. Both sides trace with the same random
+// numbers. Other radiance leaving the next vertex is continuous along ω (its own hemisphere
+// integrals smooth out their jumps), so (A) and (B) are all the curves for flat-shaded, untextured
+// surfaces; (C) adds the texel boundaries of mesh-colors materials on the surfaces a further
+// bounce sees. (B)'s uniform s still weights receiver points close to x by 1/r.
+#ifndef SFT_RENDER_INTERNAL_SECONDARY_EDGES_H_
+#define SFT_RENDER_INTERNAL_SECONDARY_EDGES_H_
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "src/core/rng.h"
+#include "src/render/internal/context.h"
+#include "src/render/internal/edge_sampling.h"
+#include "src/render/internal/sampling.h"
+#include "src/render/internal/texel_edges.h"
+
+namespace sft {
+namespace render_internal {
+
+class PathDerivatives;
+
+// The candidates of one view's secondary edge samples.
+struct SecondaryEdges {
+  std::vector<int> edges;          // mesh edges where radiance can jump for some viewpoint.
+  DiscreteDistribution by_length;  // over `edges`, ∝ length.
+  bool environment = false;        // the environment is lit with visibility (shadows on).
+  // Texel boundaries (when a further bounce is traced and the material has any), and a
+  // distribution over them ∝ 3D length × material jump.
+  std::vector<TexelSegment> texels;
+  DiscreteDistribution texels_by_weight;
+  // Per point light of the view (when shadows and a further bounce exist): shadow-casting edges
+  // and a distribution over them ∝ angle at the light.
+  std::vector<std::vector<EdgeCandidate>> shadow_candidates;
+  std::vector<DiscreteDistribution> shadow_by_angle;
+};
+
+SecondaryEdges BuildSecondaryEdges(const RenderScene& scene, const Material& material,
+                                   const ViewSetup& view, const RenderOptions& options,
+                                   bool environment, int max_segments);
+
+// The secondary edge samples (request->secondary_edge_samples of them on average) at path vertex
+// x (segment depth + 1 of the path, face `face`, normal n facing wo, BSDF `params`, path
+// throughput up to x), added to the path's derivatives.
+void AddSecondaryEdgeSamples(const Context& ctx, const Sampler& path_sampler, int depth, int face,
+                             const Eigen::Vector3d& throughput, const Eigen::Vector3d& x,
+                             const Eigen::Vector3d& n, const Eigen::Vector3d& wo,
+                             const BsdfParams& params, PathDerivatives* path, RenderStats* stats);
+
+}  // namespace render_internal
+}  // namespace sft
+
+#endif  // SFT_RENDER_INTERNAL_SECONDARY_EDGES_H_

@@ -1,0 +1,132 @@
+#include "src/render/internal/shadow_edges.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "src/render/geometry_derivatives.h"
+#include "src/render/internal/integrator.h"
+
+namespace sft {
+namespace render_internal {
+namespace {
+
+// The jump across the shadow that point light `light` casts on face `receiver` seen directly
+// at image point q: only that light's direct term at the first vertex is discontinuous there
+// (the rest of the paths varies smoothly with the same random numbers), so the jump is
+// C(y⁻)V(y⁻) − C(y⁺)V(y⁺) with C the unshadowed direct term and V the shadow ray's visibility at
+// the receiver points y± seen through q ∓ εm. Zero when a side does not see the receiver (the
+// shadow boundary meets a primary edge there: a set of measure zero).
+Eigen::Vector3d ShadowJump(const EdgeView& view, const PointLight& light, int receiver,
+                           const Eigen::Vector2d& q, const Eigen::Vector2d& m, RenderStats* stats) {
+  const Context& ctx = view.ctx;
+  const Eigen::Vector3d& center = view.center;
+  Eigen::Vector3d dirs[2];
+  view.SideDirections(q, m, dirs);
+  Eigen::Vector3d direct[2];
+  for (int i = 0; i < 2; ++i) {
+    if (!DirectAtReceiver(ctx, light, center, dirs[i], 0.0, receiver, stats, &direct[i])) {
+      return Eigen::Vector3d::Zero();
+    }
+  }
+  return direct[0] - direct[1];
+}
+
+}  // namespace
+
+bool CastShadowPoint(const Context& ctx, const Eigen::Vector3d& light, const MeshEdge& edge,
+                     double s, RenderStats* stats, ShadowPoint* out) {
+  const RenderScene& scene = ctx.scene;
+  const Eigen::Vector3d& a = scene.positions()[edge.v0];
+  const Eigen::Vector3d& b = scene.positions()[edge.v1];
+  const Eigen::Vector3d point = a + s * (b - a);
+  const Eigen::Vector3d d = point - light;
+  const double dist = d.norm();
+  // The edge point lies on all of the edge's faces: the largest of their scales.
+  double scale = SurfaceScale(scene, edge.f0, point);
+  if (edge.f1 >= 0) scale = std::max(scale, SurfaceScale(scene, edge.f1, point));
+  if (!(dist > kMinRelativeLightDistance * scale)) return false;
+  const Eigen::Vector3d dir = d / dist;
+  const double offset = kRelativeRayOffset * scale;
+  // The light must reach the edge, and the ray grazing it must land on a receiver. A hit on the
+  // edge's own faces before the edge point is float noise of the grazing ray (a plane containing
+  // the point cannot be crossed on the way to it).
+  ++stats->shadow_rays;
+  const RayHit blocker = scene.Intersect(light, dir, 0.0, dist - offset);
+  if (blocker.hit && blocker.face != edge.f0 && blocker.face != edge.f1) return false;
+  ++stats->shadow_rays;
+  const RayHit hit = scene.Intersect(point, dir, offset, kInfinity);
+  if (!hit.hit || hit.face == edge.f0 || hit.face == edge.f1) return false;
+  const Eigen::Vector3d n_r = scene.FaceNormal(hit.face);
+  const double cosine = n_r.dot(dir);
+  if (!(std::abs(cosine) > kMinHitCosine)) return false;
+  out->receiver = hit.face;
+  out->y = scene.Point(hit.face, hit.u, hit.v);
+  out->barycentrics = Eigen::Vector3d(1.0 - hit.u - hit.v, hit.u, hit.v);
+  const double tau = (dist + hit.t) / dist;
+  out->along = dir * n_r.transpose() / cosine;
+  out->d_y_d_point = tau * (Eigen::Matrix3d::Identity() - out->along);
+  return true;
+}
+
+void ShadowPointRows(const ShadowPoint& shadow, const RenderScene& scene, const MeshEdge& edge,
+                     double s, const Eigen::Vector3d& row, BoundaryRows* out) {
+  const Eigen::Vector3d point_row = shadow.d_y_d_point.transpose() * row;
+  const Eigen::Vector3d receiver_row = shadow.along.transpose() * row;
+  const Eigen::Vector3i& corners = scene.faces()[shadow.receiver];
+  AddEdgePointRows(scene, edge, s, point_row, out);
+  for (int j = 0; j < 3; ++j) out->Add(corners[j], shadow.barycentrics[j] * receiver_row);
+}
+
+std::vector<EdgeCandidate> ShadowEdgeCandidates(const RenderScene& scene,
+                                                const Eigen::Vector3d& light) {
+  std::vector<EdgeCandidate> candidates;
+  const auto& positions = scene.positions();
+  const auto& edges = scene.edges();
+  for (size_t e = 0; e < edges.size(); ++e) {
+    const MeshEdge& edge = edges[e];
+    const Eigen::Vector3d a = positions[edge.v0] - light, b = positions[edge.v1] - light;
+    if (a == b || !IsDiscontinuityEdge(scene, edge, light, /*creases=*/false)) continue;
+    const double angle = std::atan2(a.cross(b).norm(), a.dot(b));
+    if (!(angle > 0.0) || !std::isfinite(angle)) continue;
+    candidates.push_back({static_cast<int>(e), 0.0, 1.0, angle});
+  }
+  return candidates;
+}
+
+void AddShadowEdgeTerms(const EdgeView& view, std::vector<EdgeEntry>* entries) {
+  const Context& ctx = view.ctx;
+  const RenderOptions& options = ctx.options;
+  const double ratio = ctx.request->shadow_edge_ratio;
+  if (!(ratio > 0.0 && options.effects.shadows && options.effects.direct)) return;
+  const RenderScene& scene = ctx.scene;
+  const auto& positions = scene.positions();
+  for (size_t l = 0; l < ctx.view.point_lights.size(); ++l) {
+    const PointLight& point_light = ctx.view.point_lights[l];
+    const Eigen::Vector3d light = point_light.position;
+    const auto sample_shadow = [&](const EdgeCandidate& candidate, double s, double inv_pdf,
+                                   const Sampler& /*sampler*/, std::vector<EdgeEntry>* out) {
+      RenderStats& local = view.thread_stats.local();
+      const MeshEdge& edge = scene.edges()[candidate.edge];
+      ShadowPoint shadow;
+      if (!CastShadowPoint(ctx, light, edge, s, &local, &shadow)) return;
+      EmitCurveSample(
+          view, shadow.y, inv_pdf, options.spp,
+          [&](const Eigen::Matrix<double, 2, 3>& d_q) {
+            return (d_q * shadow.d_y_d_point * (positions[edge.v1] - positions[edge.v0])).eval();
+          },
+          [&](const Eigen::Vector2d& q, const Eigen::Vector2d& m) {
+            return ShadowJump(view, point_light, shadow.receiver, q, m, &local);
+          },
+          [&](const Eigen::Vector3d& m_row, BoundaryRows* rows) {
+            ShadowPointRows(shadow, scene, edge, s, m_row, rows);
+          },
+          &local, out);
+    };
+    const int64_t num_samples = static_cast<int64_t>(std::ceil(ratio * options.spp * view.pixels));
+    SampleCandidates(options, ShadowEdgeCandidates(scene, light), num_samples,
+                     kShadowEdgeKey + (l << 40), ctx.view.view_index, sample_shadow, entries);
+  }
+}
+
+}  // namespace render_internal
+}  // namespace sft

@@ -1,0 +1,48 @@
+// Internal to src/render: point-light shadow boundaries — the shadow that a silhouette edge as
+// seen from a point light casts on the first surface behind it. Seen directly by the camera they
+// are image curves (AddShadowEdgeTerms, the receiver's motion included); seen through a bounce,
+// secondary edges (B) (secondary_edges.cc).
+#ifndef SFT_RENDER_INTERNAL_SHADOW_EDGES_H_
+#define SFT_RENDER_INTERNAL_SHADOW_EDGES_H_
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "src/render/internal/context.h"
+#include "src/render/internal/edge_sampling.h"
+
+namespace sft {
+namespace render_internal {
+
+// A point of a mesh edge lit by a point light, and the shadow point it casts: the first surface
+// behind the edge point along the light's ray.
+struct ShadowPoint {
+  int receiver = -1;             // face of the shadow point.
+  Eigen::Vector3d y;             // the shadow point.
+  Eigen::Vector3d barycentrics;  // of y on the receiver.
+  Eigen::Matrix3d d_y_d_point;   // ∂y/∂(edge point).
+  Eigen::Matrix3d along;         // ∂y/∂p_j = barycentrics_j·along (receiver corners p_j).
+};
+
+// Casts the shadow of point a + s(b − a) of `edge` from the light at `light`; false when the
+// light does not reach the edge point, nothing lies behind it, or the receiver is grazed.
+// y = light + τ·d on the receiver's plane, d = point − light, τ = (|d| + t)/|d|:
+//   ∂y/∂point = τ(I − d̂ n_rᵀ/(n_r·d̂)),  ∂y/∂p_j = b_j·d̂ n_rᵀ/(n_r·d̂).
+bool CastShadowPoint(const Context& ctx, const Eigen::Vector3d& light, const MeshEdge& edge,
+                     double s, RenderStats* stats, ShadowPoint* out);
+
+// The vertices that move a shadow point of `edge` at parameter s, and rows_j = (∂y/∂p_j)ᵀ·row for
+// a row vector `row` (= some linear functional of y's motion): the edge's two ends (their copies,
+// AddEdgePointRows) through the edge point, the receiver's three corners through its plane.
+void ShadowPointRows(const ShadowPoint& shadow, const RenderScene& scene, const MeshEdge& edge,
+                     double s, const Eigen::Vector3d& row, BoundaryRows* out);
+
+// Shadow-casting edges of a point light: every edge that can be a silhouette from it, weighted
+// by the angle it subtends there (shadow samples are spread ∝ angle at the light).
+std::vector<EdgeCandidate> ShadowEdgeCandidates(const RenderScene& scene,
+                                                const Eigen::Vector3d& light);
+
+}  // namespace render_internal
+}  // namespace sft
+
+#endif  // SFT_RENDER_INTERNAL_SHADOW_EDGES_H_
