@@ -14,18 +14,6 @@ double Seconds(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-// The time split's parts in report order, with their names.
-std::vector<std::pair<const char*, double>> Parts(const SolverTimeSplit& t) {
-  return {{"superset_renders", t.superset_renders},
-          {"problem_assembly", t.problem_assembly},
-          {"solve_startup", t.solve_startup},
-          {"render", t.render},
-          {"pyramid", t.pyramid},
-          {"evaluation", t.evaluation},
-          {"linear_solver", t.linear_solver},
-          {"other", t.other}};
-}
-
 // Seconds of one solver iteration: everything after the solver's start-up, per iteration.
 double SecondsPerIteration(const SolverRunStats& stats) {
   const SolverTimeSplit& t = stats.time;
@@ -105,7 +93,7 @@ std::string ReconstructCostTable(const ReconstructCostReport& report) {
                   phase.phase.c_str(), s.iterations, s.evaluations, s.seconds, per_iteration,
                   per_iteration / std::max(1e-9, report.forward_seconds));
     out += line;
-    for (const auto& [name, seconds] : Parts(s.time)) {
+    for (const auto& [name, seconds] : TimeSplitParts(s.time)) {
       std::snprintf(line, sizeof(line), "  %-17s %9.2f s %6.1f%%\n", name, seconds,
                     100.0 * seconds / std::max(1e-9, s.seconds));
       out += line;
@@ -135,7 +123,7 @@ nlohmann::json ReconstructCostToJson(const ReconstructCostReport& report) {
   for (const PhaseRecord& phase : report.phases_run) {
     const SolverRunStats& s = phase.stats;
     nlohmann::json split = nlohmann::json::object();
-    for (const auto& [name, seconds] : Parts(s.time)) split[name] = seconds;
+    for (const auto& [name, seconds] : TimeSplitParts(s.time)) split[name] = seconds;
     const double per_iteration = SecondsPerIteration(s);
     phases.push_back(
         {{"phase", phase.phase},

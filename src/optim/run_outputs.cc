@@ -14,14 +14,9 @@ using json = nlohmann::json;
 namespace {
 
 json TimeSplitJson(const SolverTimeSplit& t) {
-  return {{"superset_renders", t.superset_renders},
-          {"problem_assembly", t.problem_assembly},
-          {"solve_startup", t.solve_startup},
-          {"render", t.render},
-          {"pyramid", t.pyramid},
-          {"evaluation", t.evaluation},
-          {"linear_solver", t.linear_solver},
-          {"other", t.other}};
+  json split = json::object();
+  for (const auto& [name, seconds] : TimeSplitParts(t)) split[name] = seconds;
+  return split;
 }
 
 }  // namespace

@@ -34,9 +34,9 @@ struct CacheClock {
 
 // Sets the remainder of the split so that the parts add up to the call's wall time.
 void FinishTimeSplit(SolverRunStats* stats) {
-  const SolverTimeSplit& t = stats->time;
-  const double parts = t.superset_renders + t.problem_assembly + t.solve_startup + t.render +
-                       t.pyramid + t.evaluation + t.linear_solver;
+  stats->time.other = 0.0;
+  double parts = 0.0;
+  for (const auto& part : TimeSplitParts(stats->time)) parts += part.second;
   stats->time.other = std::max(0.0, stats->seconds - parts);
 }
 
@@ -84,6 +84,17 @@ ceres::Solver::Options TrustRegionOptions(const SolverOptions& options) {
 }
 
 }  // namespace
+
+std::vector<std::pair<const char*, double>> TimeSplitParts(const SolverTimeSplit& t) {
+  return {{"superset_renders", t.superset_renders},
+          {"problem_assembly", t.problem_assembly},
+          {"solve_startup", t.solve_startup},
+          {"render", t.render},
+          {"pyramid", t.pyramid},
+          {"evaluation", t.evaluation},
+          {"linear_solver", t.linear_solver},
+          {"other", t.other}};
+}
 
 bool SolverKindFromName(const std::string& name, SolverKind* kind) {
   if (name == "lm") {

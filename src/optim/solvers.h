@@ -19,6 +19,7 @@
 
 #include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "src/optim/parameters.h"
@@ -83,6 +84,9 @@ struct SolverTimeSplit {
   double linear_solver = 0.0;     // the trust-region step's linear solve (CGNR, Cholesky, QR).
   double other = 0.0;             // the remainder.
 };
+
+// The split's parts in report order with their names ("superset_renders", ..., "other").
+std::vector<std::pair<const char*, double>> TimeSplitParts(const SolverTimeSplit& time);
 
 // Counters of one call, for the report.
 struct SolverRunStats {

@@ -13,6 +13,8 @@
 namespace sft {
 namespace {
 
+// Every field of the split, listed here rather than through TimeSplitParts, so that a part the
+// list forgets makes the sum disagree.
 double Sum(const SolverTimeSplit& t) {
   return t.superset_renders + t.problem_assembly + t.solve_startup + t.render + t.pyramid +
          t.evaluation + t.linear_solver + t.other;

@@ -8,27 +8,15 @@
 #include "src/render/environment.h"
 #include "src/render/render.h"
 #include "src/render/scene.h"
+#include "tests/testing/views.h"
 
 namespace sft {
 namespace {
 
-// A camera at height h above the origin looking down −z (world), square image.
-ViewSetup TopDownView(double height, int res, double focal) {
-  ViewSetup view;
-  view.camera.model = CameraModel::kPinhole;
-  view.camera.width = view.camera.height = res;
-  view.camera.params = {focal, focal, 0.5 * res, 0.5 * res};
-  view.cam_from_world.rotation =
-      Eigen::Quaterniond(Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()));
-  view.cam_from_world.translation = -(view.cam_from_world.rotation * Eigen::Vector3d(0, 0, height));
-  return view;
-}
+using testing::TopDownView;
 
 RenderScene Quad(double half) {
-  return RenderScene(
-      std::vector<Eigen::Vector3d>{
-          {-half, -half, 0}, {half, -half, 0}, {half, half, 0}, {-half, half, 0}},
-      std::vector<Eigen::Vector3i>{{0, 1, 2}, {0, 2, 3}});
+  return RenderScene(testing::QuadPositions(half), testing::QuadFaces());
 }
 
 // Per pixel and channel, Σ of the row entries of one parameter kind.

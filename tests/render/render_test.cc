@@ -8,27 +8,14 @@
 #include "src/geometry/material.h"
 #include "src/geometry/mesh.h"
 #include "tests/testing/temp_dir.h"
+#include "tests/testing/views.h"
 
 namespace sft {
 namespace {
 
-// A camera at height h above the origin looking down −z (world), square image.
-ViewSetup TopDownView(double height, int res, double focal) {
-  ViewSetup view;
-  view.camera.model = CameraModel::kPinhole;
-  view.camera.width = view.camera.height = res;
-  view.camera.params = {focal, focal, 0.5 * res, 0.5 * res};
-  // Camera axes in world: x_cam = +x, y_cam = −y, z_cam = −z (a rotation of π about x).
-  view.cam_from_world.rotation =
-      Eigen::Quaterniond(Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()));
-  view.cam_from_world.translation = -(view.cam_from_world.rotation * Eigen::Vector3d(0, 0, height));
-  return view;
-}
-
-std::vector<Eigen::Vector3d> QuadPositions(double half) {
-  return {{-half, -half, 0}, {half, -half, 0}, {half, half, 0}, {-half, half, 0}};
-}
-std::vector<Eigen::Vector3i> QuadFaces() { return {{0, 1, 2}, {0, 2, 3}}; }
+using testing::QuadFaces;
+using testing::QuadPositions;
+using testing::TopDownView;
 
 // Lambert plane under a point light: radiance ρ·I·cos θ/(π·d²) at every point (DESIGN.md §2.5).
 // The pixel value is the box-filter average of that smooth function, computed here by a 16×16
