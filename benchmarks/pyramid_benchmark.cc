@@ -17,6 +17,7 @@
 #include <memory>
 #include <vector>
 
+#include "benchmarks/bunny_scene.h"
 #include "src/core/rng.h"
 #include "src/eval/throughput.h"
 #include "src/geometry/material.h"
@@ -33,22 +34,10 @@ constexpr int kSpp = 16;
 constexpr int kLevels = 4;
 constexpr int kNoiseSeeds = 4;
 
-struct PyramidFixture {
-  std::unique_ptr<RenderScene> scene;
-  Material material;
-  ViewSetup view;
-};
-
-const PyramidFixture& Fixture() {
-  static const PyramidFixture* fixture = [] {
-    auto* f = new PyramidFixture;
-    TriMesh mesh;
-    const Status status = ReadMesh(SFT_DATA_DIR "/meshes/bunny_watertight_5k.obj", &mesh);
-    CHECK(status.ok()) << status.message();
-    f->scene = std::make_unique<RenderScene>(mesh);
-    f->material = ConstantMaterial(static_cast<int>(mesh.n_faces()), Eigen::Vector3d::Constant(0.7),
-                                   0.5, 0.0);
-    f->view = ThroughputView(*f->scene, kResolution);
+const BunnyScene& Fixture() {
+  static const BunnyScene* fixture = [] {
+    auto* f = new BunnyScene;
+    MakeBunnyScene(kResolution, f);
     return f;
   }();
   return *fixture;
@@ -66,7 +55,7 @@ ViewSetup CoarseView(const ViewSetup& view, int level) {
 
 // Level-0 image and rows of `view` at `spp`.
 void RenderRows(const ViewSetup& view, int spp, uint64_t seed, Image* image, LevelRows* rows) {
-  const PyramidFixture& f = Fixture();
+  const BunnyScene& f = Fixture();
   RenderOptions options;
   options.spp = spp;
   options.bounces = 1;
@@ -84,7 +73,7 @@ void RenderRows(const ViewSetup& view, int spp, uint64_t seed, Image* image, Lev
 // with spp·4^l when `per_level` = 1).
 void Levels(int per_level, uint64_t seed, std::vector<Image>* images,
             std::vector<LevelRows>* rows) {
-  const PyramidFixture& f = Fixture();
+  const BunnyScene& f = Fixture();
   images->assign(kLevels, Image());
   rows->assign(kLevels, LevelRows());
   Image image;

@@ -10,8 +10,10 @@
 #include <glog/logging.h>
 
 #include <memory>
+#include <utility>
 #include <vector>
 
+#include "benchmarks/bunny_scene.h"
 #include "src/core/rng.h"
 #include "src/eval/throughput.h"
 #include "src/geometry/material.h"
@@ -40,13 +42,11 @@ struct BunnyFixture {
 const BunnyFixture& Bunny() {
   static const BunnyFixture* fixture = [] {
     auto* f = new BunnyFixture;
-    TriMesh mesh;
-    const Status status = ReadMesh(SFT_DATA_DIR "/meshes/bunny_watertight_5k.obj", &mesh);
-    CHECK(status.ok()) << status.message();
-    f->scene = std::make_unique<RenderScene>(mesh);
-    f->material = ConstantMaterial(static_cast<int>(mesh.n_faces()), Eigen::Vector3d::Constant(0.7),
-                                   0.5, 0.0);
-    f->view = ThroughputView(*f->scene, kResolution);
+    BunnyScene bunny;
+    MakeBunnyScene(kResolution, &bunny);
+    f->scene = std::move(bunny.scene);
+    f->material = std::move(bunny.material);
+    f->view = bunny.view;
     f->camera_rays = CameraRays(f->view, kSpp, kSeed);
     f->shadow_rays = ShadowRays(*f->scene, f->view, kSpp, kSeed, /*threads=*/0);
     f->derivative_view = f->view;
