@@ -27,7 +27,7 @@ constexpr double kSecondaryTexelProbability = 0.25;
 void AddSecondaryTexels(const RenderScene& scene, const Material& material, bool glossy,
                         SecondaryEdges* out) {
   std::vector<double> weights;
-  for (const TexelSegment& segment : TexelSegments(scene, material, glossy)) {
+  for (const TexelSegment& segment : *TexelSegments(scene, material, glossy)) {
     const Eigen::Vector3i& corners = scene.faces()[segment.face];
     Eigen::Vector3d along = Eigen::Vector3d::Zero();
     for (int k = 0; k < 3; ++k) {

@@ -2,6 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <mutex>
+
+#include "src/core/rng.h"
 
 namespace sft {
 namespace render_internal {
@@ -217,14 +221,63 @@ void TexelSegmentEnds(const RenderScene& scene, const TexelSegment& segment, Eig
   }
 }
 
-std::vector<TexelSegment> TexelSegments(const RenderScene& scene, const Material& material,
-                                        bool glossy) {
+namespace {
+
+std::vector<TexelSegment> BuildTexelSegments(const RenderScene& scene, const Material& material,
+                                             bool glossy) {
   std::vector<TexelSegment> segments;
   const std::vector<double> lines = TexelGridLines(material);
   if (lines.empty()) return segments;
   AddGridLineSegments(scene, material, glossy, lines, &segments);
   AddCoplanarEdgeSegments(scene, material, glossy, lines, &segments);
   return segments;
+}
+
+// A 64-bit fingerprint of everything BuildTexelSegments reads: the faces and positions (which
+// edges are coplanar), both mesh-colors grids and their values, and `glossy`.
+uint64_t SegmentsKey(const RenderScene& scene, const Material& material, bool glossy) {
+  uint64_t key = Mix64(glossy ? 0x6C055Eull : 0xD1FF05Eull);
+  const auto add_bits = [&key](const void* data, size_t bytes) {
+    const unsigned char* p = static_cast<const unsigned char*>(data);
+    for (size_t i = 0; i + 8 <= bytes; i += 8) {
+      uint64_t word;
+      std::memcpy(&word, p + i, 8);
+      key = Mix64(key ^ word);
+    }
+    for (size_t i = bytes - bytes % 8; i < bytes; ++i) key = Mix64(key ^ p[i]);
+    key = Mix64(key ^ bytes);
+  };
+  add_bits(scene.faces().data(), scene.faces().size() * sizeof(Eigen::Vector3i));
+  add_bits(scene.positions().data(), scene.positions().size() * sizeof(Eigen::Vector3d));
+  for (const MeshColors* colors : {&material.albedo, &material.roughness}) {
+    const int shape[2] = {colors->num_faces(), colors->resolution()};
+    add_bits(shape, sizeof(shape));
+    add_bits(colors->values().data(), colors->values().size() * sizeof(double));
+  }
+  return key;
+}
+
+}  // namespace
+
+std::shared_ptr<const std::vector<TexelSegment>> TexelSegments(const RenderScene& scene,
+                                                               const Material& material,
+                                                               bool glossy) {
+  // The last build, shared by every view of a pass, by both passes of an evaluation and by the
+  // direct and secondary terms of a view, until the mesh state or material changes.
+  static std::mutex mutex;
+  static uint64_t cached_key = 0;
+  static std::shared_ptr<const std::vector<TexelSegment>> cached;
+  const uint64_t key = SegmentsKey(scene, material, glossy);
+  {
+    std::lock_guard<std::mutex> lock(mutex);
+    if (cached != nullptr && cached_key == key) return cached;
+  }
+  auto built = std::make_shared<const std::vector<TexelSegment>>(
+      BuildTexelSegments(scene, material, glossy));
+  std::lock_guard<std::mutex> lock(mutex);
+  cached_key = key;
+  cached = built;
+  return built;
 }
 
 namespace {
@@ -236,7 +289,7 @@ std::vector<TexelCandidate> TexelCandidates(const EdgeView& view) {
   const Material& material = view.ctx.material;
   const bool glossy = material.specular * view.ctx.specular_scale > 0.0;
   std::vector<TexelCandidate> candidates;
-  for (const TexelSegment& segment : TexelSegments(scene, material, glossy)) {
+  for (const TexelSegment& segment : *TexelSegments(scene, material, glossy)) {
     // A coplanar edge seen edge-on from the camera is a primary edge there.
     if (segment.edge >= 0 &&
         IsDiscontinuityEdge(scene, scene.edges()[segment.edge], view.center, /*creases=*/true)) {

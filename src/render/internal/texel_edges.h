@@ -7,6 +7,7 @@
 #define SFT_RENDER_INTERNAL_TEXEL_EDGES_H_
 
 #include <Eigen/Core>
+#include <memory>
 #include <vector>
 
 #include "src/geometry/material.h"
@@ -37,9 +38,12 @@ void AddTexelPointRows(const RenderScene& scene, int face, int other, const Eige
 // Every texel boundary of the material on the mesh: grid lines inside faces whose texels vary
 // and edges between coplanar, equally oriented faces, each cut where other grid lines cross so
 // that a piece separates two texels, kept where the two sides' materials differ (roughness only
-// counts with the glossy lobe on).
-std::vector<TexelSegment> TexelSegments(const RenderScene& scene, const Material& material,
-                                        bool glossy);
+// counts with the glossy lobe on). They depend on the mesh state (faces, and positions through
+// coplanarity) and the material, not on the view: the last set is kept (keyed by a fingerprint of
+// those inputs) and shared until they change.
+std::shared_ptr<const std::vector<TexelSegment>> TexelSegments(const RenderScene& scene,
+                                                               const Material& material,
+                                                               bool glossy);
 
 // The ends Σ_k b0_k·p_k and Σ_k b1_k·p_k of a texel segment, world frame.
 void TexelSegmentEnds(const RenderScene& scene, const TexelSegment& segment, Eigen::Vector3d* y0,
