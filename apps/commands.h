@@ -49,6 +49,7 @@ CommandRunner SetupPerturbCommand(CLI::App* app);
 CommandRunner SetupEvalCommand(CLI::App* app);
 CommandRunner SetupCompareCommand(CLI::App* app);
 CommandRunner SetupImportCommand(CLI::App* app);
+CommandRunner SetupAlignProbeCommand(CLI::App* app);
 CommandRunner SetupInitCommand(CLI::App* app);
 
 }  // namespace sft

@@ -25,6 +25,17 @@ int RunImportColmap(const ColmapImportOptions& opts) {
         report.dense_points.empty() ? ""
                                     : ("dense points from " + report.dense_points + "; ").c_str(),
         report.seconds);
+    if (report.auto_masks > 0) {
+      std::fprintf(stderr, "sft import colmap: %d automatic masks (GrabCut) in masks/\n",
+                   report.auto_masks);
+    }
+    if (report.probe_aligned) {
+      const ProbeAlignmentResult& a = report.alignment;
+      std::fprintf(stderr,
+                   "sft import colmap: probe aligned: rotation %.2f deg; %d inliers of %d "
+                   "matches; median residual %.3f deg\n",
+                   a.rotation_angle_deg, a.inliers, a.matches, a.median_residual_deg);
+    }
   }
   return 0;
 }
@@ -44,10 +55,13 @@ CommandRunner SetupImportCommand(CLI::App* app) {
       ->required();
   colmap->add_option("--masks", opts->masks,
                      "Mask folder: NAME.png (COLMAP's convention) or STEM.png per image, > 127 = "
-                     "object");
+                     "object; or 'auto' (GrabCut seeded by the sparse points near the object)");
   colmap->add_option("--probe", opts->probe,
                      "Equirectangular probe (.exr/.hdr linear, or an 8-bit sRGB panorama), added "
-                     "as an environment light with world_from_env = identity");
+                     "as an environment light, rotated into the world frame by matching its crops "
+                     "against the frames' background (see --no-align-probe)");
+  colmap->add_flag("!--no-align-probe", opts->align_probe,
+                   "Keep the probe unaligned (world_from_env = identity)");
   colmap->add_option("--out", opts->out, "Output dataset folder")->required();
   colmap
       ->add_option("--axis-cone", opts->normalization.axis_cone,

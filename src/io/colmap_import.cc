@@ -12,10 +12,12 @@
 #include "src/core/file_util.h"
 #include "src/core/progress.h"
 #include "src/geometry/mesh.h"
+#include "src/io/auto_masks.h"
 #include "src/io/colmap_model.h"
 #include "src/io/dataset.h"
 #include "src/io/image_io.h"
 #include "src/io/point_cloud_ply.h"
+#include "src/io/probe_alignment.h"
 
 namespace sft {
 namespace {
@@ -277,7 +279,7 @@ Status ImportViews(const ColmapImportOptions& opts, const ColmapModel& model,
     obs.camera = camera;
     obs.cam_from_world.rotation = image.cam_from_world_rotation;
     obs.cam_from_world.translation = image.cam_from_world_translation;
-    if (!opts.masks.empty()) {
+    if (opts.HasMaskFolder()) {
       view.mask = "masks/" + WithoutExtension(view.image.substr(7)) + ".png";
       SFT_RETURN_IF_ERROR(
           ImportMask(opts.masks, image.name, camera, root, view.mask, &(*masks)[i]));
@@ -290,6 +292,32 @@ Status ImportViews(const ColmapImportOptions& opts, const ColmapModel& model,
   progress.Finish();
 
   return Status::Ok();
+}
+
+// --masks auto and the probe's alignment, on the written dataset (both need the normalised
+// poses); rewrites scene.json when either ran.
+Status AutoMasksAndProbe(const ColmapImportOptions& opts,
+                         const std::vector<Eigen::Vector3d>& sparse, Dataset* dataset,
+                         ColmapImportReport* report) {
+  if (opts.masks == "auto") {
+    AutoMaskOptions mask_options = opts.auto_masks;
+    mask_options.quiet = mask_options.quiet || opts.quiet;
+    SFT_RETURN_IF_ERROR(WriteAutoMasks(dataset, sparse, mask_options));
+    report->auto_masks = static_cast<int>(dataset->views.size());
+  }
+  if (!opts.probe.empty() && opts.align_probe) {
+    ProbeAlignmentOptions align = opts.alignment;
+    align.quiet = align.quiet || opts.quiet;
+    const Status status = AlignProbe(*dataset, 0, align, &report->alignment);
+    if (!status.ok()) {
+      return Status::Error(status.message() + " (--no-align-probe imports the probe unaligned)");
+    }
+    dataset->lights[0].world_from_env = report->alignment.world_from_env;
+    dataset->lighting = AlignedProbeLighting(report->alignment);
+    report->probe_aligned = true;
+  }
+  if (opts.masks != "auto" && !report->probe_aligned) return Status::Ok();
+  return WriteSceneJson(*dataset, dataset->root);
 }
 
 Status ImportInto(const ColmapImportOptions& opts, const std::string& root,
@@ -305,7 +333,7 @@ Status ImportInto(const ColmapImportOptions& opts, const std::string& root,
   SFT_RETURN_IF_ERROR(ConvertCameras(model, &dataset, &camera_index).Prefixed(opts.model));
 
   // Images and masks, with the views in the model's frame for the normalisation.
-  std::vector<MaskBits> masks(opts.masks.empty() ? 0 : model.images.size());
+  std::vector<MaskBits> masks(!opts.HasMaskFolder() ? 0 : model.images.size());
   std::unordered_map<uint32_t, ObservingView> observing;
   std::vector<std::string> encodings;
   SFT_RETURN_IF_ERROR(
@@ -372,7 +400,8 @@ Status ImportInto(const ColmapImportOptions& opts, const std::string& root,
   report->views = static_cast<int>(dataset.views.size());
   SFT_RETURN_IF_ERROR(WriteSceneJson(dataset, root));
   Dataset check;
-  return ReadDataset(root, &check);
+  SFT_RETURN_IF_ERROR(ReadDataset(root, &check));
+  return AutoMasksAndProbe(opts, sparse.positions, &check, report);
 }
 
 }  // namespace
@@ -385,6 +414,10 @@ bool ColmapImportOptions::Check(std::string* why) const {
   else if (out.empty())
     *why = "--out: required";
   else if (!normalization.Check(why))
+    return false;
+  else if (!alignment.Check(why))
+    return false;
+  else if (!auto_masks.Check(why))
     return false;
   else
     return true;
@@ -399,7 +432,7 @@ Status ImportColmap(const ColmapImportOptions& opts, ColmapImportReport* report)
   std::error_code ec;
   for (const auto& [flag, dir] : {std::pair<const char*, std::string>{"--model", opts.model},
                                   {"--images", opts.images},
-                                  {"--masks", opts.masks}}) {
+                                  {"--masks", opts.HasMaskFolder() ? opts.masks : ""}}) {
     if (!dir.empty() && !fs::is_directory(dir, ec)) {
       return Status::Error(std::string(flag) + ": " + dir + ": folder not found");
     }
@@ -409,7 +442,7 @@ Status ImportColmap(const ColmapImportOptions& opts, ColmapImportReport* report)
   }
   std::string dense_mesh, dense_points;
   if (opts.import_dense) FindDense(opts.model, &dense_mesh, &dense_points);
-  const RunInputs inputs{{opts.model, opts.images, opts.masks},
+  const RunInputs inputs{{opts.model, opts.images, opts.HasMaskFolder() ? opts.masks : ""},
                          {opts.probe, dense_mesh, dense_points}};
   SFT_RETURN_IF_ERROR(CheckOutputDirectory(opts.out, inputs, "--out"));
   const std::string partial = opts.out + ".partial";

@@ -16,22 +16,31 @@
 #include <string>
 
 #include "src/core/status.h"
+#include "src/io/auto_masks.h"
 #include "src/io/import_normalization.h"
+#include "src/io/probe_alignment.h"
 
 namespace sft {
 
 struct ColmapImportOptions {
   std::string model;   // COLMAP sparse model folder (cameras/images/points3D .bin or .txt).
   std::string images;  // folder the model's image names are relative to.
-  std::string masks;   // optional mask folder: NAME.png (COLMAP's convention) or STEM.png.
-  std::string probe;   // optional equirectangular probe: .exr/.hdr (linear) or 8-bit (sRGB).
-  std::string out;     // output dataset folder.
+  // optional mask folder: NAME.png (COLMAP's convention) or STEM.png; "auto" segments the
+  // object in every view (auto_masks.h) after the normalisation.
+  std::string masks;
+  std::string probe;        // optional equirectangular probe: .exr/.hdr (linear) or 8-bit (sRGB).
+  std::string out;          // output dataset folder.
+  bool align_probe = true;  // align the probe (probe_alignment.h); else identity.
+  ProbeAlignmentOptions alignment;     // how the probe is aligned.
+  AutoMaskOptions auto_masks;          // how --masks auto segments.
   NormalizationOptions normalization;  // how the object is found among the sparse points.
   bool import_dense = true;            // import fused.ply / meshed-*.ply found beside the model.
   bool overwrite = false;              // replace an existing, non-empty output folder.
   bool quiet = false;                  // no progress line.
 
   bool Check(std::string* why) const;
+  // A mask folder was given (not empty and not "auto").
+  bool HasMaskFolder() const { return !masks.empty() && masks != "auto"; }
 };
 
 // What the import did, for the command's summary and for tests.
@@ -42,7 +51,10 @@ struct ColmapImportReport {
   NormalizationResult normalization;
   std::string dense_mesh;    // source file imported as init/mesh.ply, or "".
   std::string dense_points;  // source file imported as init/fused.ply, or "".
-  double seconds = 0;        // wall time.
+  int auto_masks = 0;        // masks made by --masks auto.
+  bool probe_aligned = false;
+  ProbeAlignmentResult alignment;  // when probe_aligned.
+  double seconds = 0;              // wall time.
 };
 
 Status ImportColmap(const ColmapImportOptions& options, ColmapImportReport* report);

@@ -87,8 +87,18 @@ void ImportAndCheck(const std::string& format, bool masks, const std::string& pr
     EXPECT_LT((s * sparse.positions[i] - model.points[i].xyz).norm(), 1e-9 * kTrueScale);
   }
   EXPECT_EQ(dataset.image_encoding, "sRGB 8-bit JPEG converted to PNG; sRGB 8-bit PNG");
-  EXPECT_EQ(dataset.lighting,
-            probe.empty() ? "unknown" : "probe not yet aligned (world_from_env = identity)");
+  if (probe.empty()) {
+    EXPECT_EQ(dataset.lighting, "unknown");
+  } else {
+    // The probe was aligned (probe_alignment_test.cc checks the rotation in detail): synth's world
+    // is the probe's env frame, and the fixture rotated it into COLMAP's frame by a known R.
+    EXPECT_THAT(dataset.lighting, HasSubstr("probe aligned"));
+    const double s = std::sin(0.4);
+    const Eigen::Matrix3d truth =
+        Eigen::Quaterniond(std::cos(0.4), s * 0.48, s * 0.6, s * 0.64).toRotationMatrix();
+    const Eigen::Matrix3d error = truth.transpose() * dataset.lights[0].world_from_env;
+    EXPECT_LT(Eigen::AngleAxisd(error).angle() * 180.0 / M_PI, 2.0);
+  }
   EXPECT_EQ(dataset.background, probe.empty() ? Background::kBlack : Background::kEnvironment);
   // The PNG is a byte copy; a JPEG's pixels are the decoded JPEG's.
   std::string a, b;
