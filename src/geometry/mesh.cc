@@ -1083,6 +1083,14 @@ Status ReadMesh(const std::string& path, TriMesh* mesh, MeshReport* report) {
   }
   std::string text;
   SFT_RETURN_IF_ERROR(ReadTextFile(path, &text));
+  return ParseMesh(text, path, mesh, report);
+}
+
+Status ParseMesh(std::string text, const std::string& path, TriMesh* mesh, MeshReport* report) {
+  const std::string ext = FileExtension(path);
+  if (ext != "obj" && ext != "ply" && ext != "off") {
+    return Status::Error(path + ": unknown mesh extension '" + ext + "' (expected obj, ply, off)");
+  }
   StripUtf8Bom(&text);
   if (text.find_first_not_of(" \t\r\n") == std::string::npos) {
     return Status::Error(path + ": empty file (no faces)");

@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <limits>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <string>
@@ -67,9 +68,10 @@ float ChannelValue(const unsigned char* plane, int pixel_type, size_t i) {
   return reinterpret_cast<const float*>(plane)[i];
 }
 
-Status ReadExr(const std::string& path, Image* image) {
+Status DecodeExr(const std::string& data, const std::string& path, Image* image) {
+  const auto* bytes = reinterpret_cast<const unsigned char*>(data.data());
   EXRVersion version;
-  if (ParseEXRVersionFromFile(&version, path.c_str()) != TINYEXR_SUCCESS) {
+  if (ParseEXRVersionFromMemory(&version, bytes, data.size()) != TINYEXR_SUCCESS) {
     return PathError(path, "not a readable OpenEXR file");
   }
   if (version.multipart || version.non_image) {
@@ -79,7 +81,8 @@ Status ReadExr(const std::string& path, Image* image) {
   const char* err = nullptr;
   // tinyexr may allocate channel tables before failing: the header is freed either way.
   exr.header_parsed = true;
-  if (ParseEXRHeaderFromFile(&exr.header, &version, path.c_str(), &err) != TINYEXR_SUCCESS) {
+  if (ParseEXRHeaderFromMemory(&exr.header, &version, bytes, data.size(), &err) !=
+      TINYEXR_SUCCESS) {
     return PathError(path, "cannot read OpenEXR header (" + TakeExrError(err) + ")");
   }
   for (int c = 0; c < exr.header.num_channels; ++c) {
@@ -90,7 +93,8 @@ Status ReadExr(const std::string& path, Image* image) {
       return PathError(path, "subsampled OpenEXR channels are not supported");
     }
   }
-  if (LoadEXRImageFromFile(&exr.image, &exr.header, path.c_str(), &err) != TINYEXR_SUCCESS) {
+  if (LoadEXRImageFromMemory(&exr.image, &exr.header, bytes, data.size(), &err) !=
+      TINYEXR_SUCCESS) {
     return PathError(path, "cannot read OpenEXR pixels (" + TakeExrError(err) + ")");
   }
   exr.image_loaded = true;
@@ -189,10 +193,17 @@ const std::vector<float>& SrgbTable(int bits) {
   return bits == 8 ? table8 : table16;
 }
 
-Status ReadPng(const std::string& path, Image* image, bool srgb) {
+Status DecodePng(const std::string& data, const std::string& path, Image* image, bool srgb) {
   cv::Mat mat;
   try {
-    mat = cv::imread(path, cv::IMREAD_UNCHANGED);
+    // imdecode needs a non-empty buffer; an empty file is simply not a PNG.
+    if (data.empty()) return PathError(path, "cannot read PNG (empty file)");
+    if (data.size() > static_cast<size_t>(std::numeric_limits<int>::max())) {
+      return PathError(path, "cannot read PNG (file larger than 2 GiB)");
+    }
+    const cv::Mat buffer(1, static_cast<int>(data.size()), CV_8U,
+                         const_cast<char*>(data.data()));
+    mat = cv::imdecode(buffer, cv::IMREAD_UNCHANGED);
   } catch (const cv::Exception& e) {
     return PathError(path, "cannot read PNG (" + std::string(e.what()) + ")");
   }
@@ -287,7 +298,17 @@ Status ReadImage(const std::string& path, Image* image, bool srgb) {
     return PathError(path, "unsupported image extension \"" + ext + "\" (expected .exr or .png)");
   }
   SFT_RETURN_IF_ERROR(CheckReadable(path));
-  return ext == "exr" ? ReadExr(path, image) : ReadPng(path, image, srgb);
+  std::string data;
+  SFT_RETURN_IF_ERROR(ReadTextFile(path, &data));
+  return DecodeImage(data, path, image, srgb);
+}
+
+Status DecodeImage(const std::string& data, const std::string& path, Image* image, bool srgb) {
+  const std::string ext = FileExtension(path);
+  if (ext != "exr" && ext != "png") {
+    return PathError(path, "unsupported image extension \"" + ext + "\" (expected .exr or .png)");
+  }
+  return ext == "exr" ? DecodeExr(data, path, image) : DecodePng(data, path, image, srgb);
 }
 
 Status ReadMask(const std::string& path, Image* mask) {

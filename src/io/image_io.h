@@ -19,6 +19,10 @@ float LinearToSrgb(float v);
 // alpha is never decoded. Errors name the path: missing, unreadable, unsupported extension.
 Status ReadImage(const std::string& path, Image* image, bool srgb = true);
 
+// Decodes the contents of an .exr or .png file held in memory (`data`), as ReadImage does;
+// `path` selects the format by its extension and names the file in errors.
+Status DecodeImage(const std::string& data, const std::string& path, Image* image,
+                   bool srgb = true);
 // Reads a mask PNG: 1 channel, 1.0 where the first channel > 127 (of 255), else 0.0.
 Status ReadMask(const std::string& path, Image* mask);
 
