@@ -21,6 +21,11 @@
 namespace sft {
 namespace {
 
+// Largest EXR read (DecodeExr): 65536 pixels a side, 2 GiB of decoded 32-bit channel values
+// (a 16384x8192 RGB float probe is 1.5 GiB).
+constexpr int64_t kMaxExrSide = 65536;
+constexpr int64_t kMaxExrBytes = int64_t{2} << 30;
+
 Status PathError(const std::string& path, const std::string& what) {
   return Status::Error(path + ": " + what);
 }
@@ -84,6 +89,23 @@ Status DecodeExr(const std::string& data, const std::string& path, Image* image)
   if (ParseEXRHeaderFromMemory(&exr.header, &version, bytes, data.size(), &err) !=
       TINYEXR_SUCCESS) {
     return PathError(path, "cannot read OpenEXR header (" + TakeExrError(err) + ")");
+  }
+  // tinyexr allocates every channel plane from the header's data window before it decodes a
+  // pixel, so a few-kilobyte file can ask for tens of gigabytes (found by fuzz/exr_fuzzer).
+  // Bounded here: each side at most kMaxExrSide, and the decoded planes (4-byte values per
+  // channel) at most kMaxExrBytes.
+  const int64_t exr_width =
+      int64_t{exr.header.data_window.max_x} - exr.header.data_window.min_x + 1;
+  const int64_t exr_height =
+      int64_t{exr.header.data_window.max_y} - exr.header.data_window.min_y + 1;
+  if (exr_width <= 0 || exr_height <= 0 || exr_width > kMaxExrSide || exr_height > kMaxExrSide ||
+      exr_width * exr_height * std::max(exr.header.num_channels, 1) * 4 > kMaxExrBytes) {
+    return PathError(path, "OpenEXR data window " + std::to_string(exr_width) + "x" +
+                               std::to_string(exr_height) + " with " +
+                               std::to_string(exr.header.num_channels) +
+                               " channels is empty or too large (at most " +
+                               std::to_string(kMaxExrSide) + " pixels a side and " +
+                               std::to_string(kMaxExrBytes >> 30) + " GiB of pixels)");
   }
   for (int c = 0; c < exr.header.num_channels; ++c) {
     if (exr.header.pixel_types[c] == TINYEXR_PIXELTYPE_HALF) {

@@ -16,7 +16,8 @@ float LinearToSrgb(float v);
 
 // Reads .exr or .png (by extension, case-insensitive). Channels as stored (1, 3 or 4; a 2-channel
 // grey+alpha PNG becomes 4-channel RGBA). For PNG, colour channels are sRGB-decoded when `srgb`;
-// alpha is never decoded. Errors name the path: missing, unreadable, unsupported extension.
+// alpha is never decoded. Errors name the path: missing, unreadable, unsupported extension, an EXR
+// data window over 65536 pixels a side or over 2 GiB of decoded 32-bit values.
 Status ReadImage(const std::string& path, Image* image, bool srgb = true);
 
 // Decodes the contents of an .exr or .png file held in memory (`data`), as ReadImage does;
