@@ -1,4 +1,5 @@
-// libFuzzer target: the EXR reader (DecodeImage in src/io/image_io.h, the decoder behind ReadImage).
+// libFuzzer target: the EXR reader (DecodeImage in src/io/image_io.h, the decoder behind
+// ReadImage).
 #include <cstddef>
 #include <cstdint>
 #include <string>

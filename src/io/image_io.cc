@@ -100,12 +100,11 @@ Status DecodeExr(const std::string& data, const std::string& path, Image* image)
       int64_t{exr.header.data_window.max_y} - exr.header.data_window.min_y + 1;
   if (exr_width <= 0 || exr_height <= 0 || exr_width > kMaxExrSide || exr_height > kMaxExrSide ||
       exr_width * exr_height * std::max(exr.header.num_channels, 1) * 4 > kMaxExrBytes) {
-    return PathError(path, "OpenEXR data window " + std::to_string(exr_width) + "x" +
-                               std::to_string(exr_height) + " with " +
-                               std::to_string(exr.header.num_channels) +
-                               " channels is empty or too large (at most " +
-                               std::to_string(kMaxExrSide) + " pixels a side and " +
-                               std::to_string(kMaxExrBytes >> 30) + " GiB of pixels)");
+    return PathError(
+        path, "OpenEXR data window " + std::to_string(exr_width) + "x" +
+                  std::to_string(exr_height) + " with " + std::to_string(exr.header.num_channels) +
+                  " channels is empty or too large (at most " + std::to_string(kMaxExrSide) +
+                  " pixels a side and " + std::to_string(kMaxExrBytes >> 30) + " GiB of pixels)");
   }
   for (int c = 0; c < exr.header.num_channels; ++c) {
     if (exr.header.pixel_types[c] == TINYEXR_PIXELTYPE_HALF) {
@@ -223,8 +222,7 @@ Status DecodePng(const std::string& data, const std::string& path, Image* image,
     if (data.size() > static_cast<size_t>(std::numeric_limits<int>::max())) {
       return PathError(path, "cannot read PNG (file larger than 2 GiB)");
     }
-    const cv::Mat buffer(1, static_cast<int>(data.size()), CV_8U,
-                         const_cast<char*>(data.data()));
+    const cv::Mat buffer(1, static_cast<int>(data.size()), CV_8U, const_cast<char*>(data.data()));
     mat = cv::imdecode(buffer, cv::IMREAD_UNCHANGED);
   } catch (const cv::Exception& e) {
     return PathError(path, "cannot read PNG (" + std::string(e.what()) + ")");

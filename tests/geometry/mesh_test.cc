@@ -498,7 +498,8 @@ TEST(MeshReadTest, ParseMeshMatchesReadMesh) {
 // Found by mesh_ply_fuzzer (data/fuzz_regressions/): an element without properties but with a
 // count of 444444444 made the reader loop for minutes; it occupies no bytes and is skipped.
 TEST(MeshFuzzRegression, PlyElementWithoutPropertiesIsSkipped) {
-  const std::string path = testing::DataDir() + "/fuzz_regressions/mesh_ply_empty_element_timeout.ply";
+  const std::string path =
+      testing::DataDir() + "/fuzz_regressions/mesh_ply_empty_element_timeout.ply";
   TriMesh mesh;
   const auto start = std::chrono::steady_clock::now();
   const Status status = ReadMesh(path, &mesh);
