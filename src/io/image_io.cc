@@ -35,6 +35,11 @@ std::string TakeExrError(const char* err) {
   if (err == nullptr) return "unknown error";
   std::string message(err);
   FreeEXRErrorMessage(err);
+  // tinyexr's messages may end in (or contain) newlines; errors are one line.
+  for (char& c : message) {
+    if (c == '\n' || c == '\r') c = ' ';
+  }
+  while (!message.empty() && message.back() == ' ') message.pop_back();
   return message;
 }
 

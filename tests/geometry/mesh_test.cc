@@ -506,7 +506,7 @@ TEST(MeshFuzzRegression, PlyElementWithoutPropertiesIsSkipped) {
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   ASSERT_FALSE(status.ok());
-  EXPECT_THAT(status.message(), ::testing::StartsWith(path + ": truncated or malformed data"));
+  EXPECT_THAT(status.message(), ::testing::StartsWith(path + ": face 1 has 0 vertices"));
   EXPECT_EQ(status.message().find('\n'), std::string::npos);
   EXPECT_LT(seconds, 1.0);
 
