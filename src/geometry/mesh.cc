@@ -658,6 +658,10 @@ Status ParsePly(const std::string& path, const std::string& text, ParsedMesh* ou
   const long long num_vertices = vertex_element->count;
   std::vector<double> values;
   for (const PlyElement& e : elements) {
+    // An element without properties occupies no bytes, whatever its count: skipping it keeps the
+    // loop below bounded by the file's size (a count of 2^31 - 1 would otherwise spin for
+    // minutes on nothing).
+    if (e.properties.empty()) continue;
     for (long long n = 0; n < e.count; ++n) {
       Eigen::Vector3d p = Eigen::Vector3d::Zero();
       Eigen::Vector2d uv = Eigen::Vector2d::Zero();
@@ -1083,6 +1087,14 @@ Status ReadMesh(const std::string& path, TriMesh* mesh, MeshReport* report) {
   }
   std::string text;
   SFT_RETURN_IF_ERROR(ReadTextFile(path, &text));
+  return ParseMesh(text, path, mesh, report);
+}
+
+Status ParseMesh(std::string text, const std::string& path, TriMesh* mesh, MeshReport* report) {
+  const std::string ext = FileExtension(path);
+  if (ext != "obj" && ext != "ply" && ext != "off") {
+    return Status::Error(path + ": unknown mesh extension '" + ext + "' (expected obj, ply, off)");
+  }
   StripUtf8Bom(&text);
   if (text.find_first_not_of(" \t\r\n") == std::string::npos) {
     return Status::Error(path + ": empty file (no faces)");

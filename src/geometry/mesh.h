@@ -37,6 +37,10 @@ struct MeshReport {
 // a face index out of range (detected before OpenMesh sees the file, since OpenMesh skips such
 // faces silently). Degenerate faces are counted in `report`, not errors.
 Status ReadMesh(const std::string& path, TriMesh* mesh, MeshReport* report = nullptr);
+// The same from a file's contents held in memory: `path` selects the format by its extension and
+// names the file in errors (ReadMesh reads the file and calls this).
+Status ParseMesh(std::string text, const std::string& path, TriMesh* mesh,
+                 MeshReport* report = nullptr);
 
 // Writes OBJ, PLY (binary) or OFF by extension, atomically. OBJ includes per-corner UVs when the
 // mesh has halfedge texcoords.

@@ -127,6 +127,11 @@ Status ReadMeshColors(const std::string& path, MeshColors* colors,
                       std::vector<std::string>* channel_names) {
   std::string data;
   SFT_RETURN_IF_ERROR(ReadTextFile(path, &data));
+  return ParseMeshColors(data, path, colors, channel_names);
+}
+
+Status ParseMeshColors(const std::string& data, const std::string& path, MeshColors* colors,
+                       std::vector<std::string>* channel_names) {
   const size_t newline = data.find('\n');
   if (newline == std::string::npos || newline > kMaxHeaderBytes) {
     return Status::Error(path + ": not a mesh-colors file (no one-line JSON header)");

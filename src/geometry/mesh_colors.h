@@ -64,6 +64,9 @@ Status WriteMeshColors(const std::string& path, const MeshColors& colors,
                        const std::vector<std::string>& channel_names);
 Status ReadMeshColors(const std::string& path, MeshColors* colors,
                       std::vector<std::string>* channel_names = nullptr);
+// The same from a file's contents held in memory; `path` names the file in errors.
+Status ParseMeshColors(const std::string& data, const std::string& path, MeshColors* colors,
+                       std::vector<std::string>* channel_names = nullptr);
 
 }  // namespace sft
 

@@ -577,6 +577,11 @@ Status ReadDataset(const std::string& dir, Dataset* dataset) {
   }
   std::string text;
   SFT_RETURN_IF_ERROR(ReadTextFile(file, &text));
+  return ParseSceneJson(text, dir, dataset);
+}
+
+Status ParseSceneJson(std::string text, const std::string& dir, Dataset* dataset) {
+  const std::string file = JoinPath(dir, kSceneFile);
   StripUtf8Bom(&text);  // nlohmann::json skips it too; explicit for every reader.
   try {
     json root;

@@ -118,6 +118,9 @@ struct Dataset {
 // Does not open images (see CheckDatasetFiles). Errors name the file and the JSON path, e.g.
 // "data/x/scene.json: views[3].cam_from_world.rotation: expected 4 numbers, got 3".
 Status ReadDataset(const std::string& dir, Dataset* dataset);
+// The same from scene.json's contents held in memory (`dir` becomes Dataset::root and prefixes
+// the messages); ReadDataset reads DIR/scene.json and calls this. Touches no file.
+Status ParseSceneJson(std::string text, const std::string& dir, Dataset* dataset);
 
 // Renderers need every view's lighting: an error naming the first view whose `lights` list is
 // empty (unknown lighting, as importers write it; DESIGN.md §2.5), else OK. Reading such a

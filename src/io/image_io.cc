@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <limits>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <string>
@@ -20,6 +21,11 @@
 namespace sft {
 namespace {
 
+// Largest EXR read (DecodeExr): 65536 pixels a side, 2 GiB of decoded 32-bit channel values
+// (a 16384x8192 RGB float probe is 1.5 GiB).
+constexpr int64_t kMaxExrSide = 65536;
+constexpr int64_t kMaxExrBytes = int64_t{2} << 30;
+
 Status PathError(const std::string& path, const std::string& what) {
   return Status::Error(path + ": " + what);
 }
@@ -29,6 +35,11 @@ std::string TakeExrError(const char* err) {
   if (err == nullptr) return "unknown error";
   std::string message(err);
   FreeEXRErrorMessage(err);
+  // tinyexr's messages may end in (or contain) newlines; errors are one line.
+  for (char& c : message) {
+    if (c == '\n' || c == '\r') c = ' ';
+  }
+  while (!message.empty() && message.back() == ' ') message.pop_back();
   return message;
 }
 
@@ -67,9 +78,10 @@ float ChannelValue(const unsigned char* plane, int pixel_type, size_t i) {
   return reinterpret_cast<const float*>(plane)[i];
 }
 
-Status ReadExr(const std::string& path, Image* image) {
+Status DecodeExr(const std::string& data, const std::string& path, Image* image) {
+  const auto* bytes = reinterpret_cast<const unsigned char*>(data.data());
   EXRVersion version;
-  if (ParseEXRVersionFromFile(&version, path.c_str()) != TINYEXR_SUCCESS) {
+  if (ParseEXRVersionFromMemory(&version, bytes, data.size()) != TINYEXR_SUCCESS) {
     return PathError(path, "not a readable OpenEXR file");
   }
   if (version.multipart || version.non_image) {
@@ -79,8 +91,25 @@ Status ReadExr(const std::string& path, Image* image) {
   const char* err = nullptr;
   // tinyexr may allocate channel tables before failing: the header is freed either way.
   exr.header_parsed = true;
-  if (ParseEXRHeaderFromFile(&exr.header, &version, path.c_str(), &err) != TINYEXR_SUCCESS) {
+  if (ParseEXRHeaderFromMemory(&exr.header, &version, bytes, data.size(), &err) !=
+      TINYEXR_SUCCESS) {
     return PathError(path, "cannot read OpenEXR header (" + TakeExrError(err) + ")");
+  }
+  // tinyexr allocates every channel plane from the header's data window before it decodes a
+  // pixel, so a few-kilobyte file can ask for tens of gigabytes (found by fuzz/exr_fuzzer).
+  // Bounded here: each side at most kMaxExrSide, and the decoded planes (4-byte values per
+  // channel) at most kMaxExrBytes.
+  const int64_t exr_width =
+      int64_t{exr.header.data_window.max_x} - exr.header.data_window.min_x + 1;
+  const int64_t exr_height =
+      int64_t{exr.header.data_window.max_y} - exr.header.data_window.min_y + 1;
+  if (exr_width <= 0 || exr_height <= 0 || exr_width > kMaxExrSide || exr_height > kMaxExrSide ||
+      exr_width * exr_height * std::max(exr.header.num_channels, 1) * 4 > kMaxExrBytes) {
+    return PathError(
+        path, "OpenEXR data window " + std::to_string(exr_width) + "x" +
+                  std::to_string(exr_height) + " with " + std::to_string(exr.header.num_channels) +
+                  " channels is empty or too large (at most " + std::to_string(kMaxExrSide) +
+                  " pixels a side and " + std::to_string(kMaxExrBytes >> 30) + " GiB of pixels)");
   }
   for (int c = 0; c < exr.header.num_channels; ++c) {
     if (exr.header.pixel_types[c] == TINYEXR_PIXELTYPE_HALF) {
@@ -90,7 +119,8 @@ Status ReadExr(const std::string& path, Image* image) {
       return PathError(path, "subsampled OpenEXR channels are not supported");
     }
   }
-  if (LoadEXRImageFromFile(&exr.image, &exr.header, path.c_str(), &err) != TINYEXR_SUCCESS) {
+  if (LoadEXRImageFromMemory(&exr.image, &exr.header, bytes, data.size(), &err) !=
+      TINYEXR_SUCCESS) {
     return PathError(path, "cannot read OpenEXR pixels (" + TakeExrError(err) + ")");
   }
   exr.image_loaded = true;
@@ -189,10 +219,16 @@ const std::vector<float>& SrgbTable(int bits) {
   return bits == 8 ? table8 : table16;
 }
 
-Status ReadPng(const std::string& path, Image* image, bool srgb) {
+Status DecodePng(const std::string& data, const std::string& path, Image* image, bool srgb) {
   cv::Mat mat;
   try {
-    mat = cv::imread(path, cv::IMREAD_UNCHANGED);
+    // imdecode needs a non-empty buffer; an empty file is simply not a PNG.
+    if (data.empty()) return PathError(path, "cannot read PNG (empty file)");
+    if (data.size() > static_cast<size_t>(std::numeric_limits<int>::max())) {
+      return PathError(path, "cannot read PNG (file larger than 2 GiB)");
+    }
+    const cv::Mat buffer(1, static_cast<int>(data.size()), CV_8U, const_cast<char*>(data.data()));
+    mat = cv::imdecode(buffer, cv::IMREAD_UNCHANGED);
   } catch (const cv::Exception& e) {
     return PathError(path, "cannot read PNG (" + std::string(e.what()) + ")");
   }
@@ -287,7 +323,17 @@ Status ReadImage(const std::string& path, Image* image, bool srgb) {
     return PathError(path, "unsupported image extension \"" + ext + "\" (expected .exr or .png)");
   }
   SFT_RETURN_IF_ERROR(CheckReadable(path));
-  return ext == "exr" ? ReadExr(path, image) : ReadPng(path, image, srgb);
+  std::string data;
+  SFT_RETURN_IF_ERROR(ReadTextFile(path, &data));
+  return DecodeImage(data, path, image, srgb);
+}
+
+Status DecodeImage(const std::string& data, const std::string& path, Image* image, bool srgb) {
+  const std::string ext = FileExtension(path);
+  if (ext != "exr" && ext != "png") {
+    return PathError(path, "unsupported image extension \"" + ext + "\" (expected .exr or .png)");
+  }
+  return ext == "exr" ? DecodeExr(data, path, image) : DecodePng(data, path, image, srgb);
 }
 
 Status ReadMask(const std::string& path, Image* mask) {

@@ -16,9 +16,14 @@ float LinearToSrgb(float v);
 
 // Reads .exr or .png (by extension, case-insensitive). Channels as stored (1, 3 or 4; a 2-channel
 // grey+alpha PNG becomes 4-channel RGBA). For PNG, colour channels are sRGB-decoded when `srgb`;
-// alpha is never decoded. Errors name the path: missing, unreadable, unsupported extension.
+// alpha is never decoded. Errors name the path: missing, unreadable, unsupported extension, an EXR
+// data window over 65536 pixels a side or over 2 GiB of decoded 32-bit values.
 Status ReadImage(const std::string& path, Image* image, bool srgb = true);
 
+// Decodes the contents of an .exr or .png file held in memory (`data`), as ReadImage does;
+// `path` selects the format by its extension and names the file in errors.
+Status DecodeImage(const std::string& data, const std::string& path, Image* image,
+                   bool srgb = true);
 // Reads a mask PNG: 1 channel, 1.0 where the first channel > 127 (of 255), else 0.0.
 Status ReadMask(const std::string& path, Image* mask);
 

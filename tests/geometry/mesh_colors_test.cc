@@ -248,5 +248,24 @@ TEST(MeshColorsFileTest, MalformedFilesNameFileAndField) {
   EXPECT_THAT(missing.message(), HasSubstr("missing.meshcolors"));
 }
 
+// ParseMeshColors (the fuzzed entry point) is ReadMeshColors without the file read.
+TEST(MeshColorsFileTest, ParseMatchesRead) {
+  testing::TempDir tmp;
+  const MeshColors colors = RandomColors(3, 2, 1);
+  const std::string path = tmp.Join("r.meshcolors");
+  ASSERT_TRUE(WriteMeshColors(path, colors, {"roughness"}).ok());
+  std::ifstream in(path, std::ios::binary);
+  const std::string data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  MeshColors parsed;
+  std::vector<std::string> names;
+  ASSERT_TRUE(ParseMeshColors(data, "buffer.meshcolors", &parsed, &names).ok());
+  EXPECT_EQ(parsed.values(), colors.values());
+  EXPECT_EQ(names, std::vector<std::string>{"roughness"});
+  const Status truncated =
+      ParseMeshColors(data.substr(0, data.size() - 1), "buffer.meshcolors", &parsed);
+  ASSERT_FALSE(truncated.ok());
+  EXPECT_THAT(truncated.message(), ::testing::StartsWith("buffer.meshcolors: payload has"));
+}
+
 }  // namespace
 }  // namespace sft

@@ -5,12 +5,14 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 
+#include "src/core/file_util.h"
 #include "tests/testing/temp_dir.h"
 
 namespace sft {
@@ -466,6 +468,57 @@ TEST(MeshWriteTest, UnknownExtensionFails) {
   ASSERT_FALSE(status.ok());
   EXPECT_THAT(status.message(), HasSubstr("out.stl"));
   EXPECT_FALSE(std::filesystem::exists(tmp.Join("out.stl")));
+}
+
+// ParseMesh (the fuzzed entry point) is ReadMesh without the file read.
+TEST(MeshReadTest, ParseMeshMatchesReadMesh) {
+  for (const std::string name : {"cube_2x2x2_12f.obj", "icosphere_r1_320f.obj"}) {
+    const std::string path = MeshesDir() + "/" + name;
+    std::string text;
+    ASSERT_TRUE(ReadTextFile(path, &text).ok());
+    TriMesh from_file, from_buffer;
+    MeshReport file_report, buffer_report;
+    ASSERT_TRUE(ReadMesh(path, &from_file, &file_report).ok());
+    const Status status = ParseMesh(text, path, &from_buffer, &buffer_report);
+    ASSERT_TRUE(status.ok()) << status.message();
+    ASSERT_EQ(from_buffer.n_vertices(), from_file.n_vertices());
+    ASSERT_EQ(from_buffer.n_faces(), from_file.n_faces());
+    for (size_t v = 0; v < from_file.n_vertices(); ++v) {
+      const auto vh = TriMesh::VertexHandle(static_cast<int>(v));
+      EXPECT_EQ(from_buffer.point(vh), from_file.point(vh));
+    }
+    EXPECT_EQ(buffer_report.num_degenerate_faces, file_report.num_degenerate_faces);
+  }
+  TriMesh mesh;
+  const Status status = ParseMesh("v 0 0 0\n", "in_memory.stl", &mesh);
+  ASSERT_FALSE(status.ok());
+  EXPECT_THAT(status.message(), HasSubstr("in_memory.stl: unknown mesh extension"));
+}
+
+// Found by mesh_ply_fuzzer (data/fuzz_regressions/): an element without properties but with a
+// count of 444444444 made the reader loop for minutes; it occupies no bytes and is skipped.
+TEST(MeshFuzzRegression, PlyElementWithoutPropertiesIsSkipped) {
+  const std::string path =
+      testing::DataDir() + "/fuzz_regressions/mesh_ply_empty_element_timeout.ply";
+  TriMesh mesh;
+  const auto start = std::chrono::steady_clock::now();
+  const Status status = ReadMesh(path, &mesh);
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  ASSERT_FALSE(status.ok());
+  EXPECT_THAT(status.message(), ::testing::StartsWith(path + ": face 1 has 0 vertices"));
+  EXPECT_EQ(status.message().find('\n'), std::string::npos);
+  EXPECT_LT(seconds, 1.0);
+
+  // The same header shape with valid data reads: the empty element is ignored.
+  const std::string ply =
+      "ply\nformat ascii 1.0\nelement nothing 2147483647\nelement vertex 3\nproperty float x\n"
+      "property float y\nproperty float z\nelement face 1\nproperty list uchar int "
+      "vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+  const Status ok = ParseMesh(ply, "empty_element.ply", &mesh);
+  ASSERT_TRUE(ok.ok()) << ok.message();
+  EXPECT_EQ(mesh.n_vertices(), 3u);
+  EXPECT_EQ(mesh.n_faces(), 1u);
 }
 
 }  // namespace

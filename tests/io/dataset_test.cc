@@ -904,5 +904,22 @@ TEST(DatasetWrite, DatasetBuiltInCodeUsesIndices) {
   EXPECT_FALSE(std::filesystem::exists(bad.Join("scene.json")));
 }
 
+// ParseSceneJson (the fuzzed entry point) is ReadDataset without the file read.
+TEST(DatasetRead, ParseSceneJsonMatchesReadDataset) {
+  const std::string dir = testing::DataDir() + "/cycles/bunny_point_diffuse";
+  std::ifstream in(dir + "/scene.json");
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  Dataset from_file, from_buffer;
+  ASSERT_TRUE(ReadDataset(dir, &from_file).ok());
+  const Status status = ParseSceneJson(text, dir, &from_buffer);
+  ASSERT_TRUE(status.ok()) << status.message();
+  EXPECT_EQ(from_buffer.root, dir);
+  ASSERT_EQ(from_buffer.views.size(), from_file.views.size());
+  EXPECT_EQ(from_buffer.views.back().image, from_file.views.back().image);
+  const Status bad = ParseSceneJson("{\"format\": ", "somewhere", &from_buffer);
+  ASSERT_FALSE(bad.ok());
+  EXPECT_THAT(bad.message(), ::testing::StartsWith("somewhere/scene.json: invalid JSON"));
+}
+
 }  // namespace
 }  // namespace sft
