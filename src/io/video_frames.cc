@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <opencv2/core/utils/logger.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
@@ -48,6 +49,17 @@ FrameScore ScoreFrame(const cv::Mat& frame, int index) {
 
 namespace {
 
+// Opens `video` with OpenCV's FFmpeg backend (then any other), with OpenCV's own log silenced so
+// that a file it cannot decode gives only our one error line.
+bool OpenVideo(const std::string& video, cv::VideoCapture* capture) {
+  const auto level = cv::utils::logging::getLogLevel();
+  cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_SILENT);
+  bool opened = capture->open(video, cv::CAP_FFMPEG) && capture->isOpened();
+  if (!opened) opened = capture->open(video, cv::CAP_ANY) && capture->isOpened();
+  cv::utils::logging::setLogLevel(level);
+  return opened;
+}
+
 double ThumbnailDifference(const std::vector<float>& a, const std::vector<float>& b) {
   if (a.size() != b.size() || a.empty()) return 1.0;
   double sum = 0;
@@ -90,8 +102,8 @@ Status ScoreVideoFrames(const std::string& video, std::vector<FrameScore>* score
   scores->clear();
   if (!FileExists(video)) return Status::Error("--video: " + video + ": file not found");
   try {
-    cv::VideoCapture capture(video);
-    if (!capture.isOpened()) {
+    cv::VideoCapture capture;
+    if (!OpenVideo(video, &capture)) {
       return Status::Error("--video: " + video + ": cannot open (not a video OpenCV can decode)");
     }
     const double reported = capture.get(cv::CAP_PROP_FRAME_COUNT);
@@ -122,8 +134,8 @@ Status WriteVideoFrames(const std::string& video, const std::vector<int>& frame_
   names->clear();
   SFT_RETURN_IF_ERROR(MakeDirectories(dir));
   try {
-    cv::VideoCapture capture(video);
-    if (!capture.isOpened()) return Status::Error("--video: " + video + ": cannot open");
+    cv::VideoCapture capture;
+    if (!OpenVideo(video, &capture)) return Status::Error("--video: " + video + ": cannot open");
     cv::Mat frame;
     size_t next = 0;
     for (int index = 0; next < frame_numbers.size() && capture.read(frame); ++index) {

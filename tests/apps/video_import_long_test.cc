@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -55,13 +56,14 @@ TEST(VideoImportLongTest, SyntheticVideoToDatasetAndHull) {
   std::string out;
   auto t = std::chrono::steady_clock::now();
   ASSERT_EQ(
-      RunSft("synth --quiet --mesh " + spot + "/mesh_uv.obj --material '{\"albedo_texture\": \"" +
-                 spot + "/texture.png\", \"colorspace\": \"srgb\", \"roughness\": 0.6}' " +
-                 "--envmap " + probe + " --background-environment --ground --path orbit " +
-                 "--elevation 20,45 --cameras " + std::to_string(kFrames) +
-                 " --zooms 1 --res 480 --fov 45 --fill 0.5 --spp 16 --bounces 1 --out " +
-                 tmp.Join("synth"),
-             &out),
+      testing::RunSft("synth --quiet --mesh " + spot +
+                          "/mesh_uv.obj --material '{\"albedo_texture\": \"" + spot +
+                          "/texture.png\", \"colorspace\": \"srgb\", \"roughness\": 0.6}' " +
+                          "--envmap " + probe + " --background-environment --ground --path orbit " +
+                          "--elevation 20,45 --cameras " + std::to_string(kFrames) +
+                          " --zooms 1 --res 480 --fov 45 --fill 0.5 --spp 16 --bounces 1 --out " +
+                          tmp.Join("synth"),
+                      &out),
       0)
       << out;
   const double synth_seconds = Seconds(t);
@@ -93,9 +95,9 @@ TEST(VideoImportLongTest, SyntheticVideoToDatasetAndHull) {
   const double video_seconds = Seconds(t);
 
   t = std::chrono::steady_clock::now();
-  ASSERT_EQ(RunSft("import video --video " + video + " --frames 40 --masks " + tmp.Join("masks") +
-                       " --out " + tmp.Join("imported"),
-                   &out),
+  ASSERT_EQ(testing::RunSft("import video --video " + video + " --frames 40 --masks " +
+                                tmp.Join("masks") + " --out " + tmp.Join("imported"),
+                            &out),
             0)
       << out;
   const double import_seconds = Seconds(t);
@@ -130,7 +132,7 @@ TEST(VideoImportLongTest, SyntheticVideoToDatasetAndHull) {
   }
 
   t = std::chrono::steady_clock::now();
-  ASSERT_EQ(RunSft("init --quiet --dataset " + tmp.Join("imported"), &out), 0) << out;
+  ASSERT_EQ(testing::RunSft("init --quiet --dataset " + tmp.Join("imported"), &out), 0) << out;
   const double init_seconds = Seconds(t);
   TriMesh hull, gt;
   ASSERT_TRUE(ReadMesh(tmp.Join("imported/init/mesh.ply"), &hull).ok());
