@@ -57,9 +57,15 @@ Status RunColmap(const VideoImportOptions& opts, const std::string& work, int fr
        "--ImageReader.camera_model", opts.camera_model, "--SiftExtraction.use_gpu", "0"},
       log, frames, progress, &report->seconds_features));
   report->matcher = frames <= opts.exhaustive_limit ? "exhaustive_matcher" : "sequential_matcher";
-  SFT_RETURN_IF_ERROR(RunColmapStage(opts.colmap, report->matcher,
-                                     {"--database_path", database, "--SiftMatching.use_gpu", "0"},
-                                     log, frames, progress, &report->seconds_matching));
+  // Exhaustive matching in blocks of 10 images (COLMAP's default 50 reports a single block for a
+  // small video, so the progress line would not move).
+  std::vector<std::string> match_args = {"--database_path", database, "--SiftMatching.use_gpu",
+                                         "0"};
+  if (report->matcher == "exhaustive_matcher") {
+    match_args.insert(match_args.end(), {"--ExhaustiveMatching.block_size", "10"});
+  }
+  SFT_RETURN_IF_ERROR(RunColmapStage(opts.colmap, report->matcher, match_args, log, frames,
+                                     progress, &report->seconds_matching));
   const std::string sparse = JoinPath(work, "sparse");
   SFT_RETURN_IF_ERROR(MakeDirectories(sparse));
   return RunColmapStage(
