@@ -1,7 +1,8 @@
 // sft synth: renders a synthetic dataset of a mesh in the report's setup (DESIGN.md §1): cameras
-// on a Fibonacci sphere looking at the object, one or more zoom levels, a camera-attached point
-// light (or an environment probe), black background, masks from pixel coverage, and the ground
-// truth (normalized mesh and material) under gt/.
+// on a Fibonacci sphere (or an orbit, --path orbit) looking at the object, one or more zoom
+// levels, a camera-attached point light (or an environment probe), black background, masks from
+// pixel coverage, and the ground truth (normalized mesh and material) under gt/. --ground adds a
+// textured ground plane seen in the images only (src/io/synth_scene.h).
 //
 // Decisions (README "sft synth"): the mesh is centred on its bounding-box centre and scaled to a
 // bounding-box diagonal of 1 (--no-normalize keeps it as is); --up-axis y rotates y-up meshes to
@@ -221,6 +222,12 @@ Status RunSynth(const SynthOptions& opts) {
       view.camera = static_cast<int>(z);
       view.light_ids = {dataset.lights[0].id};
       view.lights = {0};
+      // Object-only masks assume the plane never hides the object: every camera above it.
+      if (opts.ground && !(centre.z() > lo.z() + 1e-6)) {
+        return Status::Error("--ground: camera " + std::to_string(index) +
+                             " is not above the ground plane (use --path orbit with a positive "
+                             "--elevation range)");
+      }
       view.cam_from_world = LookAt(centre, target, up);
       dataset.views.push_back(view);
     }
