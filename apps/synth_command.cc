@@ -224,6 +224,7 @@ Status RunSynth(const SynthOptions& opts) {
       view.lights = {0};
       // Object-only masks assume the plane never hides the object: every camera above it.
       if (opts.ground && !(centre.z() > lo.z() + 1e-6)) {
+        fs::remove_all(partial, ec);
         return Status::Error("--ground: camera " + std::to_string(index) +
                              " is not above the ground plane (use --path orbit with a positive "
                              "--elevation range)");
