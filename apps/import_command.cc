@@ -1,10 +1,12 @@
 // sft import: brings captures into the sft-dataset/1 format. `sft import colmap` converts a COLMAP
-// sparse model and its images (src/io/colmap_import.h; decisions in docs/import.md).
+// sparse model and its images (src/io/colmap_import.h); `sft import video` selects frames of a
+// video and runs COLMAP on them first (src/io/video_import.h). Decisions in docs/import.md.
 #include <cstdio>
 #include <memory>
 
 #include "apps/commands.h"
 #include "src/io/colmap_import.h"
+#include "src/io/video_import.h"
 
 namespace sft {
 namespace {
@@ -38,6 +40,51 @@ int RunImportColmap(const ColmapImportOptions& opts) {
     }
   }
   return 0;
+}
+
+int RunImportVideo(const VideoImportOptions& opts) {
+  VideoImportReport report;
+  const Status status = ImportVideo(opts, &report);
+  if (!status.ok()) return PrintError("import video", status);
+  if (!opts.quiet) {
+    std::fprintf(stderr,
+                 "sft import video: %d of %d decoded frames selected; COLMAP registered %d (%s, "
+                 "%d model(s), mean reprojection error %.3f px); frames %.1f s, features %.1f s, "
+                 "matching %.1f s, mapping %.1f s; total %.1f s\n",
+                 report.frames_selected, report.frames_decoded, report.registered,
+                 report.matcher.c_str(), report.models, report.reprojection_error,
+                 report.seconds_frames, report.seconds_features, report.seconds_matching,
+                 report.seconds_mapping, report.seconds);
+  }
+  return 0;
+}
+
+void SetupImportVideo(CLI::App* video, VideoImportOptions* opts) {
+  video->add_option("--video", opts->video, "Input video (any format OpenCV decodes)")->required();
+  video->add_option("--out", opts->out, "Output dataset folder")->required();
+  video->add_option("--frames", opts->selection.frames, "Frames to select (sharpest per segment)")
+      ->capture_default_str();
+  video
+      ->add_option("--duplicate-threshold", opts->selection.duplicate_threshold,
+                   "Mean 32x32 thumbnail difference below which a frame is a near-duplicate")
+      ->capture_default_str();
+  video->add_option("--probe", opts->probe,
+                    "Equirectangular probe, added as an environment light (not yet aligned)");
+  video->add_option("--masks", opts->masks,
+                    "Folder of masks named like the frames (frame_NNNNNN.png), or auto (GrabCut)");
+  video
+      ->add_option("--min-registered", opts->min_registered,
+                   "Fraction of the selected frames COLMAP must register")
+      ->capture_default_str();
+  video
+      ->add_option("--exhaustive-limit", opts->exhaustive_limit,
+                   "Exhaustive matching up to this many frames, sequential beyond")
+      ->capture_default_str();
+  video->add_option("--camera-model", opts->camera_model, "Shared COLMAP camera model")
+      ->capture_default_str();
+  video->add_option("--colmap", opts->colmap, "COLMAP executable")->capture_default_str();
+  video->add_flag("--overwrite", opts->overwrite, "Replace an existing output folder");
+  video->add_flag("--quiet", opts->quiet, "No progress or summary line");
 }
 
 }  // namespace
@@ -76,8 +123,13 @@ CommandRunner SetupImportCommand(CLI::App* app) {
                    "Ignore fused.ply / meshed-*.ply beside the model");
   colmap->add_flag("--overwrite", opts->overwrite, "Replace an existing output folder");
   colmap->add_flag("--quiet", opts->quiet, "No progress or summary line");
-  return [opts, colmap]() {
+  CLI::App* video = app->add_subcommand(
+      "video", "Select frames of a video, run COLMAP (CPU) on them and import the result");
+  auto video_opts = std::make_shared<VideoImportOptions>();
+  SetupImportVideo(video, video_opts.get());
+  return [opts, colmap, video_opts, video]() {
     if (colmap->parsed()) return RunImportColmap(*opts);
+    if (video->parsed()) return RunImportVideo(*video_opts);
     return 2;
   };
 }

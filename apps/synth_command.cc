@@ -1,7 +1,8 @@
 // sft synth: renders a synthetic dataset of a mesh in the report's setup (DESIGN.md §1): cameras
-// on a Fibonacci sphere looking at the object, one or more zoom levels, a camera-attached point
-// light (or an environment probe), black background, masks from pixel coverage, and the ground
-// truth (normalized mesh and material) under gt/.
+// on a Fibonacci sphere (or an orbit, --path orbit) looking at the object, one or more zoom
+// levels, a camera-attached point light (or an environment probe), black background, masks from
+// pixel coverage, and the ground truth (normalized mesh and material) under gt/. --ground adds a
+// textured ground plane seen in the images only (src/io/synth_scene.h).
 //
 // Decisions (README "sft synth"): the mesh is centred on its bounding-box centre and scaled to a
 // bounding-box diagonal of 1 (--no-normalize keeps it as is); --up-axis y rotates y-up meshes to
@@ -9,9 +10,11 @@
 // the bounding sphere at --fill of the half-image at zoom 1; zoom z multiplies the focal length.
 // The default light intensity gives a white Lambertian patch facing the camera at the object's
 // centre a radiance of 0.5. The dataset is written to OUT.partial and renamed to OUT at the end.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <memory>
 #include <nlohmann/json.hpp>
 
 #include "apps/commands.h"
@@ -22,6 +25,7 @@
 #include "src/io/dataset.h"
 #include "src/io/image_io.h"
 #include "src/io/scene_setup.h"
+#include "src/io/synth_scene.h"
 #include "src/render/camera_rig.h"
 #include "src/render/render.h"
 
@@ -50,6 +54,10 @@ struct SynthOptions {
   std::string effects = "all";          // enabled effects (Effects::Parse).
   bool overwrite = false;               // replace an existing, non-empty output directory.
   bool quiet = false;                   // no progress line.
+  bool ground = false;                  // add a textured ground plane (rendered, not in gt/).
+  GroundOptions ground_options;         // the plane's size and texture (src/io/synth_scene.h).
+  std::string path = "sphere";          // camera path: "sphere" (Fibonacci) or "orbit".
+  std::vector<double> elevation = {15.0, 40.0};  // orbit elevation range, degrees, [-89, 89].
 
   // Errors name the command-line flag and the value; NaN fails every range test. --spp,
   // --bounces and --threads are checked by RenderOptions::Check.
@@ -86,6 +94,12 @@ struct SynthOptions {
     if (!(envmap_scale >= 0 && envmap_scale <= 1e30)) {
       return Fail(why, "--envmap-scale: must be in [0, 1e30], got " + Text(envmap_scale));
     }
+    if (path != "sphere" && path != "orbit") return Fail(why, "--path: must be sphere or orbit");
+    if (elevation.size() != 2 ||
+        !(elevation[0] >= -89 && elevation[0] <= elevation[1] && elevation[1] <= 89)) {
+      return Fail(why, "--elevation: needs lo,hi degrees with -89 <= lo <= hi <= 89");
+    }
+    if (ground && !ground_options.Check(why)) return false;
     if (environment_background && envmap.empty()) {
       return Fail(why, "--background-environment: needs --envmap");
     }
@@ -190,10 +204,15 @@ Status RunSynth(const SynthOptions& opts) {
     if (opts.environment_background) dataset.background = Background::kEnvironment;
   }
   const Eigen::Vector3d up(0, 0, 1);
+  const std::vector<Eigen::Vector3d> orbit =
+      OrbitPath(opts.cameras, target, distance, opts.elevation[0], opts.elevation[1]);
   int index = 0;
   for (size_t z = 0; z < opts.zooms.size(); ++z) {
     for (int k = 0; k < opts.cameras; ++k, ++index) {
-      const Eigen::Vector3d dir = FibonacciSphereDirection(k, opts.cameras);
+      const Eigen::Vector3d centre =
+          opts.path == "orbit"
+              ? orbit[k]
+              : Eigen::Vector3d(target + distance * FibonacciSphereDirection(k, opts.cameras));
       ViewSpec view;
       char name[32];
       std::snprintf(name, sizeof(name), "%03d", index);
@@ -203,20 +222,42 @@ Status RunSynth(const SynthOptions& opts) {
       view.camera = static_cast<int>(z);
       view.light_ids = {dataset.lights[0].id};
       view.lights = {0};
-      view.cam_from_world = LookAt(target + distance * dir, target, up);
+      // Object-only masks assume the plane never hides the object: every camera above it.
+      if (opts.ground && !(centre.z() > lo.z() + 1e-6)) {
+        fs::remove_all(partial, ec);
+        return Status::Error("--ground: camera " + std::to_string(index) +
+                             " is not above the ground plane (use --path orbit with a positive "
+                             "--elevation range)");
+      }
+      view.cam_from_world = LookAt(centre, target, up);
       dataset.views.push_back(view);
     }
   }
   DatasetViews views;
   SFT_RETURN_IF_ERROR(MakeDatasetViews(dataset, &views));
-  const RenderScene scene(mesh);
+  // With --ground the images show object + plane; masks come from a coverage pass of the object
+  // alone (the plane, below every camera, never hides the object: src/io/synth_scene.h).
+  TriMesh scene_mesh;
+  Material scene_material;
+  if (opts.ground) {
+    SFT_RETURN_IF_ERROR(
+        AddGroundPlane(mesh, material, opts.ground_options, &scene_mesh, &scene_material));
+  }
+  const RenderScene scene(opts.ground ? scene_mesh : mesh);
+  std::unique_ptr<RenderScene> object_scene;
+  if (opts.ground) object_scene = std::make_unique<RenderScene>(mesh);
+  RenderOptions coverage = render;
+  coverage.spp = std::min(render.spp, 16);
+  coverage.bounces = 1;
   Progress progress("synth", static_cast<int64_t>(views.views.size()), !opts.quiet);
   for (size_t v = 0; v < views.views.size(); ++v) {
-    Image image;
-    RenderView(scene, material, views.views[v], render, &image);
+    Image image, object_image;
+    RenderView(scene, opts.ground ? scene_material : material, views.views[v], render, &image);
+    if (opts.ground) RenderView(*object_scene, material, views.views[v], coverage, &object_image);
+    const Image& alpha = opts.ground ? object_image : image;
     Image mask(image.width, image.height, 1);
     for (int y = 0; y < image.height; ++y) {
-      for (int x = 0; x < image.width; ++x) mask.at(x, y) = image.at(x, y, 3) > 0.5f ? 1.f : 0.f;
+      for (int x = 0; x < image.width; ++x) mask.at(x, y) = alpha.at(x, y, 3) > 0.5f ? 1.f : 0.f;
     }
     SFT_RETURN_IF_ERROR(WriteExr(JoinPath(partial, dataset.views[v].image), image));
     SFT_RETURN_IF_ERROR(WritePng(JoinPath(partial, dataset.views[v].mask), mask, false));
@@ -286,6 +327,26 @@ CommandRunner SetupSynthCommand(CLI::App* app) {
       ->capture_default_str();
   app->add_option("--seed", opts->render.seed, "Sample seed")->capture_default_str();
   app->add_option("--threads", opts->render.threads, "Worker threads (0 = all cores)")
+      ->capture_default_str();
+  app->add_flag(
+      "--ground", opts->ground,
+      "Add a textured ground plane under the object (in the images, not in gt/ or masks)");
+  app->add_option("--ground-size", opts->ground_options.half_size,
+                  "Ground plane half side, in object bounding-box diagonals")
+      ->capture_default_str();
+  app->add_option("--ground-cells", opts->ground_options.cells, "Ground grid cells per side")
+      ->capture_default_str();
+  app->add_option("--ground-feature", opts->ground_options.feature,
+                  "Finest ground-texture wavelength, in object diagonals")
+      ->capture_default_str();
+  app->add_option(
+         "--path", opts->path,
+         "Camera path: sphere (Fibonacci sphere) or orbit (one turn, elevation oscillating "
+         "twice between --elevation lo,hi; views in path order)")
+      ->capture_default_str();
+  app->add_option("--elevation", opts->elevation, "Orbit elevation range lo,hi in degrees")
+      ->delimiter(',')
+      ->expected(2)
       ->capture_default_str();
   app->add_flag("--overwrite", opts->overwrite, "Replace an existing output directory");
   app->add_flag("--quiet", opts->quiet, "No progress line");
