@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <mutex>
@@ -201,6 +202,8 @@ void RenderScene::BuildEdges() {
 }
 
 void RenderScene::UpdateDerived() {
+  static std::atomic<uint64_t> next_state_id{1};
+  state_id_ = next_state_id.fetch_add(1);
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
   Eigen::Vector3d hi = -lo;
   bool any = false;

@@ -10,6 +10,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <cstdint>
 #include <vector>
 
 #include "src/geometry/material.h"
@@ -110,6 +111,10 @@ class RenderScene {
   // and distance thresholds scale with it, so far-away faces do not change those of the others.
   double FaceScale(int face) const { return face_scales_[face]; }
   RTCScene embree_scene() const { return scene_; }
+  // Identifies the geometry state (faces and positions): unique within the process, a new one
+  // at construction and at every SetVertices. Caches of per-mesh-state structures (texel
+  // segments, edge tables, shadow-edge candidates) key on it.
+  uint64_t state_id() const { return state_id_; }
 
  private:
   void Build();
@@ -127,6 +132,7 @@ class RenderScene {
   std::vector<EdgeCopy> edge_copies_;
   std::vector<int> welded_;
   double extent_ = 1.0;
+  uint64_t state_id_ = 0;
   RTCScene scene_ = nullptr;
   RTCGeometry geometry_ = nullptr;
   float* vertex_buffer_ = nullptr;  // owned by Embree.

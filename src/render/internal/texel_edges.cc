@@ -233,8 +233,9 @@ std::vector<TexelSegment> BuildTexelSegments(const RenderScene& scene, const Mat
   return segments;
 }
 
-// A 64-bit fingerprint of everything BuildTexelSegments reads: the faces and positions (which
-// edges are coplanar), both mesh-colors grids and their values, and `glossy`.
+// A 64-bit fingerprint of everything BuildTexelSegments reads: the mesh state (faces and
+// positions decide which edges are coplanar), both mesh-colors grids and their values, and
+// `glossy`.
 uint64_t SegmentsKey(const RenderScene& scene, const Material& material, bool glossy) {
   uint64_t key = Mix64(glossy ? 0x6C055Eull : 0xD1FF05Eull);
   const auto add_bits = [&key](const void* data, size_t bytes) {
@@ -247,8 +248,8 @@ uint64_t SegmentsKey(const RenderScene& scene, const Material& material, bool gl
     for (size_t i = bytes - bytes % 8; i < bytes; ++i) key = Mix64(key ^ p[i]);
     key = Mix64(key ^ bytes);
   };
-  add_bits(scene.faces().data(), scene.faces().size() * sizeof(Eigen::Vector3i));
-  add_bits(scene.positions().data(), scene.positions().size() * sizeof(Eigen::Vector3d));
+  const uint64_t state = scene.state_id();
+  add_bits(&state, sizeof(state));
   for (const MeshColors* colors : {&material.albedo, &material.roughness}) {
     const int shape[2] = {colors->num_faces(), colors->resolution()};
     add_bits(shape, sizeof(shape));

@@ -39,8 +39,8 @@ void AddTexelPointRows(const RenderScene& scene, int face, int other, const Eige
 // and edges between coplanar, equally oriented faces, each cut where other grid lines cross so
 // that a piece separates two texels, kept where the two sides' materials differ (roughness only
 // counts with the glossy lobe on). They depend on the mesh state (faces, and positions through
-// coplanarity) and the material, not on the view: the last set is kept (keyed by a fingerprint of
-// those inputs) and shared until they change.
+// coplanarity) and the material, not on the view: the last set is kept (keyed by the scene's
+// state_id and a fingerprint of the material) and shared until they change.
 std::shared_ptr<const std::vector<TexelSegment>> TexelSegments(const RenderScene& scene,
                                                                const Material& material,
                                                                bool glossy);
