@@ -186,6 +186,11 @@ CommandRunner SetupBenchCommand(CLI::App* app) {
   gradient->add_flag("--keep-rows", gradient_opts->cost.keep_rows,
                      "Hold every view's Jacobian rows until the end of the pass (default: one "
                      "view's at a time) and report the total resident memory");
+  gradient
+      ->add_option("--noise-seeds", gradient_opts->cost.noise_seeds,
+                   "Also repeat the adjoint pass with this many render seeds (0 = off, or 2..64) "
+                   "and report the vertex gradient's seed-to-seed noise and cost x variance")
+      ->capture_default_str();
   AddEdgeBudgetOptions(gradient, &gradient_opts->cost.derivatives);
   gradient->add_option("--json", gradient_opts->json, "Also write the results to this JSON file");
   gradient->add_flag("--quiet", gradient_opts->quiet, "No progress lines");

@@ -134,6 +134,10 @@ bool DerivativeCostOptions::Check(std::string* why) const {
     *why = "res: must be in [1, 4096], got " + std::to_string(resolution);
     return false;
   }
+  if (noise_seeds != 0 && (noise_seeds < 2 || noise_seeds > 64)) {
+    *why = "noise-seeds: must be 0 or in [2, 64], got " + std::to_string(noise_seeds);
+    return false;
+  }
   if (!derivatives.Check(why)) return false;
   RenderOptions render;
   render.spp = spp;
@@ -210,23 +214,24 @@ void RowsPass(const CostScene& s, const RenderOptions& render, const DerivativeR
       options.keep_rows ? result->rows_bytes_total : result->rows_bytes_peak_view;
 }
 
-// (3) Forward + adjoint gradient for fixed random weights of each view's size.
-void AdjointPass(const CostScene& s, const RenderOptions& render, DerivativeRequest request,
-                 const DerivativeCostOptions& options, DerivativeCostReport* result) {
-  BeginPass(result, &result->adjoint);
+// Σ_views Jᵀw of the adjoint request with fixed random weights of each view's size (seeded by
+// options.seed), rendered with `render`'s seed; adds the render time and rays to *cost.
+std::vector<double> AdjointGradient(const CostScene& s, const RenderOptions& render,
+                                    DerivativeRequest request, const DerivativeCostOptions& options,
+                                    const char* label, DerivativePassCost* cost) {
   std::vector<double> gradient;
-  Progress progress("adjoint", static_cast<int64_t>(s.views->size()), options.progress);
+  Progress progress(label, static_cast<int64_t>(s.views->size()), options.progress);
   for (const ViewSetup& view : *s.views) {
     const Image weights = MakeWeights(view.camera.width, view.camera.height, options.seed);
     request.adjoint_weights = &weights;
     Image image;
     DerivativeOutput output;
     RenderStats stats;
-    result->adjoint.seconds += WallSeconds([&] {
+    cost->seconds += WallSeconds([&] {
       RenderViewWithDerivatives(*s.scene, *s.material, view, render, request, s.num_lights, &image,
                                 &output, &stats);
     });
-    AddRays(stats, &result->adjoint.rays);
+    AddRays(stats, &cost->rays);
     if (gradient.empty()) gradient.assign(output.gradient.size(), 0.0);
     for (size_t i = 0; i < gradient.size() && i < output.gradient.size(); ++i) {
       gradient[i] += output.gradient[i];
@@ -234,10 +239,51 @@ void AdjointPass(const CostScene& s, const RenderOptions& render, DerivativeRequ
     progress.Advance();
   }
   progress.Finish();
+  return gradient;
+}
+
+// (3) Forward + adjoint gradient for fixed random weights.
+void AdjointPass(const CostScene& s, const RenderOptions& render, const DerivativeRequest& request,
+                 const DerivativeCostOptions& options, DerivativeCostReport* result) {
+  BeginPass(result, &result->adjoint);
+  const std::vector<double> gradient =
+      AdjointGradient(s, render, request, options, "adjoint", &result->adjoint);
   EndPass(&result->adjoint);
   double sum2 = 0.0;
   for (double g : gradient) sum2 += g * g;
   result->gradient_norm = std::sqrt(sum2);
+}
+
+// The noise measurement (DerivativeCostOptions::noise_seeds): the vertex part of the adjoint
+// gradient over several render seeds.
+void NoisePasses(const CostScene& s, RenderOptions render, const DerivativeRequest& request,
+                 const DerivativeCostOptions& options, DerivativeCostReport* result) {
+  const int n = options.noise_seeds;
+  const size_t num_vertex = 3 * s.scene->positions().size();
+  std::vector<std::vector<double>> gradients;
+  DerivativePassCost cost;
+  for (int k = 0; k < n; ++k) {
+    render.seed = options.seed + 1 + static_cast<uint64_t>(k);
+    std::vector<double> g = AdjointGradient(s, render, request, options, "noise", &cost);
+    g.resize(num_vertex);  // the vertex coordinates come first in the layout.
+    gradients.push_back(std::move(g));
+  }
+  std::vector<double> mean(num_vertex, 0.0);
+  for (const auto& g : gradients) {
+    for (size_t i = 0; i < num_vertex; ++i) mean[i] += g[i] / n;
+  }
+  double spread2 = 0.0, mean2 = 0.0;
+  for (size_t i = 0; i < num_vertex; ++i) mean2 += mean[i] * mean[i];
+  for (const auto& g : gradients) {
+    for (size_t i = 0; i < num_vertex; ++i) spread2 += (g[i] - mean[i]) * (g[i] - mean[i]);
+  }
+  result->noise_seeds = n;
+  // E‖ḡ‖² = ‖E g‖² + tr(Cov)/N, and spread2/(N − 1) estimates tr(Cov): the noise is relative to
+  // the unbiased estimate of ‖E g‖² (all configurations of unbiased estimators share E g).
+  const double trace = spread2 / (n - 1);
+  const double signal2 = mean2 - trace / n;
+  result->vertex_noise = signal2 > 0.0 ? std::sqrt(trace / signal2) : 0.0;
+  result->noise_adjoint_seconds = cost.seconds / n;
 }
 
 // The three passes over `s`; `result` already holds the setup fields.
@@ -282,11 +328,16 @@ Status MeasureScene(const CostScene& s, const DerivativeCostOptions& options,
   ForwardPass(s, render, options.progress, result);
   RowsPass(s, render, rows_request, options, result);
   AdjointPass(s, render, adjoint_request, options, result);
+  if (options.noise_seeds > 0) NoisePasses(s, render, adjoint_request, options, result);
 
   const double forward = result->forward.seconds;
   result->forward.ratio = forward > 0.0 ? 1.0 : 0.0;
   result->jacobian_rows.ratio = forward > 0.0 ? result->jacobian_rows.seconds / forward : 0.0;
   result->adjoint.ratio = forward > 0.0 ? result->adjoint.seconds / forward : 0.0;
+  if (result->noise_seeds > 0 && forward > 0.0) {
+    result->cost_times_variance =
+        result->noise_adjoint_seconds / forward * result->vertex_noise * result->vertex_noise;
+  }
   return Status::Ok();
 }
 
@@ -369,6 +420,12 @@ nlohmann::json DerivativeCostReportToJson(const DerivativeCostReport& report) {
                            {"keep_rows", report.keep_rows}};
   json["peak_rss_reset"] = report.peak_rss_reset;
   json["gradient_norm"] = report.gradient_norm;
+  if (report.noise_seeds > 0) {
+    json["noise"] = {{"seeds", report.noise_seeds},
+                     {"vertex_noise", report.vertex_noise},
+                     {"adjoint_seconds_mean", report.noise_adjoint_seconds},
+                     {"cost_times_variance", report.cost_times_variance}};
+  }
   json["aim_ratio"] = kAim;
   json["aim_met"] = report.jacobian_rows.ratio <= kAim && report.adjoint.ratio <= kAim;
   return json;
@@ -413,6 +470,13 @@ std::string DerivativeCostReportTable(const DerivativeCostReport& report) {
   const bool met = report.jacobian_rows.ratio <= kAim && report.adjoint.ratio <= kAim;
   add("aim <= %.0fx    rows %.2fx, adjoint %.2fx: %s\n", kAim, report.jacobian_rows.ratio,
       report.adjoint.ratio, met ? "met" : "not met");
+  if (report.noise_seeds > 0) {
+    add("noise          vertex gradient %.2f%% (seed-to-seed, %d seeds); adjoint %.3f s mean = "
+        "%.2fx; cost x variance %.4g (forward passes x relative variance)\n",
+        100.0 * report.vertex_noise, report.noise_seeds, report.noise_adjoint_seconds,
+        report.forward.seconds > 0.0 ? report.noise_adjoint_seconds / report.forward.seconds : 0.0,
+        report.cost_times_variance);
+  }
   if (!report.peak_rss_reset) {
     add("note           peak RSS could not be reset per pass: it is the process peak so far\n");
   }

@@ -46,6 +46,10 @@ struct DerivativeCostOptions {
   uint64_t seed = 0;       // sample seed of every pass; also seeds the albedo and the weights.
   bool keep_rows = false;  // hold every view's Jacobian rows until the end of the rows pass.
   bool progress = false;   // print a progress line per pass on stderr.
+  // Seeds of the noise measurement, 0 (off) or in [2, 64]: the adjoint pass is repeated with
+  // render seeds seed + 1 … seed + noise_seeds (same weights) and the seed-to-seed spread of the
+  // vertex part of Σ_views Jᵀw is reported (DerivativeCostReport::vertex_noise).
+  int noise_seeds = 0;
   // Edge-sampling budgets of both derivative passes (DerivativeRequest defaults unless changed);
   // its parameter selection and outputs are set by the benchmark.
   DerivativeRequest derivatives;
@@ -85,6 +89,17 @@ struct DerivativeCostReport {
   int64_t rows_bytes_resident = 0;   // the most rows memory alive at once: the peak view, or the
                                      // total with keep_rows.
   double gradient_norm = 0.0;  // ‖Σ_views Jᵀw‖₂ of the adjoint pass (a sanity value).
+
+  // With noise_seeds: the vertex gradient's noise √(T/S) over the N seeds' vertex gradients g_k,
+  // T = Σ_k ‖g_k − ḡ‖²/(N − 1) (the trace of one seed's covariance) and S = ‖ḡ‖² − T/N (the
+  // unbiased estimate of ‖E g‖²; 0 when that is not positive), the mean adjoint
+  // seconds of those passes, and the efficiency (mean seconds / forward seconds) × noise²: the
+  // time, in forward passes, to reach unit relative variance (lower is better; halving it halves
+  // the time to reach any given noise).
+  int noise_seeds = 0;
+  double vertex_noise = 0.0;
+  double noise_adjoint_seconds = 0.0;
+  double cost_times_variance = 0.0;
 };
 
 // Runs the three passes on `mesh` (see the file comment). Errors: invalid options, a mesh without

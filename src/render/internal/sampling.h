@@ -6,6 +6,7 @@
 #define SFT_RENDER_INTERNAL_SAMPLING_H_
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -29,18 +30,27 @@ class DiscreteDistribution {
   int size() const { return static_cast<int>(cumulative_.size()); }
   double total() const { return total_; }
   double weight(int i) const { return weights_[i]; }
+  // Sample for each of u[0 … n): the interface ResampleSegmentPoint's proposals share.
+  void SampleBatch(const double* u, int n, int* out) const {
+    for (int k = 0; k < n; ++k) out[k] = Sample(u[k]);
+  }
+  // Σw / w_i: the inverse of index i's probability.
+  double InverseProbability(int i) const { return total_ / weights_[i]; }
   // Σ_{j<i} w_j.
   double CumulativeBefore(int i) const { return i > 0 ? cumulative_[i - 1] : 0.0; }
   // The index i with Σ_{j<i} w_j ≤ u·Σw < Σ_{j≤i} w_j (the last index for u·Σw at the end).
   int SampleInverse(double u) const;
   // The alias-table draw for u ∈ [0, 1).
   int Sample(double u) const;
-
- private:
+  // Cell i of the alias table (Sample keeps i with `probability`, else takes `alias`), for
+  // tables that pack it next to their own data.
   struct Cell {
     double probability = 1.0;  // of keeping index i in cell i.
     int alias = 0;
   };
+  const Cell& cell(int i) const { return cells_[i]; }
+
+ private:
   std::vector<double> weights_;
   std::vector<double> cumulative_;
   std::vector<Cell> cells_;
@@ -67,8 +77,9 @@ bool AngleUniformEdgePoint(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                            const Eigen::Vector3d& x, double xi, double* s, double* subtended);
 
 // One (segment, point) pair drawn by resampled importance sampling (Talbot et al. 2005):
-// `num_candidates` segments drawn from `table` (pdf w_c/Σw), each with a point uniform in the
-// angle it subtends at x, weighted w_k = p̂_k·Θ_k/p_k with p̂ = `target`(ω_k), one kept ∝ w_k.
+// `num_candidates` segments drawn from `proposal` (any type with `SampleBatch(u, n, out)` and
+// `double InverseProbability(int c)`, e.g. DiscreteDistribution), each with a point uniform in
+// the angle it subtends at x, weighted w_k = p̂_k·Θ_k/p_k with p̂ = `target`(ω_k), one kept ∝ w_k.
 // `ends(c, &a, &b)` gives candidate c's endpoints, or false where it cannot be a jump seen from
 // x (p̂ = 0). The first candidate uses (u_index, u_point), the rest `sampler`.
 struct ResampledPoint {
@@ -77,25 +88,38 @@ struct ResampledPoint {
   double inv_pdf = 0.0;  // Θ/(p·p̂) replaced by (1/K)Σ_k w_k/p̂: the estimate's weight/jump.
 };
 
-template <typename Ends, typename Target>
-ResampledPoint ResampleSegmentPoint(const DiscreteDistribution& table, int num_candidates,
+// At most this many candidates per draw.
+constexpr int kMaxResampleCandidates = 32;
+
+template <typename Proposal, typename Ends, typename Target>
+ResampledPoint ResampleSegmentPoint(const Proposal& proposal, int num_candidates,
                                     const Eigen::Vector3d& x, double u_index, double u_point,
                                     Sampler* sampler, const Ends& ends, const Target& target) {
+  // All candidates are drawn (and their data prefetched) before any is weighed, so that their
+  // memory loads overlap; the random numbers are consumed in the same order either way.
+  int index[kMaxResampleCandidates];
+  double point_u[kMaxResampleCandidates], pick_u[kMaxResampleCandidates];
+  num_candidates = std::min(num_candidates, kMaxResampleCandidates);
+  double index_u[kMaxResampleCandidates];
+  for (int k = 0; k < num_candidates; ++k) {
+    index_u[k] = k == 0 ? u_index : sampler->Next1D();
+    point_u[k] = k == 0 ? u_point : sampler->Next1D();
+    pick_u[k] = sampler->Next1D();
+  }
+  proposal.SampleBatch(index_u, num_candidates, index);
   ResampledPoint out;
   double w_sum = 0.0, kept_target = 0.0;
   for (int k = 0; k < num_candidates; ++k) {
-    const int c = table.Sample(k == 0 ? u_index : sampler->Next1D());
-    const double xi = k == 0 ? u_point : sampler->Next1D();
-    const double pick = sampler->Next1D();
+    const int c = index[k];
     Eigen::Vector3d a, b;
     if (!ends(c, &a, &b)) continue;
     double s_k = 0.0, subtended = 0.0;
-    if (!AngleUniformEdgePoint(a, b, x, xi, &s_k, &subtended)) continue;
+    if (!AngleUniformEdgePoint(a, b, x, point_u[k], &s_k, &subtended)) continue;
     const double p_hat = target((a + s_k * (b - a) - x).normalized());
-    const double w = p_hat * subtended * table.total() / table.weight(c);
+    const double w = p_hat * subtended * proposal.InverseProbability(c);
     if (!(w > 0.0) || !std::isfinite(w)) continue;
     w_sum += w;
-    if (pick * w_sum < w) {
+    if (pick_u[k] * w_sum < w) {
       out.index = c;
       out.s = s_k;
       kept_target = p_hat;

@@ -41,25 +41,6 @@ void AddSecondaryTexels(const RenderScene& scene, const Material& material, bool
   if (!out->texels.empty()) out->texels_by_weight = DiscreteDistribution(weights);
 }
 
-// Mesh edges that can be a silhouette or crease from some viewpoint, ∝ length.
-void AddSecondaryMeshEdges(const RenderScene& scene, SecondaryEdges* out) {
-  std::vector<double> lengths;
-  for (size_t e = 0; e < scene.edges().size(); ++e) {
-    const MeshEdge& edge = scene.edges()[e];
-    const double length = (scene.positions()[edge.v1] - scene.positions()[edge.v0]).norm();
-    if (!(length > 0.0) || !std::isfinite(length)) continue;
-    if (edge.num_faces == 2) {
-      Eigen::Vector3d n0, n1;
-      ConsistentEdgeNormals(scene, edge, &n0, &n1);
-      // Coplanar neighbours (consistently oriented): never a silhouette nor a crease.
-      if (!n0.isZero() && !n1.isZero() && n0.dot(n1) > 1.0 - 1e-12) continue;
-    }
-    out->edges.push_back(static_cast<int>(e));
-    lengths.push_back(length);
-  }
-  if (!out->edges.empty()) out->by_length = DiscreteDistribution(lengths);
-}
-
 // A path vertex x where secondary edges are sampled, and what its samples share.
 struct SecondaryVertex {
   const Context& ctx;
@@ -166,25 +147,24 @@ bool TwoSidedJump(const SecondaryVertex& v, const SphereCurvePoint& point, const
 // without it, the few points that land in a narrow lobe carry heavy-tailed weights.
 void SampleMeshEdge(const SecondaryVertex& v, double u_index, double u_point, Sampler* sampler,
                     PathDerivatives* path, RenderStats* stats) {
-  const SecondaryEdges& secondary = *v.ctx.secondary;
+  const MeshEdgeTable& table = *v.ctx.secondary->mesh_edges;
   const RenderScene& scene = v.ctx.scene;
-  const auto& positions = scene.positions();
-  if (secondary.edges.empty()) return;
+  if (table.empty()) return;
   auto edge_ends = [&](int c, Eigen::Vector3d* a, Eigen::Vector3d* b) {
-    const MeshEdge& edge = scene.edges()[secondary.edges[c]];
-    if (edge.f0 == v.face || edge.f1 == v.face) return false;
-    *a = positions[edge.v0];
-    *b = positions[edge.v1];
+    const MeshEdgeTable::Record& r = table.record(c);
+    if (r.f0 == v.face || r.f1 == v.face) return false;
+    *a = r.a.cast<double>();
+    *b = r.b.cast<double>();
     if (!(std::max(v.n.dot(*a - v.x), v.n.dot(*b - v.x)) > 0.0)) return false;
-    return IsDiscontinuityEdge(scene, edge, v.x, /*creases=*/v.indirect);
+    return table.IsDiscontinuity(c, v.x, /*creases=*/v.indirect);
   };
-  const ResampledPoint kept = ResampleSegmentPoint(
-      secondary.by_length, kSecondaryCandidates, v.x, u_index, u_point, sampler, edge_ends,
-      [&](const Eigen::Vector3d& omega) { return v.BsdfCosine(omega); });
+  const ResampledPoint kept =
+      ResampleSegmentPoint(table, kSecondaryCandidates, v.x, u_index, u_point, sampler, edge_ends,
+                           [&](const Eigen::Vector3d& omega) { return v.BsdfCosine(omega); });
   if (kept.index < 0) return;
-  const MeshEdge& edge = scene.edges()[secondary.edges[kept.index]];
-  const Eigen::Vector3d& a = positions[edge.v0];
-  const Eigen::Vector3d& b = positions[edge.v1];
+  const MeshEdge& edge = scene.edges()[table.edge(kept.index)];
+  const Eigen::Vector3d& a = scene.positions()[edge.v0];
+  const Eigen::Vector3d& b = scene.positions()[edge.v1];
   const Eigen::Vector3d y = a + kept.s * (b - a);
   SphereCurvePoint point;
   if (!SphereCurveAt(
@@ -307,7 +287,7 @@ SecondaryEdges BuildSecondaryEdges(const RenderScene& scene, const Material& mat
     AddSecondaryTexels(scene, material, options.effects.specular && material.specular > 0.0, &out);
   }
   out.environment = environment && options.effects.shadows;
-  AddSecondaryMeshEdges(scene, &out);
+  out.mesh_edges = MeshEdgeTable::Of(scene);
   if (options.effects.shadows && max_segments > 1) {
     for (const PointLight& light : view.point_lights) {
       std::vector<EdgeCandidate> candidates = ShadowEdgeCandidates(scene, light.position);

@@ -25,11 +25,13 @@
 #define SFT_RENDER_INTERNAL_SECONDARY_EDGES_H_
 
 #include <Eigen/Core>
+#include <memory>
 #include <vector>
 
 #include "src/core/rng.h"
 #include "src/render/internal/context.h"
 #include "src/render/internal/edge_sampling.h"
+#include "src/render/internal/mesh_edge_table.h"
 #include "src/render/internal/sampling.h"
 #include "src/render/internal/texel_edges.h"
 
@@ -40,9 +42,9 @@ class PathDerivatives;
 
 // The candidates of one view's secondary edge samples.
 struct SecondaryEdges {
-  std::vector<int> edges;          // mesh edges where radiance can jump for some viewpoint.
-  DiscreteDistribution by_length;  // over `edges`, ∝ length.
-  bool environment = false;        // the environment is lit with visibility (shadows on).
+  // Mesh edges where radiance can jump for some viewpoint, ∝ length (per mesh state).
+  std::shared_ptr<const MeshEdgeTable> mesh_edges;
+  bool environment = false;  // the environment is lit with visibility (shadows on).
   // Texel boundaries (when a further bounce is traced and the material has any), and a
   // distribution over them ∝ 3D length × material jump.
   std::vector<TexelSegment> texels;

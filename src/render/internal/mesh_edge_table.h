@@ -1,0 +1,86 @@
+// Internal to src/render: the mesh edges that secondary edge samples (A) draw from, per mesh
+// state, packed for the candidate loop.
+#ifndef SFT_RENDER_INTERNAL_MESH_EDGE_TABLE_H_
+#define SFT_RENDER_INTERNAL_MESH_EDGE_TABLE_H_
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <memory>
+#include <vector>
+
+#include "src/render/scene.h"
+
+namespace sft {
+namespace render_internal {
+
+// The mesh edges where radiance can jump seen from some point — every edge except those between
+// coplanar, consistently oriented faces — with a length-proportional alias table. A secondary
+// edge sample draws 16 candidates per path vertex from all of the mesh's edges (75k for a
+// 50k-face mesh: far more than the caches hold), so a candidate reads one cache line instead of
+// the edge, both ends and both face normals scattered over the scene's arrays. The table
+// depends on the mesh state only: MeshEdgeTable::Of returns the last build while
+// scene.state_id() is unchanged.
+class MeshEdgeTable {
+ public:
+  // One cache line per edge: what deciding whether a candidate can be a jump seen from x, and
+  // weighing it, reads. Floats: they place the candidate point (the kept point is then evaluated
+  // on the double-precision mesh) and decide the sign of a distance (silhouette test).
+  struct alignas(64) Record {
+    Eigen::Vector3f a, b;    // the edge's ends (welded vertices v0, v1), world frame.
+    Eigen::Vector3f n0, n1;  // the faces' consistently oriented unit normals; both zero for an
+                             // edge that is always a jump (boundary, non-manifold, degenerate).
+    int f0 = -1, f1 = -1;    // the edge's faces (f1 = −1 for a boundary edge).
+    float inverse_probability = 0.0f;  // 1 / this record's probability.
+    float crease = 0.0f;               // 1 when the neighbours are not coplanar (a crease), else 0.
+  };
+
+  // The table of `scene`'s current mesh state (built on first use, then shared).
+  static std::shared_ptr<const MeshEdgeTable> Of(const RenderScene& scene);
+
+  explicit MeshEdgeTable(const RenderScene& scene);
+
+  bool empty() const { return records_.empty(); }
+  int size() const { return static_cast<int>(records_.size()); }
+  const Record& record(int i) const { return records_[i]; }
+  int edge(int i) const { return edges_[i]; }  // index into scene.edges().
+  // Alias-table draws of record indices ∝ edge length for u[0 … n) ∈ [0, 1). The cells are kept
+  // apart from the records (8 bytes each), and all n cells, then all n records, are prefetched
+  // before any is used, so that a vertex's candidates wait for memory together, not in turn.
+  void SampleBatch(const double* u, int n, int* out) const {
+    const int size = static_cast<int>(cells_.size());
+    for (int k = 0; k < n; ++k) {
+      out[k] = std::min(static_cast<int>(u[k] * size), size - 1);
+      __builtin_prefetch(&cells_[out[k]]);
+    }
+    for (int k = 0; k < n; ++k) {
+      const Cell& cell = cells_[out[k]];
+      if (!(u[k] * size - out[k] < cell.keep)) out[k] = cell.alias;
+      __builtin_prefetch(&records_[out[k]]);
+    }
+  }
+  double InverseProbability(int i) const { return records_[i].inverse_probability; }
+
+  // Whether record i can be a jump seen from x: a silhouette from x, always, or a crease when
+  // `creases`.
+  bool IsDiscontinuity(int i, const Eigen::Vector3d& x, bool creases) const {
+    const Record& r = records_[i];
+    if (creases && r.crease > 0.0f) return true;
+    if (r.n0.isZero()) return true;
+    const Eigen::Vector3f to_x = x.cast<float>() - r.a;
+    return (r.n0.dot(to_x) > 0.0f) != (r.n1.dot(to_x) > 0.0f);
+  }
+
+ private:
+  struct Cell {
+    float keep = 1.0f;  // probability of keeping index i in cell i, else `alias`.
+    int alias = 0;
+  };
+  std::vector<Record> records_;
+  std::vector<Cell> cells_;
+  std::vector<int> edges_;
+};
+
+}  // namespace render_internal
+}  // namespace sft
+
+#endif  // SFT_RENDER_INTERNAL_MESH_EDGE_TABLE_H_
