@@ -169,13 +169,13 @@ void CollectDerivatives(TileJob* job, const ParameterLayout& layout, DerivativeO
 std::optional<render_internal::SecondaryEdges> MaybeSecondaryEdges(
     const RenderScene& scene, const Material& material, const ViewSetup& view,
     const RenderOptions& options, const DerivativeRequest* request,
-    const EnvironmentMap* environment, int max_segments) {
+    const EnvironmentMap* environment, int max_segments, RenderStats* stats) {
   if (request != nullptr && (request->jacobian_rows || request->adjoint_weights != nullptr) &&
       request->params.vertices && options.pass == RenderPass::kColor &&
       request->secondary_edge_samples > 0 &&
       ((environment != nullptr && options.effects.shadows) || max_segments > 1)) {
-    return render_internal::BuildSecondaryEdges(scene, material, view, options,
-                                                environment != nullptr, max_segments);
+    return render_internal::BuildSecondaryEdges(scene, material, view, options, *request,
+                                                environment != nullptr, max_segments, stats);
   }
   return std::nullopt;
 }
@@ -187,8 +187,9 @@ void RenderImpl(const RenderScene& scene, const Material& material, const ViewSe
   const auto start = std::chrono::steady_clock::now();
   const EnvironmentMap* environment = options.effects.environment ? view.environment : nullptr;
   const int max_segments = options.effects.bounces ? options.bounces : 1;
-  const std::optional<render_internal::SecondaryEdges> secondary =
-      MaybeSecondaryEdges(scene, material, view, options, request, environment, max_segments);
+  RenderStats edge_stats;  // of the edge terms' set-up and samples outside the tiles.
+  const std::optional<render_internal::SecondaryEdges> secondary = MaybeSecondaryEdges(
+      scene, material, view, options, request, environment, max_segments, &edge_stats);
   const Context ctx{scene,
                     material,
                     options.sampling_material != nullptr ? *options.sampling_material : material,
@@ -218,7 +219,6 @@ void RenderImpl(const RenderScene& scene, const Material& material, const ViewSe
   const int num_tiles = job.tiles_x * ((height + kTile - 1) / kTile);
   if (job.want_rows) job.pixel_rows.resize(static_cast<size_t>(width) * height);
   if (job.weights != nullptr) job.tile_gradients.resize(num_tiles);
-  RenderStats edge_stats;
   if (job.want_derivatives && request->params.vertices && options.pass == RenderPass::kColor) {
     job.edge_lists.resize(static_cast<size_t>(width) * height);
     render_internal::AddEdgeTerms(ctx, &job.edge_lists, &edge_stats);

@@ -22,6 +22,13 @@ constexpr int kSecondaryCandidates = 16;
 // inverse): (C) traces two paths where it is seen, and the indirect light's texel jumps are
 // usually a small part of the derivative (docs/design-notes.md).
 constexpr double kSecondaryTexelProbability = 0.25;
+// (B)'s shadow pools: attempts per expected secondary sample of the view (pixels × spp × rate),
+// clamped; entries weighed per (B) sample. See docs/design-notes.md for the measured choice.
+constexpr double kShadowPoolAttemptsPerSample = 0.25;
+constexpr int64_t kMinShadowPoolAttempts = 256;
+constexpr int64_t kMaxShadowPoolAttempts = 65536;
+constexpr int kShadowPoolCandidates = 8;
+constexpr uint64_t kShadowPoolKey = 0x5AD0B001ull << 20;
 
 // Texel boundaries with a positive weight (3D length × material jump), and the weights.
 void AddSecondaryTexels(const RenderScene& scene, const Material& material, bool glossy,
@@ -232,36 +239,53 @@ void SampleTexelBoundary(const SecondaryVertex& v, Sampler* texel_sampler, PathD
 }
 
 // (B) Point-light shadow boundaries on the surfaces a further bounce sees: a light uniformly
-// (u_light), a shadow-casting edge ∝ its angle at the light (the rest of u_light's slot), the
-// edge point uniform in s = u_point.
-void SampleShadowBoundary(const SecondaryVertex& v, double u_light, double u_point,
+// (u_light), then one of its pool's shadow points by resampled importance sampling:
+// kShadowPoolCandidates entries drawn uniformly, target p̂ = Σ_rgb f·(n·ω)·|dω/ds|/p (the
+// integrand's geometry: the jump is left out), one kept ∝ p̂. The estimate of the pool's sum
+// over entries, F_kept/p̂_kept·(1/K)Σ_k p̂_k·n, divided by the pool's attempts, is unbiased for
+// the curve integral given the pool, and the pool is unbiased.
+void SampleShadowBoundary(const SecondaryVertex& v, double u_light, Sampler* sampler,
                           PathDerivatives* path, RenderStats* stats) {
   const SecondaryEdges& secondary = *v.ctx.secondary;
   const RenderScene& scene = v.ctx.scene;
-  const int num_lights = static_cast<int>(secondary.shadow_candidates.size());
+  const int num_lights = static_cast<int>(secondary.shadow_pools.size());
   const int l = std::min(static_cast<int>(u_light * num_lights), num_lights - 1);
-  const DiscreteDistribution& by_angle = secondary.shadow_by_angle[l];
-  if (by_angle.empty()) return;
-  const int c = by_angle.SampleInverse(u_light * num_lights - l);
-  const EdgeCandidate& candidate = secondary.shadow_candidates[l][c];
-  const MeshEdge& edge = scene.edges()[candidate.edge];
-  const PointLight& light = v.ctx.view.point_lights[l];
-  ShadowPoint shadow;
-  if (!CastShadowPoint(v.ctx, light.position, edge, u_point, stats, &shadow)) return;
-  if (shadow.receiver == v.face) return;
-  const Eigen::Vector3d edge_direction = scene.positions()[edge.v1] - scene.positions()[edge.v0];
+  const ShadowPool& pool = secondary.shadow_pools[l];
+  const int n = static_cast<int>(pool.entries.size());
+  if (n == 0) return;
+  int kept = -1;
+  double w_sum = 0.0, kept_target = 0.0;
+  for (int k = 0; k < kShadowPoolCandidates; ++k) {
+    const int j = std::min(static_cast<int>(sampler->Next1D() * n), n - 1);
+    const double pick = sampler->Next1D();
+    const ShadowPoolEntry& e = pool.entries[j];
+    if (e.shadow.receiver == v.face) continue;
+    const Eigen::Vector3d to_y = e.shadow.y - v.x;
+    const double r = to_y.norm();
+    const Eigen::Vector3d omega = to_y / r;
+    if (!(r > v.offset) || !(v.n.dot(omega) > 0.0)) continue;
+    const double speed = (e.dy_ds - omega * omega.dot(e.dy_ds)).norm() / r;
+    const double target = v.BsdfCosine(omega) * speed * e.inverse_probability;
+    if (!(target > 0.0) || !std::isfinite(target)) continue;
+    w_sum += target;
+    if (pick * w_sum < target) {
+      kept = j;
+      kept_target = target;
+    }
+  }
+  if (kept < 0) return;
+  const ShadowPoolEntry& e = pool.entries[kept];
+  const MeshEdge& edge = scene.edges()[e.edge];
   SphereCurvePoint point;
   if (!SphereCurveAt(
-          v, shadow.y - v.x,
-          [&](const Eigen::Matrix3d& t) {
-            return (t * shadow.d_y_d_point * edge_direction).eval();
-          },
+          v, e.shadow.y - v.x, [&](const Eigen::Matrix3d& t) { return (t * e.dy_ds).eval(); },
           &point)) {
     return;
   }
+  const PointLight& light = v.ctx.view.point_lights[l];
   Eigen::Vector3d direct[2];
   for (int k = 0; k < 2; ++k) {
-    if (!DirectAtReceiver(v.ctx, light, v.x, point.sides[k], v.offset, shadow.receiver, stats,
+    if (!DirectAtReceiver(v.ctx, light, v.x, point.sides[k], v.offset, e.shadow.receiver, stats,
                           &direct[k])) {
       return;
     }
@@ -269,19 +293,50 @@ void SampleShadowBoundary(const SecondaryVertex& v, double u_light, double u_poi
   const Eigen::Vector3d jump =
       v.Integrand(point.sides[0], direct[0]) - v.Integrand(point.sides[1], direct[1]);
   if (jump.isZero()) return;
-  const double inv_pdf = num_lights * by_angle.total() / candidate.weight / v.num_samples;
+  // F/p̂ = jump·speed·(1/p)/p̂, times (1/K)Σ p̂_k·n, over the attempts, lights and samples.
+  const double resampling = w_sum * n / (kept_target * kShadowPoolCandidates);
+  const double weight = point.speed * e.inverse_probability * resampling * num_lights /
+                        (static_cast<double>(pool.attempts) * v.num_samples);
   const Eigen::Vector3d m_row = point.m / point.r;
   BoundaryRows rows;
-  ShadowPointRows(shadow, scene, edge, u_point, m_row, &rows);
-  path->AddBoundary(v.throughput.cwiseProduct(jump) * (point.speed * inv_pdf), rows.vertices,
-                    rows.rows, rows.count, -m_row);
+  ShadowPointRows(e.shadow, scene, edge, e.s, m_row, &rows);
+  path->AddBoundary(v.throughput.cwiseProduct(jump) * weight, rows.vertices, rows.rows, rows.count,
+                    -m_row);
+}
+
+// The shadow pool of the light at `light` (ShadowPool); rays counted in *stats.
+ShadowPool BuildShadowPool(const Context& ctx, const Eigen::Vector3d& light, int64_t attempts,
+                           uint64_t key, RenderStats* stats) {
+  ShadowPool pool;
+  const std::vector<EdgeCandidate> candidates = ShadowEdgeCandidates(ctx.scene, light);
+  std::vector<double> angles;
+  for (const EdgeCandidate& c : candidates) angles.push_back(c.weight);
+  const DiscreteDistribution by_angle(angles);
+  if (by_angle.empty()) return pool;
+  pool.attempts = attempts;
+  Sampler sampler(ctx.options.seed, ctx.view.view_index, key, 0);
+  for (int64_t j = 0; j < attempts; ++j) {
+    // Stratified over the edges' cumulative angle: every edge of a large angle gets its share.
+    const int c = by_angle.SampleInverse((j + sampler.Next1D()) / attempts);
+    ShadowPoolEntry e;
+    e.edge = candidates[c].edge;
+    e.s = sampler.Next1D();
+    const MeshEdge& edge = ctx.scene.edges()[e.edge];
+    if (!CastShadowPoint(ctx, light, edge, e.s, stats, &e.shadow)) continue;
+    e.inverse_probability = by_angle.InverseProbability(c);
+    e.dy_ds =
+        e.shadow.d_y_d_point * (ctx.scene.positions()[edge.v1] - ctx.scene.positions()[edge.v0]);
+    pool.entries.push_back(e);
+  }
+  return pool;
 }
 
 }  // namespace
 
 SecondaryEdges BuildSecondaryEdges(const RenderScene& scene, const Material& material,
                                    const ViewSetup& view, const RenderOptions& options,
-                                   bool environment, int max_segments) {
+                                   const DerivativeRequest& request, bool environment,
+                                   int max_segments, RenderStats* stats) {
   SecondaryEdges out;
   if (max_segments > 1) {
     AddSecondaryTexels(scene, material, options.effects.specular && material.specular > 0.0, &out);
@@ -289,12 +344,17 @@ SecondaryEdges BuildSecondaryEdges(const RenderScene& scene, const Material& mat
   out.environment = environment && options.effects.shadows;
   out.mesh_edges = MeshEdgeTable::Of(scene);
   if (options.effects.shadows && max_segments > 1) {
-    for (const PointLight& light : view.point_lights) {
-      std::vector<EdgeCandidate> candidates = ShadowEdgeCandidates(scene, light.position);
-      std::vector<double> angles;
-      for (const EdgeCandidate& c : candidates) angles.push_back(c.weight);
-      out.shadow_candidates.push_back(std::move(candidates));
-      out.shadow_by_angle.emplace_back(angles);
+    // CastShadowPoint reads only the scene of its context.
+    const Context ctx{scene, material, material, view,    options, nullptr,
+                      1,     1.0,      nullptr,  nullptr, nullptr};
+    const double expected = static_cast<double>(view.camera.width) * view.camera.height *
+                            options.spp * request.secondary_edge_samples;
+    const int64_t attempts = std::clamp<int64_t>(
+        static_cast<int64_t>(std::ceil(expected * kShadowPoolAttemptsPerSample)),
+        kMinShadowPoolAttempts, kMaxShadowPoolAttempts);
+    for (size_t l = 0; l < view.point_lights.size(); ++l) {
+      out.shadow_pools.push_back(
+          BuildShadowPool(ctx, view.point_lights[l].position, attempts, kShadowPoolKey + l, stats));
     }
   }
   return out;
@@ -337,8 +397,9 @@ void AddSecondaryEdgeSamples(const Context& ctx, const Sampler& path_sampler, in
         texel_sampler.Next1D() < kSecondaryTexelProbability) {
       SampleTexelBoundary(v, &texel_sampler, path, stats);  // (C)
     }
-    if (v.indirect && !secondary.shadow_candidates.empty()) {
-      SampleShadowBoundary(v, u3, u4, path, stats);  // (B)
+    if (v.indirect && !secondary.shadow_pools.empty()) {
+      Sampler shadow_sampler = sampler.Fork(2);
+      SampleShadowBoundary(v, u3, &shadow_sampler, path, stats);  // (B)
     }
   }
 }

@@ -7,7 +7,8 @@
 //       environment, when it is lit with shadows, or a farther surface, when a further bounce
 //       is traced) and, when a further bounce is traced, creases (flat shading);
 //   (B) when a further bounce is traced with shadows, the directions of the shadow points that
-//       point lights' silhouette edges cast (the next vertex's direct term jumps there);
+//       point lights' silhouette edges cast (the next vertex's direct term jumps there), drawn
+//       from a per-view pool of cast shadow points;
 //   (C) when a further bounce is traced, the directions of texel boundaries (TexelSegments) on
 //       the surfaces seen (the material, hence the radiance leaving them, jumps there).
 // Boundary term: ∂H/∂θ += ∫_curve (g(ω⁻) − g(ω⁺))·(m·∂ω/∂θ) dl, g = f·(n·ω)·L_in, m the unit
@@ -15,16 +16,17 @@
 // ω = (y − x)/r and m·∂ω/∂θ = mᵀ(∂y/∂θ − ∂x/∂θ)/r; dl = |dω/ds| ds along the curve parameter s.
 // Estimator per sample: (A) an edge chosen by resampling among length-proportional candidates,
 // a point uniform in the angle it subtends at x (see the loop below); (B) a light uniformly, a
-// shadow-casting edge ∝ its angle at the light, s uniform; weight (g⁻ − g⁺)·(arc length)/pdf,
-// times the path throughput, credited to the path's pixel. Both sides trace with the same random
-// numbers. Other radiance leaving the next vertex is continuous along ω (its own hemisphere
-// integrals smooth out their jumps), so (A) and (B) are all the curves for flat-shaded, untextured
-// surfaces; (C) adds the texel boundaries of mesh-colors materials on the surfaces a further
-// bounce sees. (B)'s uniform s still weights receiver points close to x by 1/r.
+// pool entry chosen by resampling with target f·(n·ω)·|dω/ds|/p; weight (g⁻ − g⁺)·(arc
+// length)/pdf, times the path throughput, credited to the path's pixel. Both sides trace with the
+// same random numbers. Other radiance leaving the next vertex is continuous along ω (its own
+// hemisphere integrals smooth out their jumps), so (A) and (B) are all the curves for flat-shaded,
+// untextured surfaces; (C) adds the texel boundaries of mesh-colors materials on the surfaces a
+// further bounce sees.
 #ifndef SFT_RENDER_INTERNAL_SECONDARY_EDGES_H_
 #define SFT_RENDER_INTERNAL_SECONDARY_EDGES_H_
 
 #include <Eigen/Core>
+#include <cstdint>
 #include <memory>
 #include <vector>
 
@@ -33,12 +35,31 @@
 #include "src/render/internal/edge_sampling.h"
 #include "src/render/internal/mesh_edge_table.h"
 #include "src/render/internal/sampling.h"
+#include "src/render/internal/shadow_edges.h"
 #include "src/render/internal/texel_edges.h"
 
 namespace sft {
 namespace render_internal {
 
 class PathDerivatives;
+
+// (B)'s shadow points of one point light: `attempts` draws of a silhouette edge of the light
+// (∝ its angle at the light, stratified) and a point uniform on it, cast onto the surface
+// behind; the casts that land are kept. A path vertex then draws its shadow point from the pool
+// by resampling (the pool's mean over attempts is an unbiased estimate of the curve integral,
+// failed attempts contributing zero), so the two rays of a cast are paid once per pool entry,
+// not once per path vertex.
+struct ShadowPoolEntry {
+  int edge = -1;                     // the casting edge (index into scene.edges()).
+  double s = 0.0;                    // its point a + s(b − a).
+  double inverse_probability = 0.0;  // 1 / the attempt's density in (edge, s).
+  ShadowPoint shadow;
+  Eigen::Vector3d dy_ds;  // the shadow point's motion along the edge, ∂y/∂point·(b − a).
+};
+struct ShadowPool {
+  int64_t attempts = 0;
+  std::vector<ShadowPoolEntry> entries;
+};
 
 // The candidates of one view's secondary edge samples.
 struct SecondaryEdges {
@@ -49,15 +70,17 @@ struct SecondaryEdges {
   // distribution over them ∝ 3D length × material jump.
   std::vector<TexelSegment> texels;
   DiscreteDistribution texels_by_weight;
-  // Per point light of the view (when shadows and a further bounce exist): shadow-casting edges
-  // and a distribution over them ∝ angle at the light.
-  std::vector<std::vector<EdgeCandidate>> shadow_candidates;
-  std::vector<DiscreteDistribution> shadow_by_angle;
+  // Per point light of the view (when shadows and a further bounce exist): shadow points its
+  // silhouette edges cast, drawn once per view (ShadowPool) and shared by the view's (B) samples.
+  std::vector<ShadowPool> shadow_pools;
 };
 
+// The view's secondary-edge candidates for `request`; the rays that build the shadow pools are
+// counted in *stats.
 SecondaryEdges BuildSecondaryEdges(const RenderScene& scene, const Material& material,
                                    const ViewSetup& view, const RenderOptions& options,
-                                   bool environment, int max_segments);
+                                   const DerivativeRequest& request, bool environment,
+                                   int max_segments, RenderStats* stats);
 
 // The secondary edge samples (request->secondary_edge_samples of them on average) at path vertex
 // x (segment depth + 1 of the path, face `face`, normal n facing wo, BSDF `params`, path
