@@ -44,14 +44,51 @@ MeshEdgeTable::MeshEdgeTable(const RenderScene& scene) {
   if (by_length.empty()) {
     records_.clear();
     edges_.clear();
+    near_offsets_.assign(scene.faces().size() + 1, 0);
     return;
   }
+  BuildNearLists(scene);
   cells_.resize(records_.size());
   for (size_t i = 0; i < records_.size(); ++i) {
     const int index = static_cast<int>(i);
     cells_[i] = {static_cast<float>(by_length.cell(index).probability),
                  by_length.cell(index).alias};
     records_[i].inverse_probability = static_cast<float>(by_length.InverseProbability(index));
+  }
+}
+
+void MeshEdgeTable::BuildNearLists(const RenderScene& scene) {
+  // Records per welded vertex (CSR), then per face the union over its corners.
+  const int num_vertices = static_cast<int>(scene.positions().size());
+  std::vector<int> vertex_offsets(num_vertices + 1, 0);
+  for (int edge : edges_) {
+    ++vertex_offsets[scene.edges()[edge].v0 + 1];
+    ++vertex_offsets[scene.edges()[edge].v1 + 1];
+  }
+  for (int v = 0; v < num_vertices; ++v) vertex_offsets[v + 1] += vertex_offsets[v];
+  std::vector<int> vertex_records(vertex_offsets.back());
+  std::vector<int> fill(vertex_offsets.begin(), vertex_offsets.end() - 1);
+  for (size_t i = 0; i < edges_.size(); ++i) {
+    const MeshEdge& edge = scene.edges()[edges_[i]];
+    vertex_records[fill[edge.v0]++] = static_cast<int>(i);
+    vertex_records[fill[edge.v1]++] = static_cast<int>(i);
+  }
+  const int num_faces = static_cast<int>(scene.faces().size());
+  near_offsets_.assign(num_faces + 1, 0);
+  std::vector<int> list;
+  for (int f = 0; f < num_faces; ++f) {
+    list.clear();
+    for (int k = 0; k < 3; ++k) {
+      const int v = scene.WeldedVertex(scene.faces()[f][k]);
+      for (int j = vertex_offsets[v]; j < vertex_offsets[v + 1]; ++j) {
+        const int r = vertex_records[j];
+        if (records_[r].f0 != f && records_[r].f1 != f) list.push_back(r);
+      }
+    }
+    std::sort(list.begin(), list.end());
+    list.erase(std::unique(list.begin(), list.end()), list.end());
+    near_records_.insert(near_records_.end(), list.begin(), list.end());
+    near_offsets_[f + 1] = static_cast<int>(near_records_.size());
   }
 }
 

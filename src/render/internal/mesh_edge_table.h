@@ -8,6 +8,7 @@
 #include <memory>
 #include <vector>
 
+#include "src/render/internal/sampling.h"
 #include "src/render/scene.h"
 
 namespace sft {
@@ -55,10 +56,15 @@ class MeshEdgeTable {
     for (int k = 0; k < n; ++k) {
       const Cell& cell = cells_[out[k]];
       if (!(u[k] * size - out[k] < cell.keep)) out[k] = cell.alias;
-      __builtin_prefetch(&records_[out[k]]);
+      Prefetch(out[k]);
     }
   }
+  void Prefetch(int i) const { __builtin_prefetch(&records_[i]); }
   double InverseProbability(int i) const { return records_[i].inverse_probability; }
+
+  // The records of the edges that share a vertex with `face` but are not its own, sorted.
+  const int* near_begin(int face) const { return near_records_.data() + near_offsets_[face]; }
+  const int* near_end(int face) const { return near_records_.data() + near_offsets_[face + 1]; }
 
   // Whether record i can be a jump seen from x: a silhouette from x, always, or a crease when
   // `creases`.
@@ -71,6 +77,8 @@ class MeshEdgeTable {
   }
 
  private:
+  void BuildNearLists(const RenderScene& scene);
+
   struct Cell {
     float keep = 1.0f;  // probability of keeping index i in cell i, else `alias`.
     int alias = 0;
@@ -78,6 +86,60 @@ class MeshEdgeTable {
   std::vector<Record> records_;
   std::vector<Cell> cells_;
   std::vector<int> edges_;
+  std::vector<int> near_offsets_;  // per face (+1), into near_records_.
+  std::vector<int> near_records_;
+};
+
+// The candidate proposal of (A) at a path vertex on face `face`: with probability kNearFraction
+// one of the edges around the face (MeshEdgeTable::near_begin/end) uniformly, else the table's
+// length-proportional draw. Edges next to the vertex subtend the largest angles at it, so their
+// weights Θ/p under the length-proportional draw alone are the heaviest (their probability is
+// ~1/#edges whatever their angle); the mixture bounds them. Same interface as
+// DiscreteDistribution for ResampleSegmentPoint.
+class NearEdgeMixture {
+ public:
+  static constexpr double kNearFraction = 0.25;
+
+  NearEdgeMixture(const MeshEdgeTable& table, int face)
+      : table_(table), near_begin_(table.near_begin(face)), near_end_(table.near_end(face)) {
+    const int count = static_cast<int>(near_end_ - near_begin_);
+    near_fraction_ = count > 0 ? kNearFraction : 0.0;
+    near_probability_ = near_fraction_ > 0 ? kNearFraction / count : 0.0;
+  }
+
+  void SampleBatch(const double* u, int n, int* out) const {
+    double global_u[kMaxResampleCandidates];
+    int global_k[kMaxResampleCandidates];
+    int num_global = 0;
+    const int count = static_cast<int>(near_end_ - near_begin_);
+    for (int k = 0; k < n; ++k) {
+      if (u[k] < near_fraction_) {
+        out[k] = near_begin_[std::min(static_cast<int>(u[k] / near_fraction_ * count), count - 1)];
+        table_.Prefetch(out[k]);
+      } else {
+        global_u[num_global] = (u[k] - near_fraction_) / (1.0 - near_fraction_);
+        global_k[num_global++] = k;
+      }
+    }
+    int drawn[kMaxResampleCandidates];
+    table_.SampleBatch(global_u, num_global, drawn);
+    for (int i = 0; i < num_global; ++i) out[global_k[i]] = drawn[i];
+  }
+
+  double InverseProbability(int c) const {
+    double p = (1.0 - near_fraction_) / table_.InverseProbability(c);
+    if (near_probability_ > 0.0 && std::binary_search(near_begin_, near_end_, c)) {
+      p += near_probability_;
+    }
+    return 1.0 / p;
+  }
+
+ private:
+  const MeshEdgeTable& table_;
+  const int* near_begin_;
+  const int* near_end_;
+  double near_fraction_ = 0.0;
+  double near_probability_ = 0.0;
 };
 
 }  // namespace render_internal

@@ -15,6 +15,9 @@ namespace {
 // Directions closer than this (relative to extent/r) to a curve on the sphere are its sides.
 constexpr double kSecondarySideOffset = 1e-5;
 constexpr uint64_t kSecondaryEdgeKey = 0x5EC0DE0000000000ull;
+// A hit closer than (1 − this)·r hides a curve point at distance r (faces through the point
+// itself are hit at r up to float rounding).
+constexpr double kHiddenMargin = 1e-3;
 // (Edge, point) pairs drawn per secondary sample before one is kept (resampled importance
 // sampling); see docs/design-notes.md for the measured choice.
 constexpr int kSecondaryCandidates = 16;
@@ -113,17 +116,20 @@ bool SphereCurveAt(const SecondaryVertex& v, const Eigen::Vector3d& to_y, const 
 // (A), (C): "two sides, two rays, two paths, jump". Traces the rays from x along both sides of
 // the curve point; when `accept`(hits) (the two sides see the curve's jump), *jump = g(ω⁻) −
 // g(ω⁺) with L_in the environment where a side misses (when lit) and the path continued with a
-// copy of `sampler` where it hits (when a further bounce is traced). False when rejected or the
-// jump is zero (a jump that is not finite is returned: it drops the path's sample).
-template <typename Accept>
+// copy of `sampler` where it hits (when a further bounce is traced). `reject_first`(hit) may
+// reject after the first side's ray alone. False when rejected or the jump is zero (a jump that
+// is not finite is returned: it drops the path's sample).
+template <typename RejectFirst, typename Accept>
 bool TwoSidedJump(const SecondaryVertex& v, const SphereCurvePoint& point, const Sampler& sampler,
-                  const Accept& accept, RenderStats* stats, Eigen::Vector3d* jump) {
+                  const RejectFirst& reject_first, const Accept& accept, RenderStats* stats,
+                  Eigen::Vector3d* jump) {
   const Context& ctx = v.ctx;
   RayHit hits[2];
-  for (int k = 0; k < 2; ++k) {
-    hits[k] = ctx.scene.Intersect(v.x, point.sides[k], v.offset, kInfinity);
-  }
-  stats->bounce_rays += 2;
+  hits[0] = ctx.scene.Intersect(v.x, point.sides[0], v.offset, kInfinity);
+  ++stats->bounce_rays;
+  if (reject_first(hits[0])) return false;
+  hits[1] = ctx.scene.Intersect(v.x, point.sides[1], v.offset, kInfinity);
+  ++stats->bounce_rays;
   if (!accept(hits)) return false;
   Eigen::Vector3d g[2];
   for (int k = 0; k < 2; ++k) {
@@ -165,9 +171,9 @@ void SampleMeshEdge(const SecondaryVertex& v, double u_index, double u_point, Sa
     if (!(std::max(v.n.dot(*a - v.x), v.n.dot(*b - v.x)) > 0.0)) return false;
     return table.IsDiscontinuity(c, v.x, /*creases=*/v.indirect);
   };
-  const ResampledPoint kept =
-      ResampleSegmentPoint(table, kSecondaryCandidates, v.x, u_index, u_point, sampler, edge_ends,
-                           [&](const Eigen::Vector3d& omega) { return v.BsdfCosine(omega); });
+  const ResampledPoint kept = ResampleSegmentPoint(
+      NearEdgeMixture(table, v.face), kSecondaryCandidates, v.x, u_index, u_point, sampler,
+      edge_ends, [&](const Eigen::Vector3d& omega) { return v.BsdfCosine(omega); });
   if (kept.index < 0) return;
   const MeshEdge& edge = scene.edges()[table.edge(kept.index)];
   const Eigen::Vector3d& a = scene.positions()[edge.v0];
@@ -182,8 +188,15 @@ void SampleMeshEdge(const SecondaryVertex& v, double u_index, double u_point, Sa
     const bool same = hits[0].hit == hits[1].hit && (!hits[0].hit || hits[0].face == hits[1].face);
     return !same && (v.indirect || !hits[0].hit || !hits[1].hit);
   };
+  // A surface in front of the edge point (not one of the edge's faces) hides it from x: the
+  // other side's ray meets the same surface, except within ε of that surface's own edges, whose
+  // jumps their own samples count.
+  auto hidden = [&](const RayHit& hit) {
+    return hit.hit && hit.face != edge.f0 && hit.face != edge.f1 &&
+           hit.t < (1.0 - kHiddenMargin) * point.r;
+  };
   Eigen::Vector3d jump;
-  if (!TwoSidedJump(v, point, *sampler, accept, stats, &jump)) return;
+  if (!TwoSidedJump(v, point, *sampler, hidden, accept, stats, &jump)) return;
   const double inv_pdf = kept.inv_pdf / v.num_samples;
   const Eigen::Vector3d m_row = point.m / point.r;  // m·∂ω/∂y.
   BoundaryRows rows;
@@ -226,8 +239,11 @@ void SampleTexelBoundary(const SecondaryVertex& v, Sampler* texel_sampler, PathD
            ((hits[0].face == segment.face && hits[1].face == segment.other) ||
             (hits[0].face == segment.other && hits[1].face == segment.face));
   };
+  auto off_segment = [&](const RayHit& hit) {  // accept needs both sides on its faces.
+    return !hit.hit || (hit.face != segment.face && hit.face != segment.other);
+  };
   Eigen::Vector3d jump;
-  if (!TwoSidedJump(v, point, *texel_sampler, accept, stats, &jump)) return;
+  if (!TwoSidedJump(v, point, *texel_sampler, off_segment, accept, stats, &jump)) return;
   const double inv_pdf = kept.inv_pdf / (v.num_samples * kSecondaryTexelProbability);
   const Eigen::Vector3d m_row = point.m / point.r;  // m·∂ω/∂y; ∂y/∂p_k = b_k·I.
   const Eigen::Vector3d b = segment.b0 + kept.s * (segment.b1 - segment.b0);
