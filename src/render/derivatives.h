@@ -32,9 +32,11 @@
 // (A) mesh edges seen from a path vertex — silhouettes against the environment (when it is lit
 // with shadows) or against farther surfaces, and creases, when a further bounce is traced;
 // (B) point-light shadow boundaries on the surface a bounce reaches; (C) texel boundaries on the
-// surface a bounce reaches. Their sampling ((edge, point) pairs drawn ∝ length — × material
-// jump for (C) — and uniform in subtended angle, one kept by resampling with the BSDF·cosine
-// towards it) is unbiased but noisy on finely tessellated meshes.
+// surface a bounce reaches. Their sampling is unbiased: (A) and (C) draw (edge, point) pairs —
+// (A) from a mixture of the edges around the vertex's face and all edges ∝ length, (C) ∝ length
+// × material jump — uniform in the angle they subtend, and keep one by resampling with the
+// BSDF·cosine towards it; (B) resamples a per-view pool of cast shadow points with the
+// BSDF·cosine times the curve's angular speed.
 // Primary edges cover silhouettes, boundary and non-manifold edges and, because shading is flat,
 // creases between non-coplanar faces. Texel boundaries are where piecewise-constant albedo or
 // roughness (mesh colors) jumps: grid lines inside faces and edges between coplanar faces, moving

@@ -150,9 +150,9 @@ bool TwoSidedJump(const SecondaryVertex& v, const SphereCurvePoint& point, const
 
 // (A) Silhouettes (and creases) of mesh edges seen from x. The (edge, point) pair is chosen by
 // resampled importance sampling (Talbot et al. 2005): kSecondaryCandidates pairs are drawn, the
-// edge ∝ length (pdf p_k) and the point uniformly in the angle Θ_k the edge subtends at x (not
-// uniformly in s: the sphere arc length |dω/ds| ds is then Θ_k·dξ, where uniform s would weight
-// points near x by 1/r — infinite variance for edges touching x's face). Each pair gets the
+// edge from NearEdgeMixture (pdf p_k) and the point uniformly in the angle Θ_k the edge subtends at
+// x (not uniformly in s: the sphere arc length |dω/ds| ds is then Θ_k·dξ, where uniform s would
+// weight points near x by 1/r — infinite variance for edges touching x's face). Each pair gets the
 // target p̂_k = Σ_rgb f·(n·ω_k) at its direction where the edge can be a jump seen from x
 // (silhouette or crease test) and 0 elsewhere, the weight w_k = p̂_k·Θ_k/p_k, and one is kept
 // ∝ w_k. The estimate g_jump·Θ/(p̂·Θ)·(1/K)Σ_k w_k is unbiased because p̂ > 0 wherever the

@@ -14,8 +14,9 @@
 // Boundary term: ∂H/∂θ += ∫_curve (g(ω⁻) − g(ω⁺))·(m·∂ω/∂θ) dl, g = f·(n·ω)·L_in, m the unit
 // normal of the curve on the sphere and ω± = normalize(ω ± εm). For a curve point y seen from x,
 // ω = (y − x)/r and m·∂ω/∂θ = mᵀ(∂y/∂θ − ∂x/∂θ)/r; dl = |dω/ds| ds along the curve parameter s.
-// Estimator per sample: (A) an edge chosen by resampling among length-proportional candidates,
-// a point uniform in the angle it subtends at x (see the loop below); (B) a light uniformly, a
+// Estimator per sample: (A) an edge chosen by resampling among candidates drawn from a mixture
+// of the edges around x's face and all edges ∝ length (NearEdgeMixture), a point uniform in the
+// angle it subtends at x; (B) a light uniformly, a
 // pool entry chosen by resampling with target f·(n·ω)·|dω/ds|/p; weight (g⁻ − g⁺)·(arc
 // length)/pdf, times the path throughput, credited to the path's pixel. Both sides trace with the
 // same random numbers. Other radiance leaving the next vertex is continuous along ω (its own
@@ -63,7 +64,7 @@ struct ShadowPool {
 
 // The candidates of one view's secondary edge samples.
 struct SecondaryEdges {
-  // Mesh edges where radiance can jump for some viewpoint, ∝ length (per mesh state).
+  // Mesh edges where radiance can jump for some viewpoint (per mesh state).
   std::shared_ptr<const MeshEdgeTable> mesh_edges;
   bool environment = false;  // the environment is lit with visibility (shadows on).
   // Texel boundaries (when a further bounce is traced and the material has any), and a
