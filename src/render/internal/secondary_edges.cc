@@ -267,35 +267,41 @@ void SampleShadowBoundary(const SecondaryVertex& v, double u_light, Sampler* sam
   const int num_lights = static_cast<int>(secondary.shadow_pools.size());
   const int l = std::min(static_cast<int>(u_light * num_lights), num_lights - 1);
   const ShadowPool& pool = secondary.shadow_pools[l];
-  const int n = static_cast<int>(pool.entries.size());
+  const int n = static_cast<int>(pool.points.size());
   if (n == 0) return;
+  // All candidates are drawn and prefetched before any is weighed (the loads overlap).
+  int index[kShadowPoolCandidates];
+  double pick[kShadowPoolCandidates];
+  for (int k = 0; k < kShadowPoolCandidates; ++k) {
+    index[k] = std::min(static_cast<int>(sampler->Next1D() * n), n - 1);
+    pick[k] = sampler->Next1D();
+    __builtin_prefetch(&pool.points[index[k]]);
+  }
   int kept = -1;
   double w_sum = 0.0, kept_target = 0.0;
   for (int k = 0; k < kShadowPoolCandidates; ++k) {
-    const int j = std::min(static_cast<int>(sampler->Next1D() * n), n - 1);
-    const double pick = sampler->Next1D();
-    const ShadowPoolEntry& e = pool.entries[j];
-    if (e.shadow.receiver == v.face) continue;
-    const Eigen::Vector3d to_y = e.shadow.y - v.x;
+    const ShadowPoolPoint& p = pool.points[index[k]];
+    if (p.receiver == v.face) continue;
+    const Eigen::Vector3d to_y = p.y - v.x;
     const double r = to_y.norm();
     const Eigen::Vector3d omega = to_y / r;
     if (!(r > v.offset) || !(v.n.dot(omega) > 0.0)) continue;
-    const double speed = (e.dy_ds - omega * omega.dot(e.dy_ds)).norm() / r;
-    const double target = v.BsdfCosine(omega) * speed * e.inverse_probability;
+    const double speed = (p.dy_ds - omega * omega.dot(p.dy_ds)).norm() / r;
+    const double target = v.BsdfCosine(omega) * speed * p.inverse_probability;
     if (!(target > 0.0) || !std::isfinite(target)) continue;
     w_sum += target;
-    if (pick * w_sum < target) {
-      kept = j;
+    if (pick[k] * w_sum < target) {
+      kept = index[k];
       kept_target = target;
     }
   }
   if (kept < 0) return;
+  const ShadowPoolPoint& p = pool.points[kept];
   const ShadowPoolEntry& e = pool.entries[kept];
   const MeshEdge& edge = scene.edges()[e.edge];
   SphereCurvePoint point;
   if (!SphereCurveAt(
-          v, e.shadow.y - v.x, [&](const Eigen::Matrix3d& t) { return (t * e.dy_ds).eval(); },
-          &point)) {
+          v, p.y - v.x, [&](const Eigen::Matrix3d& t) { return (t * p.dy_ds).eval(); }, &point)) {
     return;
   }
   const PointLight& light = v.ctx.view.point_lights[l];
@@ -311,7 +317,7 @@ void SampleShadowBoundary(const SecondaryVertex& v, double u_light, Sampler* sam
   if (jump.isZero()) return;
   // F/p̂ = jump·speed·(1/p)/p̂, times (1/K)Σ p̂_k·n, over the attempts, lights and samples.
   const double resampling = w_sum * n / (kept_target * kShadowPoolCandidates);
-  const double weight = point.speed * e.inverse_probability * resampling * num_lights /
+  const double weight = point.speed * p.inverse_probability * resampling * num_lights /
                         (static_cast<double>(pool.attempts) * v.num_samples);
   const Eigen::Vector3d m_row = point.m / point.r;
   BoundaryRows rows;
@@ -339,9 +345,13 @@ ShadowPool BuildShadowPool(const Context& ctx, const Eigen::Vector3d& light, int
     e.s = sampler.Next1D();
     const MeshEdge& edge = ctx.scene.edges()[e.edge];
     if (!CastShadowPoint(ctx, light, edge, e.s, stats, &e.shadow)) continue;
-    e.inverse_probability = by_angle.InverseProbability(c);
-    e.dy_ds =
+    ShadowPoolPoint p;
+    p.y = e.shadow.y;
+    p.dy_ds =
         e.shadow.d_y_d_point * (ctx.scene.positions()[edge.v1] - ctx.scene.positions()[edge.v0]);
+    p.inverse_probability = by_angle.InverseProbability(c);
+    p.receiver = e.shadow.receiver;
+    pool.points.push_back(p);
     pool.entries.push_back(e);
   }
   return pool;

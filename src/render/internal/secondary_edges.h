@@ -51,15 +51,21 @@ class PathDerivatives;
 // failed attempts contributing zero), so the two rays of a cast are paid once per pool entry,
 // not once per path vertex.
 struct ShadowPoolEntry {
-  int edge = -1;                     // the casting edge (index into scene.edges()).
-  double s = 0.0;                    // its point a + s(b − a).
-  double inverse_probability = 0.0;  // 1 / the attempt's density in (edge, s).
+  int edge = -1;   // the casting edge (index into scene.edges()).
+  double s = 0.0;  // its point a + s(b − a).
   ShadowPoint shadow;
-  Eigen::Vector3d dy_ds;  // the shadow point's motion along the edge, ∂y/∂point·(b − a).
+};
+// What weighing an entry reads, one cache line each (the pool outgrows the caches).
+struct alignas(64) ShadowPoolPoint {
+  Eigen::Vector3d y;                 // the shadow point.
+  Eigen::Vector3d dy_ds;             // its motion along the edge, ∂y/∂point·(b − a).
+  double inverse_probability = 0.0;  // 1 / the attempt's density in (edge, s).
+  int receiver = -1;
 };
 struct ShadowPool {
   int64_t attempts = 0;
-  std::vector<ShadowPoolEntry> entries;
+  std::vector<ShadowPoolPoint> points;
+  std::vector<ShadowPoolEntry> entries;  // parallel to points.
 };
 
 // The candidates of one view's secondary edge samples.
