@@ -105,6 +105,34 @@ TEST(DerivativeCostTest, KeepRowsHoldsTheTotal) {
   EXPECT_TRUE(kept.keep_rows);
 }
 
+// The noise measurement falls with the samples (8× the samples: at least 1/√8 of the noise; at
+// 2 spp the few edge samples also give heavy tails, so it falls further), and cost × variance is
+// reported with it.
+TEST(DerivativeCostTest, NoiseFallsWithSamples) {
+  TriMesh mesh;
+  ASSERT_TRUE(ReadMesh(testing::DataDir() + "/meshes/icosphere_r1_320f.obj", &mesh).ok());
+  DerivativeCostOptions options = SmallOptions();
+  options.bounces = 1;
+  options.noise_seeds = 6;
+  double noise[2];
+  for (int i = 0; i < 2; ++i) {
+    options.spp = i == 0 ? 2 : 16;
+    DerivativeCostReport report;
+    ASSERT_TRUE(MeasureDerivativeCost(options, mesh, &report).ok());
+    EXPECT_EQ(report.noise_seeds, 6);
+    EXPECT_GT(report.vertex_noise, 0.0);
+    EXPECT_TRUE(std::isfinite(report.vertex_noise));
+    EXPECT_GT(report.noise_adjoint_seconds, 0.0);
+    EXPECT_NEAR(report.cost_times_variance,
+                report.noise_adjoint_seconds / report.forward.seconds * report.vertex_noise *
+                    report.vertex_noise,
+                1e-9 * report.cost_times_variance);
+    EXPECT_TRUE(DerivativeCostReportToJson(report).contains("noise"));
+    noise[i] = report.vertex_noise;
+  }
+  EXPECT_LT(noise[1], 0.5 * noise[0]) << noise[0] << " " << noise[1];
+}
+
 TEST(DerivativeCostTest, OptionsCheck) {
   std::string why;
   DerivativeCostOptions options;
@@ -124,6 +152,12 @@ TEST(DerivativeCostTest, OptionsCheck) {
   options.bounces = 0;
   EXPECT_FALSE(options.Check(&why));
   EXPECT_NE(why.find("bounces"), std::string::npos);
+  for (int seeds : {1, 65}) {
+    options = DerivativeCostOptions();
+    options.noise_seeds = seeds;
+    EXPECT_FALSE(options.Check(&why));
+    EXPECT_NE(why.find("noise-seeds"), std::string::npos);
+  }
 
   TriMesh empty;
   DerivativeCostReport report;
