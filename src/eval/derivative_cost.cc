@@ -227,6 +227,9 @@ void AdjointPass(const CostScene& s, const RenderOptions& render, DerivativeRequ
                                 &output, &stats);
     });
     AddRays(stats, &result->adjoint.rays);
+    result->gradient_terms += stats.gradient_terms;
+    result->gradient_terms_peak_view =
+        std::max(result->gradient_terms_peak_view, stats.gradient_terms);
     if (gradient.empty()) gradient.assign(output.gradient.size(), 0.0);
     for (size_t i = 0; i < gradient.size() && i < output.gradient.size(); ++i) {
       gradient[i] += output.gradient[i];
@@ -367,6 +370,8 @@ nlohmann::json DerivativeCostReportToJson(const DerivativeCostReport& report) {
                            {"bytes_peak_view", report.rows_bytes_peak_view},
                            {"bytes_resident", report.rows_bytes_resident},
                            {"keep_rows", report.keep_rows}};
+  json["adjoint_terms"] = {{"entries", report.gradient_terms},
+                           {"entries_peak_view", report.gradient_terms_peak_view}};
   json["peak_rss_reset"] = report.peak_rss_reset;
   json["gradient_norm"] = report.gradient_norm;
   json["aim_ratio"] = kAim;
@@ -410,6 +415,9 @@ std::string DerivativeCostReportTable(const DerivativeCostReport& report) {
       Mebibytes(report.rows_bytes_total), Mebibytes(report.rows_bytes_peak_view));
   add("rows resident  %.1f MiB at once (%s)\n", Mebibytes(report.rows_bytes_resident),
       report.keep_rows ? "--keep-rows: every view's rows held" : "one view's rows at a time");
+  add("adjoint terms  %lld held before the reduction over all views, %lld for the largest view\n",
+      static_cast<long long>(report.gradient_terms),
+      static_cast<long long>(report.gradient_terms_peak_view));
   const bool met = report.jacobian_rows.ratio <= kAim && report.adjoint.ratio <= kAim;
   add("aim <= %.0fx    rows %.2fx, adjoint %.2fx: %s\n", kAim, report.jacobian_rows.ratio,
       report.adjoint.ratio, met ? "met" : "not met");

@@ -139,8 +139,10 @@ void RenderTile(TileJob* job, int tile) {
   if (options.on_tile_done) options.on_tile_done();
 }
 
-// Moves the job's per-pixel rows and per-tile gradient terms into *output.
-void CollectDerivatives(TileJob* job, const ParameterLayout& layout, DerivativeOutput* output) {
+// Moves the job's per-pixel rows and per-tile gradient terms into *output; counts the gradient
+// terms in *stats.
+void CollectDerivatives(TileJob* job, const ParameterLayout& layout, DerivativeOutput* output,
+                        RenderStats* stats) {
   output->layout = layout;
   if (job->want_rows) {
     JacobianRows& rows = output->rows;
@@ -160,6 +162,7 @@ void CollectDerivatives(TileJob* job, const ParameterLayout& layout, DerivativeO
   if (job->weights != nullptr) {
     output->gradient.assign(layout.size(), 0.0);
     for (const auto& list : job->tile_gradients) {
+      stats->gradient_terms += static_cast<int64_t>(list.size());
       for (const auto& [param, g] : list) output->gradient[param] += g;
     }
   }
@@ -226,9 +229,13 @@ void RenderImpl(const RenderScene& scene, const Material& material, const ViewSe
   tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
   arena.execute(
       [&] { tbb::parallel_for(0, num_tiles, [&](int tile) { RenderTile(&job, tile); }); });
-  if (output != nullptr && layout != nullptr) CollectDerivatives(&job, *layout, output);
+  RenderStats collect_stats;
+  if (output != nullptr && layout != nullptr) {
+    CollectDerivatives(&job, *layout, output, &collect_stats);
+  }
   if (stats != nullptr) {
     *stats = edge_stats;
+    stats->AddCounts(collect_stats);
     for (const RenderStats& s : job.thread_stats) stats->AddCounts(s);
     stats->seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
