@@ -310,7 +310,7 @@ SecondaryEdges BuildSecondaryEdges(const RenderScene& scene, const Material& mat
   AddSecondaryMeshEdges(scene, &out);
   if (options.effects.shadows && max_segments > 1) {
     for (const PointLight& light : view.point_lights) {
-      std::vector<EdgeCandidate> candidates = ShadowEdgeCandidates(scene, light.position);
+      std::vector<EdgeCandidate> candidates = *ShadowEdgeCandidates(scene, light.position);
       std::vector<double> angles;
       for (const EdgeCandidate& c : candidates) angles.push_back(c.weight);
       out.shadow_candidates.push_back(std::move(candidates));
