@@ -215,10 +215,12 @@ void RowsPass(const CostScene& s, const RenderOptions& render, const DerivativeR
 }
 
 // Σ_views Jᵀw of the adjoint request with fixed random weights of each view's size (seeded by
-// options.seed), rendered with `render`'s seed; adds the render time and rays to *cost.
+// options.seed), rendered with `render`'s seed; adds the render time and rays to *cost and,
+// when `terms` is given, the stored adjoint terms to its counts.
 std::vector<double> AdjointGradient(const CostScene& s, const RenderOptions& render,
                                     DerivativeRequest request, const DerivativeCostOptions& options,
-                                    const char* label, DerivativePassCost* cost) {
+                                    const char* label, DerivativePassCost* cost,
+                                    DerivativeCostReport* terms = nullptr) {
   std::vector<double> gradient;
   Progress progress(label, static_cast<int64_t>(s.views->size()), options.progress);
   for (const ViewSetup& view : *s.views) {
@@ -232,6 +234,11 @@ std::vector<double> AdjointGradient(const CostScene& s, const RenderOptions& ren
                                 &output, &stats);
     });
     AddRays(stats, &cost->rays);
+    if (terms != nullptr) {
+      terms->gradient_terms += stats.gradient_terms;
+      terms->gradient_terms_peak_view =
+          std::max(terms->gradient_terms_peak_view, stats.gradient_terms);
+    }
     if (gradient.empty()) gradient.assign(output.gradient.size(), 0.0);
     for (size_t i = 0; i < gradient.size() && i < output.gradient.size(); ++i) {
       gradient[i] += output.gradient[i];
@@ -247,7 +254,7 @@ void AdjointPass(const CostScene& s, const RenderOptions& render, const Derivati
                  const DerivativeCostOptions& options, DerivativeCostReport* result) {
   BeginPass(result, &result->adjoint);
   const std::vector<double> gradient =
-      AdjointGradient(s, render, request, options, "adjoint", &result->adjoint);
+      AdjointGradient(s, render, request, options, "adjoint", &result->adjoint, result);
   EndPass(&result->adjoint);
   double sum2 = 0.0;
   for (double g : gradient) sum2 += g * g;
@@ -418,6 +425,8 @@ nlohmann::json DerivativeCostReportToJson(const DerivativeCostReport& report) {
                            {"bytes_peak_view", report.rows_bytes_peak_view},
                            {"bytes_resident", report.rows_bytes_resident},
                            {"keep_rows", report.keep_rows}};
+  json["adjoint_terms"] = {{"entries", report.gradient_terms},
+                           {"entries_peak_view", report.gradient_terms_peak_view}};
   json["peak_rss_reset"] = report.peak_rss_reset;
   json["gradient_norm"] = report.gradient_norm;
   if (report.noise_seeds > 0) {
@@ -467,6 +476,9 @@ std::string DerivativeCostReportTable(const DerivativeCostReport& report) {
       Mebibytes(report.rows_bytes_total), Mebibytes(report.rows_bytes_peak_view));
   add("rows resident  %.1f MiB at once (%s)\n", Mebibytes(report.rows_bytes_resident),
       report.keep_rows ? "--keep-rows: every view's rows held" : "one view's rows at a time");
+  add("adjoint terms  %lld held before the reduction over all views, %lld for the largest view\n",
+      static_cast<long long>(report.gradient_terms),
+      static_cast<long long>(report.gradient_terms_peak_view));
   const bool met = report.jacobian_rows.ratio <= kAim && report.adjoint.ratio <= kAim;
   add("aim <= %.0fx    rows %.2fx, adjoint %.2fx: %s\n", kAim, report.jacobian_rows.ratio,
       report.adjoint.ratio, met ? "met" : "not met");

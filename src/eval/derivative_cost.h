@@ -88,6 +88,10 @@ struct DerivativeCostReport {
   int64_t rows_bytes_peak_view = 0;  // max over views of MemoryBytes().
   int64_t rows_bytes_resident = 0;   // the most rows memory alive at once: the peak view, or the
                                      // total with keep_rows.
+  // Adjoint terms held before their reduction into the gradient (RenderStats::gradient_terms):
+  // summed over the views, and the largest view's.
+  int64_t gradient_terms = 0;
+  int64_t gradient_terms_peak_view = 0;
   double gradient_norm = 0.0;  // ‖Σ_views Jᵀw‖₂ of the adjoint pass (a sanity value).
 
   // With noise_seeds: the vertex gradient's noise √(T/S) over the N seeds' vertex gradients g_k,

@@ -32,6 +32,7 @@ namespace {
 
 using render_internal::Context;
 using render_internal::DerivativeList;
+using render_internal::ParamSums;
 using render_internal::PathDerivatives;
 using render_internal::RowAccumulator;
 
@@ -51,16 +52,21 @@ struct TileJob {
   // Boundary (edge) terms of vertex derivatives, gathered per pixel before the tiles run.
   std::vector<DerivativeList> edge_lists;
   Image* image = nullptr;
-  std::vector<std::vector<JacobianEntry>> pixel_rows;               // per pixel, rows only.
-  std::vector<std::vector<std::pair<int, double>>> tile_gradients;  // per tile, adjoint only.
+  std::vector<std::vector<JacobianEntry>> pixel_rows;  // per pixel, rows only.
+  // Adjoint only: per tile, its pixels' terms w·∂RGB summed per parameter (one entry per distinct
+  // parameter of the tile), reduced in tile order by CollectDerivatives so that the gradient
+  // does not depend on which thread ran which tile.
+  std::vector<std::vector<std::pair<int, double>>> tile_gradients;
   tbb::enumerable_thread_specific<RenderStats> thread_stats;
   tbb::enumerable_thread_specific<std::array<RowAccumulator, kTile>> thread_rows;
+  tbb::enumerable_thread_specific<ParamSums<double>> thread_tile_sums;  // the running tile's.
 };
 
 // Writes pixel (x, y)'s value and coverage, and merges its derivatives (path terms in `rows`,
-// edge terms from the job's lists) into its Jacobian row and/or the tile's gradient terms.
-void FinishPixel(TileJob* job, int tile, int x, int y, const Eigen::Vector3d& sum, int hits,
-                 RowAccumulator* rows, std::vector<JacobianEntry>* merged, RenderStats* stats) {
+// edge terms from the job's lists) into its Jacobian row and/or the tile's gradient sums.
+void FinishPixel(TileJob* job, int x, int y, const Eigen::Vector3d& sum, int hits,
+                 RowAccumulator* rows, std::vector<JacobianEntry>* merged,
+                 ParamSums<double>* tile_sums, RenderStats* stats) {
   const double inv_spp = 1.0 / job->ctx.options.spp;
   const int width = job->ctx.view.camera.width;
   for (int c = 0; c < 3; ++c) {
@@ -81,7 +87,7 @@ void FinishPixel(TileJob* job, int tile, int x, int y, const Eigen::Vector3d& su
     const Eigen::Vector3d w(w_image.at(x, y, 0), w_image.at(x, y, 1), w_image.at(x, y, 2));
     for (const JacobianEntry& e : *merged) {
       const double g = w[0] * e.d[0] + w[1] * e.d[1] + w[2] * e.d[2];
-      if (g != 0.0) job->tile_gradients[tile].emplace_back(e.param, g);
+      if (g != 0.0) tile_sums->Add(e.param, g);
     }
   }
   if (job->want_rows) job->pixel_rows[static_cast<size_t>(y) * width + x] = *merged;
@@ -101,6 +107,7 @@ void RenderTile(TileJob* job, int tile) {
   std::optional<PathDerivatives> path;
   if (job->want_derivatives) path.emplace(ctx);
   std::vector<JacobianEntry> merged;
+  ParamSums<double>& tile_sums = job->thread_tile_sums.local();
   for (int y = y0; y < std::min(y0 + kTile, height); ++y) {
     Eigen::Vector3d sums[kTile];
     int hits[kTile] = {0};
@@ -133,14 +140,17 @@ void RenderTile(TileJob* job, int tile) {
       }
     }
     for (int i = 0; i < count; ++i) {
-      FinishPixel(job, tile, x0 + i, y, sums[i], hits[i], &rows[i], &merged, &local);
+      FinishPixel(job, x0 + i, y, sums[i], hits[i], &rows[i], &merged, &tile_sums, &local);
     }
   }
+  if (job->weights != nullptr) tile_sums.MoveTo(&job->tile_gradients[tile]);
   if (options.on_tile_done) options.on_tile_done();
 }
 
-// Moves the job's per-pixel rows and per-tile gradient terms into *output.
-void CollectDerivatives(TileJob* job, const ParameterLayout& layout, DerivativeOutput* output) {
+// Moves the job's per-pixel rows and per-tile gradient terms into *output; counts the gradient
+// terms in *stats.
+void CollectDerivatives(TileJob* job, const ParameterLayout& layout, DerivativeOutput* output,
+                        RenderStats* stats) {
   output->layout = layout;
   if (job->want_rows) {
     JacobianRows& rows = output->rows;
@@ -160,6 +170,7 @@ void CollectDerivatives(TileJob* job, const ParameterLayout& layout, DerivativeO
   if (job->weights != nullptr) {
     output->gradient.assign(layout.size(), 0.0);
     for (const auto& list : job->tile_gradients) {
+      stats->gradient_terms += static_cast<int64_t>(list.size());
       for (const auto& [param, g] : list) output->gradient[param] += g;
     }
   }
@@ -226,9 +237,13 @@ void RenderImpl(const RenderScene& scene, const Material& material, const ViewSe
   tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
   arena.execute(
       [&] { tbb::parallel_for(0, num_tiles, [&](int tile) { RenderTile(&job, tile); }); });
-  if (output != nullptr && layout != nullptr) CollectDerivatives(&job, *layout, output);
+  RenderStats collect_stats;
+  if (output != nullptr && layout != nullptr) {
+    CollectDerivatives(&job, *layout, output, &collect_stats);
+  }
   if (stats != nullptr) {
     *stats = edge_stats;
+    stats->AddCounts(collect_stats);
     for (const RenderStats& s : job.thread_stats) stats->AddCounts(s);
     stats->seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

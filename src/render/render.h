@@ -98,6 +98,9 @@ struct RenderStats {
   // Jacobian row / adjoint entries (dropped). Non-zero means the render cannot be trusted, e.g.
   // the reconstruction rejects the step.
   int64_t nonfinite_outputs = 0;
+  // Adjoint gradient terms (parameter, value) held between the tiles and their reduction into
+  // the gradient: the storage of the adjoint pass beyond the gradient itself.
+  int64_t gradient_terms = 0;
   double seconds = 0.0;
   int64_t TotalRays() const { return camera_rays + shadow_rays + bounce_rays; }
   int64_t NonFinite() const { return nonfinite_samples + nonfinite_outputs; }
@@ -108,6 +111,7 @@ struct RenderStats {
     bounce_rays += other.bounce_rays;
     nonfinite_samples += other.nonfinite_samples;
     nonfinite_outputs += other.nonfinite_outputs;
+    gradient_terms += other.gradient_terms;
   }
 };
 

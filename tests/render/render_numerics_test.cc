@@ -3,9 +3,11 @@
 #include <gtest/gtest.h>
 #include <xmmintrin.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <vector>
 
 #include "src/geometry/material.h"
 #include "src/render/render.h"
@@ -90,6 +92,64 @@ TEST(RenderNumericsTest, DerivativesAreBitIdenticalForOneAndTwoThreads) {
     non_zero += g1.output.gradient[i] != 0.0;
   }
   EXPECT_GT(non_zero, 20);
+}
+
+// The adjoint gradient equals Σ_pixels w·(the pixel's float row) up to summation order, and the
+// render holds one term per distinct parameter of each 8×8 tile, not one per row entry.
+TEST(RenderNumericsTest, AdjointIsTheWeightedRowsSummedPerTile) {
+  const testing::Triangles mesh = CubeOnGround();
+  const RenderScene scene(mesh.positions, mesh.faces);
+  const Material material = ConstantMaterial(static_cast<int>(mesh.faces.size()),
+                                             Eigen::Vector3d(0.7, 0.5, 0.3), 0.4, 0.3);
+  const ViewSetup view = CubeView();
+  const int res = view.camera.width;
+  Image weights(res, res, 3);
+  for (size_t i = 0; i < weights.data.size(); ++i) {
+    weights.data[i] = static_cast<float>((i * 7919) % 101) / 50.5f - 1.0f;
+  }
+  RenderOptions options;
+  options.spp = 4;
+  options.bounces = 2;
+  DerivativeRequest request;
+  request.params.vertices = true;
+  request.jacobian_rows = true;
+  request.adjoint_weights = &weights;
+  request.primary_edge_ratio = 1.0;
+  request.shadow_edge_ratio = 1.0;
+  request.secondary_edge_samples = 2.0;
+  Image image;
+  DerivativeOutput out;
+  RenderStats stats;
+  RenderViewWithDerivatives(scene, material, view, options, request, 1, &image, &out, &stats);
+
+  constexpr int kTile = 8;
+  const int tiles_x = (res + kTile - 1) / kTile;
+  ASSERT_EQ(RenderTileCount(res, res), tiles_x * tiles_x);
+  std::vector<double> expected(out.gradient.size(), 0.0);
+  std::vector<std::vector<int>> tile_params(RenderTileCount(res, res));
+  for (int p = 0; p < res * res; ++p) {
+    const int tile = (p / res / kTile) * tiles_x + (p % res) / kTile;
+    for (uint64_t e = out.rows.offsets[p]; e < out.rows.offsets[p + 1]; ++e) {
+      const JacobianEntry& entry = out.rows.entries[e];
+      double g = 0.0;
+      for (int c = 0; c < 3; ++c) g += weights.data[3 * p + c] * static_cast<double>(entry.d[c]);
+      expected[entry.param] += g;
+      if (g != 0.0) tile_params[tile].push_back(entry.param);
+    }
+  }
+  int64_t distinct = 0;
+  for (std::vector<int>& params : tile_params) {
+    std::sort(params.begin(), params.end());
+    distinct += std::unique(params.begin(), params.end()) - params.begin();
+  }
+  EXPECT_EQ(stats.gradient_terms, distinct);
+  EXPECT_LT(stats.gradient_terms, static_cast<int64_t>(out.rows.entries.size()) / 2);
+  double max_abs = 0.0;
+  for (double g : expected) max_abs = std::max(max_abs, std::abs(g));
+  ASSERT_GT(max_abs, 0.0);
+  for (size_t i = 0; i < expected.size(); ++i) {
+    EXPECT_NEAR(out.gradient[i], expected[i], 1e-12 * max_abs) << "parameter " << i;
+  }
 }
 
 // A light of infinite intensity in one channel makes every sample that sees it non-finite: the

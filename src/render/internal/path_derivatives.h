@@ -24,15 +24,15 @@ namespace render_internal {
 // (parameter, ∂RGB) pairs, in arrival order (edge terms of one pixel).
 using DerivativeList = std::vector<std::pair<int, Eigen::Vector3d>>;
 
-// One pixel's derivatives, summed per parameter as they arrive: an open-addressing hash table
-// (linear probing, load ≤ 1/2) over the parameters touched so far. A pixel's paths touch the same
-// few faces and texels over and over (every contribution re-emits the corners of the faces behind
-// it), so summing on arrival keeps the work per entry O(1) and sorts only the distinct parameters.
-class RowAccumulator {
+// Values summed per parameter as they arrive: an open-addressing hash table (linear probing,
+// load ≤ 1/2) over the parameters touched so far. `Value` is Eigen::Vector3d (a pixel's ∂RGB) or
+// double (adjoint terms w·∂RGB).
+template <typename Value>
+class ParamSums {
  public:
-  RowAccumulator() { Resize(64); }
+  ParamSums() { Resize(64); }
 
-  void Add(int param, const Eigen::Vector3d& d) {
+  void Add(int param, const Value& d) {
     uint32_t slot = Hash(param) & mask_;
     while (true) {
       const int key = keys_[slot];
@@ -49,6 +49,47 @@ class RowAccumulator {
     if (2 * used_.size() > keys_.size()) Grow();
   }
 
+  // The number of distinct parameters summed.
+  size_t size() const { return used_.size(); }
+
+  // Appends the (parameter, sum) pairs to *out in the order the parameters first arrived (a
+  // deterministic order when the additions are), and empties the table.
+  void MoveTo(std::vector<std::pair<int, Value>>* out) {
+    out->reserve(out->size() + used_.size());
+    for (const uint32_t slot : used_) {
+      out->emplace_back(keys_[slot], values_[slot]);
+      keys_[slot] = -1;
+    }
+    used_.clear();
+  }
+
+ protected:
+  static uint32_t Hash(int param) { return static_cast<uint32_t>(param) * 2654435761u; }
+
+  void Resize(size_t capacity) {
+    keys_.assign(capacity, -1);
+    values_.resize(capacity);
+    mask_ = static_cast<uint32_t>(capacity - 1);
+  }
+
+  void Grow() {
+    std::vector<std::pair<int, Value>> entries;
+    MoveTo(&entries);
+    Resize(2 * keys_.size());
+    for (const auto& [param, d] : entries) Add(param, d);
+  }
+
+  std::vector<int> keys_;  // −1: empty.
+  std::vector<Value> values_;
+  std::vector<uint32_t> used_;  // occupied slots, in insertion order.
+  uint32_t mask_ = 0;
+};
+
+// One pixel's derivatives, summed per parameter as they arrive. A pixel's paths touch the same
+// few faces and texels over and over (every contribution re-emits the corners of the faces behind
+// it), so summing on arrival keeps the work per entry O(1) and sorts only the distinct parameters.
+class RowAccumulator : public ParamSums<Eigen::Vector3d> {
+ public:
   // Writes the sums times `scale`, sorted by parameter, and empties the table. A sum that is not
   // finite or whose product with `scale` overflows float is dropped and counted in
   // *dropped.
@@ -71,29 +112,6 @@ class RowAccumulator {
     }
     used_.clear();
   }
-
- private:
-  static uint32_t Hash(int param) { return static_cast<uint32_t>(param) * 2654435761u; }
-
-  void Resize(size_t capacity) {
-    keys_.assign(capacity, -1);
-    values_.resize(capacity);
-    mask_ = static_cast<uint32_t>(capacity - 1);
-  }
-
-  void Grow() {
-    std::vector<std::pair<int, Eigen::Vector3d>> entries;
-    entries.reserve(used_.size());
-    for (const uint32_t slot : used_) entries.emplace_back(keys_[slot], values_[slot]);
-    used_.clear();
-    Resize(2 * keys_.size());
-    for (const auto& [param, d] : entries) Add(param, d);
-  }
-
-  std::vector<int> keys_;  // −1: empty.
-  std::vector<Eigen::Vector3d> values_;
-  std::vector<uint32_t> used_;  // occupied slots, in insertion order.
-  uint32_t mask_ = 0;
 };
 
 // The light term Q of a contribution, split as Q = q·c with c the part that depends on the

@@ -330,7 +330,9 @@ void SampleShadowBoundary(const SecondaryVertex& v, double u_light, Sampler* sam
 ShadowPool BuildShadowPool(const Context& ctx, const Eigen::Vector3d& light, int64_t attempts,
                            uint64_t key, RenderStats* stats) {
   ShadowPool pool;
-  const std::vector<EdgeCandidate> candidates = ShadowEdgeCandidates(ctx.scene, light);
+  const std::shared_ptr<const std::vector<EdgeCandidate>> shared =
+      ShadowEdgeCandidates(ctx.scene, light);
+  const std::vector<EdgeCandidate>& candidates = *shared;
   std::vector<double> angles;
   for (const EdgeCandidate& c : candidates) angles.push_back(c.weight);
   const DiscreteDistribution by_angle(angles);

@@ -1,7 +1,14 @@
 #include "src/render/internal/shadow_edges.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <deque>
+#include <memory>
+#include <mutex>
+#include <vector>
 
 #include "src/render/geometry_derivatives.h"
 #include "src/render/internal/integrator.h"
@@ -29,6 +36,23 @@ Eigen::Vector3d ShadowJump(const EdgeView& view, const PointLight& light, int re
     }
   }
   return direct[0] - direct[1];
+}
+
+// ShadowEdgeCandidates without the cache.
+std::vector<EdgeCandidate> BuildShadowEdgeCandidates(const RenderScene& scene,
+                                                     const Eigen::Vector3d& light) {
+  std::vector<EdgeCandidate> candidates;
+  const auto& positions = scene.positions();
+  const auto& edges = scene.edges();
+  for (size_t e = 0; e < edges.size(); ++e) {
+    const MeshEdge& edge = edges[e];
+    const Eigen::Vector3d a = positions[edge.v0] - light, b = positions[edge.v1] - light;
+    if (a == b || !IsDiscontinuityEdge(scene, edge, light, /*creases=*/false)) continue;
+    const double angle = std::atan2(a.cross(b).norm(), a.dot(b));
+    if (!(angle > 0.0) || !std::isfinite(angle)) continue;
+    candidates.push_back({static_cast<int>(e), 0.0, 1.0, angle});
+  }
+  return candidates;
 }
 
 }  // namespace
@@ -77,20 +101,42 @@ void ShadowPointRows(const ShadowPoint& shadow, const RenderScene& scene, const 
   for (int j = 0; j < 3; ++j) out->Add(corners[j], shadow.barycentrics[j] * receiver_row);
 }
 
-std::vector<EdgeCandidate> ShadowEdgeCandidates(const RenderScene& scene,
-                                                const Eigen::Vector3d& light) {
-  std::vector<EdgeCandidate> candidates;
-  const auto& positions = scene.positions();
-  const auto& edges = scene.edges();
-  for (size_t e = 0; e < edges.size(); ++e) {
-    const MeshEdge& edge = edges[e];
-    const Eigen::Vector3d a = positions[edge.v0] - light, b = positions[edge.v1] - light;
-    if (a == b || !IsDiscontinuityEdge(scene, edge, light, /*creases=*/false)) continue;
-    const double angle = std::atan2(a.cross(b).norm(), a.dot(b));
-    if (!(angle > 0.0) || !std::isfinite(angle)) continue;
-    candidates.push_back({static_cast<int>(e), 0.0, 1.0, angle});
+std::shared_ptr<const std::vector<EdgeCandidate>> ShadowEdgeCandidates(
+    const RenderScene& scene, const Eigen::Vector3d& light) {
+  // Keyed exactly: the mesh state and the light position's bits.
+  struct Entry {
+    uint64_t state;
+    std::array<uint64_t, 3> light_bits;
+    std::shared_ptr<const std::vector<EdgeCandidate>> candidates;
+  };
+  static std::mutex mutex;
+  static std::deque<Entry> recent;  // most recently used first.
+  std::array<uint64_t, 3> light_bits;
+  std::memcpy(light_bits.data(), light.data(), sizeof(light_bits));
+  const uint64_t state = scene.state_id();
+  // Moves the entry with the key to the front and returns its candidates, or null.
+  const auto find = [&]() -> std::shared_ptr<const std::vector<EdgeCandidate>> {
+    for (auto it = recent.begin(); it != recent.end(); ++it) {
+      if (it->state == state && it->light_bits == light_bits) {
+        Entry entry = std::move(*it);
+        recent.erase(it);
+        recent.push_front(std::move(entry));
+        return recent.front().candidates;
+      }
+    }
+    return nullptr;
+  };
+  {
+    std::lock_guard<std::mutex> lock(mutex);
+    if (auto found = find()) return found;
   }
-  return candidates;
+  auto built =
+      std::make_shared<const std::vector<EdgeCandidate>>(BuildShadowEdgeCandidates(scene, light));
+  std::lock_guard<std::mutex> lock(mutex);
+  if (auto found = find()) return found;  // built meanwhile by another thread: the same list.
+  recent.push_front({state, light_bits, built});
+  if (recent.size() > kShadowCandidateBuildsKept) recent.pop_back();
+  return built;
 }
 
 void AddShadowEdgeTerms(const EdgeView& view, std::vector<EdgeEntry>* entries) {
@@ -123,7 +169,7 @@ void AddShadowEdgeTerms(const EdgeView& view, std::vector<EdgeEntry>* entries) {
           &local, out);
     };
     const int64_t num_samples = static_cast<int64_t>(std::ceil(ratio * options.spp * view.pixels));
-    SampleCandidates(options, ShadowEdgeCandidates(scene, light), num_samples,
+    SampleCandidates(options, *ShadowEdgeCandidates(scene, light), num_samples,
                      kShadowEdgeKey + (l << 40), ctx.view.view_index, sample_shadow, entries);
   }
 }

@@ -6,6 +6,8 @@
 #define SFT_RENDER_INTERNAL_SHADOW_EDGES_H_
 
 #include <Eigen/Core>
+#include <cstddef>
+#include <memory>
 #include <vector>
 
 #include "src/render/internal/context.h"
@@ -37,10 +39,18 @@ bool CastShadowPoint(const Context& ctx, const Eigen::Vector3d& light, const Mes
 void ShadowPointRows(const ShadowPoint& shadow, const RenderScene& scene, const MeshEdge& edge,
                      double s, const Eigen::Vector3d& row, BoundaryRows* out);
 
+// How many (mesh state, light position) builds ShadowEdgeCandidates keeps: camera-attached lights
+// move with the view, so an evaluation meets one position per view; a few entries serve the
+// callers and passes of the views in flight without holding a list per view.
+constexpr size_t kShadowCandidateBuildsKept = 8;
+
 // Shadow-casting edges of a point light: every edge that can be a silhouette from it, weighted
-// by the angle it subtends there (shadow samples are spread ∝ angle at the light).
-std::vector<EdgeCandidate> ShadowEdgeCandidates(const RenderScene& scene,
-                                                const Eigen::Vector3d& light);
+// by the angle it subtends there (shadow samples are spread ∝ angle at the light). Built once per
+// mesh state (RenderScene::state_id) and light position: the few most recent builds are kept, so
+// that the shadow and secondary edges of a view, and the passes that render the same view, share
+// one.
+std::shared_ptr<const std::vector<EdgeCandidate>> ShadowEdgeCandidates(
+    const RenderScene& scene, const Eigen::Vector3d& light);
 
 }  // namespace render_internal
 }  // namespace sft
