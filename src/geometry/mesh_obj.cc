@@ -17,152 +17,180 @@
 namespace sft {
 namespace mesh_internal {
 
-Status ParseObj(const std::string& path, const std::string& text, ParsedMesh* out) {
-  LineReader reader(text);
-  std::string_view line;
-  std::vector<std::string_view> tokens;
-  int num_normals = 0;
-  // Positive indices may refer to vertices defined later in the file (OpenMesh's reader allows
-  // it too), so they are range-checked at the end; out->face_lines remembers where each face
-  // came from.
-  std::vector<int>& face_lines = out->face_lines;
+namespace {
+
+// Parse state beyond ParsedMesh. Positive indices may refer to elements defined later in the file
+// (OpenMesh's reader allows it too), so they are range-checked at the end.
+struct ObjState {
   struct PendingNormal {
     long long index;
     int line;
   };
-  std::vector<PendingNormal> positive_normals;
-  std::vector<int> positive_uv_corners;  // corners whose uv index is a positive (deferred) one.
+  int num_normals = 0;
+  std::vector<PendingNormal> positive_normals;  // normal indices to check at the end.
+};
 
+// "v x y z" (errors name PATH and the line).
+Status ParseObjVertex(const std::vector<std::string_view>& tokens, const std::string& path,
+                      int line, ParsedMesh* out) {
+  if (tokens.size() < 4) return Status::Error(LinePrefix(path, line) + ": vertex needs x y z");
+  Eigen::Vector3d p;
+  for (int c = 0; c < 3; ++c) {
+    if (!ParseDouble(tokens[1 + c], &p[c])) {
+      return Status::Error(LinePrefix(path, line) + ": malformed vertex coordinate '" +
+                           std::string(tokens[1 + c]) + "'");
+    }
+  }
+  if (!p.allFinite()) {
+    return Status::Error(LinePrefix(path, line) + ": non-finite vertex coordinate");
+  }
+  out->positions.push_back(p);
+  return Status::Ok();
+}
+
+// "vt u [v]".
+Status ParseObjUv(const std::vector<std::string_view>& tokens, const std::string& path, int line,
+                  ParsedMesh* out) {
+  if (tokens.size() < 2) return Status::Error(LinePrefix(path, line) + ": vt needs u [v]");
+  Eigen::Vector2d uv(0.0, 0.0);
+  for (int c = 0; c < 2 && 1 + c < static_cast<int>(tokens.size()); ++c) {
+    if (!ParseDouble(tokens[1 + c], &uv[c])) {
+      return Status::Error(LinePrefix(path, line) + ": malformed texture coordinate '" +
+                           std::string(tokens[1 + c]) + "'");
+    }
+  }
+  if (!uv.allFinite()) {
+    return Status::Error(LinePrefix(path, line) + ": non-finite texture coordinate");
+  }
+  out->uvs.push_back(uv);
+  return Status::Ok();
+}
+
+// Resolves a 1-based (or negative, relative) index against `count` elements so far; `deferred`
+// tells a positive index (checked against the final count later).
+Status ResolveObjIndex(std::string_view s, int count, const char* what, const std::string& path,
+                       int line, long long* index, bool* deferred) {
+  long long value = 0;
+  if (!ParseInt(s, &value)) {
+    return Status::Error(LinePrefix(path, line) + ": malformed " + what + " index '" +
+                         std::string(s) + "'");
+  }
+  if (value == 0) {
+    return Status::Error(LinePrefix(path, line) + ": " + what +
+                         " index 0 (OBJ indices start at 1)");
+  }
+  *deferred = value > 0;
+  *index = value > 0 ? value - 1 : count + value;
+  if (*index < 0) {
+    return Status::Error(LinePrefix(path, line) + ": " + what + " index " + std::to_string(value) +
+                         " out of range (" + std::to_string(count) + " defined before it)");
+  }
+  return Status::Ok();
+}
+
+// One face corner: v, v/vt, v//vn or v/vt/vn.
+Status ParseObjCorner(std::string_view token, const std::string& path, int line, ObjState* state,
+                      ParsedMesh* out) {
+  std::string_view parts[3];
+  int num_parts = 0;
+  std::string_view rest = token;
+  while (true) {
+    const size_t slash = rest.find('/');
+    if (num_parts == 3) {
+      return Status::Error(LinePrefix(path, line) + ": malformed face corner '" +
+                           std::string(token) + "'");
+    }
+    parts[num_parts++] = rest.substr(0, slash);
+    if (slash == std::string_view::npos) break;
+    rest = rest.substr(slash + 1);
+  }
+  long long vi = 0;
+  bool deferred = false;
+  SFT_RETURN_IF_ERROR(ResolveObjIndex(parts[0], static_cast<int>(out->positions.size()), "vertex",
+                                      path, line, &vi, &deferred));
+  if (vi > std::numeric_limits<int>::max()) {
+    return Status::Error(LinePrefix(path, line) + ": vertex index out of range");
+  }
+  out->corner_vertices.push_back(static_cast<int>(vi));
+  int uv_index = -1;
+  if (num_parts >= 2 && !parts[1].empty()) {
+    long long ti = 0;
+    SFT_RETURN_IF_ERROR(ResolveObjIndex(parts[1], static_cast<int>(out->uvs.size()),
+                                        "texture coordinate", path, line, &ti, &deferred));
+    if (ti > std::numeric_limits<int>::max()) {
+      return Status::Error(LinePrefix(path, line) + ": texture coordinate index out of range");
+    }
+    uv_index = static_cast<int>(ti);
+  }
+  out->corner_uvs.push_back(uv_index);
+  if (num_parts == 3 && !parts[2].empty()) {
+    long long ni = 0;
+    SFT_RETURN_IF_ERROR(
+        ResolveObjIndex(parts[2], state->num_normals, "normal", path, line, &ni, &deferred));
+    if (deferred) state->positive_normals.push_back({ni, line});
+  }
+  return Status::Ok();
+}
+
+// The deferred range checks against the final counts.
+Status CheckObjIndices(const std::string& path, const ObjState& state, const ParsedMesh& mesh) {
+  const int num_vertices = static_cast<int>(mesh.positions.size());
+  for (int f = 0; f < mesh.num_faces(); ++f) {
+    for (int c = mesh.face_offsets[f]; c < mesh.face_offsets[f + 1]; ++c) {
+      const int v = mesh.corner_vertices[c];
+      if (v >= num_vertices) {
+        return Status::Error(LinePrefix(path, mesh.face_lines[f]) + ": vertex index " +
+                             std::to_string(v + 1) + " out of range (" +
+                             std::to_string(num_vertices) + " vertices)");
+      }
+      if (mesh.corner_uvs[c] >= static_cast<int>(mesh.uvs.size())) {
+        return Status::Error(LinePrefix(path, mesh.face_lines[f]) + ": texture coordinate index " +
+                             std::to_string(mesh.corner_uvs[c] + 1) + " out of range (" +
+                             std::to_string(mesh.uvs.size()) + " texture coordinates)");
+      }
+    }
+  }
+  for (const ObjState::PendingNormal& n : state.positive_normals) {
+    if (n.index >= state.num_normals) {
+      return Status::Error(LinePrefix(path, n.line) + ": normal index " +
+                           std::to_string(n.index + 1) + " out of range (" +
+                           std::to_string(state.num_normals) + " normals)");
+    }
+  }
+  return Status::Ok();
+}
+
+}  // namespace
+
+Status ParseObj(const std::string& path, const std::string& text, ParsedMesh* out) {
+  LineReader reader(text);
+  std::string_view line;
+  std::vector<std::string_view> tokens;
+  ObjState state;
   while (reader.Next(&line)) {
     Tokenize(line, &tokens);
     if (tokens.empty()) continue;
     const std::string_view key = tokens[0];
     const int ln = reader.line_number();
     if (key == "v") {
-      if (tokens.size() < 4) return Status::Error(LinePrefix(path, ln) + ": vertex needs x y z");
-      Eigen::Vector3d p;
-      for (int c = 0; c < 3; ++c) {
-        if (!ParseDouble(tokens[1 + c], &p[c])) {
-          return Status::Error(LinePrefix(path, ln) + ": malformed vertex coordinate '" +
-                               std::string(tokens[1 + c]) + "'");
-        }
-      }
-      if (!p.allFinite()) {
-        return Status::Error(LinePrefix(path, ln) + ": non-finite vertex coordinate");
-      }
-      out->positions.push_back(p);
+      SFT_RETURN_IF_ERROR(ParseObjVertex(tokens, path, ln, out));
     } else if (key == "vt") {
-      if (tokens.size() < 2) return Status::Error(LinePrefix(path, ln) + ": vt needs u [v]");
-      Eigen::Vector2d uv(0.0, 0.0);
-      for (int c = 0; c < 2 && 1 + c < static_cast<int>(tokens.size()); ++c) {
-        if (!ParseDouble(tokens[1 + c], &uv[c])) {
-          return Status::Error(LinePrefix(path, ln) + ": malformed texture coordinate '" +
-                               std::string(tokens[1 + c]) + "'");
-        }
-      }
-      if (!uv.allFinite()) {
-        return Status::Error(LinePrefix(path, ln) + ": non-finite texture coordinate");
-      }
-      out->uvs.push_back(uv);
+      SFT_RETURN_IF_ERROR(ParseObjUv(tokens, path, ln, out));
     } else if (key == "vn") {
-      ++num_normals;
+      ++state.num_normals;
     } else if (key == "f") {
       if (tokens.size() < 4) {
         return Status::Error(LinePrefix(path, ln) + ": face with fewer than 3 vertices");
       }
       for (size_t t = 1; t < tokens.size(); ++t) {
-        // v, v/vt, v//vn or v/vt/vn.
-        std::string_view parts[3];
-        int num_parts = 0;
-        std::string_view rest = tokens[t];
-        while (true) {
-          const size_t slash = rest.find('/');
-          if (num_parts == 3) {
-            return Status::Error(LinePrefix(path, ln) + ": malformed face corner '" +
-                                 std::string(tokens[t]) + "'");
-          }
-          parts[num_parts++] = rest.substr(0, slash);
-          if (slash == std::string_view::npos) break;
-          rest = rest.substr(slash + 1);
-        }
-        // Resolves a 1-based (or negative, relative) index against `count` elements so far.
-        auto resolve = [&](std::string_view s, int count, const char* what, long long* index,
-                           bool* deferred) -> Status {
-          long long value = 0;
-          if (!ParseInt(s, &value)) {
-            return Status::Error(LinePrefix(path, ln) + ": malformed " + what + " index '" +
-                                 std::string(s) + "'");
-          }
-          if (value == 0) {
-            return Status::Error(LinePrefix(path, ln) + ": " + what +
-                                 " index 0 (OBJ indices start at 1)");
-          }
-          *deferred = value > 0;
-          *index = value > 0 ? value - 1 : count + value;
-          if (*index < 0) {
-            return Status::Error(LinePrefix(path, ln) + ": " + what + " index " +
-                                 std::to_string(value) + " out of range (" + std::to_string(count) +
-                                 " defined before it)");
-          }
-          return Status::Ok();
-        };
-        long long vi = 0;
-        bool deferred = false;
-        SFT_RETURN_IF_ERROR(
-            resolve(parts[0], static_cast<int>(out->positions.size()), "vertex", &vi, &deferred));
-        if (vi > std::numeric_limits<int>::max()) {
-          return Status::Error(LinePrefix(path, ln) + ": vertex index out of range");
-        }
-        out->corner_vertices.push_back(static_cast<int>(vi));
-        int uv_index = -1;
-        if (num_parts >= 2 && !parts[1].empty()) {
-          long long ti = 0;
-          SFT_RETURN_IF_ERROR(resolve(parts[1], static_cast<int>(out->uvs.size()),
-                                      "texture coordinate", &ti, &deferred));
-          if (ti > std::numeric_limits<int>::max()) {
-            return Status::Error(LinePrefix(path, ln) + ": texture coordinate index out of range");
-          }
-          uv_index = static_cast<int>(ti);
-          if (deferred) positive_uv_corners.push_back(static_cast<int>(out->corner_uvs.size()));
-        }
-        out->corner_uvs.push_back(uv_index);
-        if (num_parts == 3 && !parts[2].empty()) {
-          long long ni = 0;
-          SFT_RETURN_IF_ERROR(resolve(parts[2], num_normals, "normal", &ni, &deferred));
-          if (deferred) positive_normals.push_back({ni, ln});
-        }
+        SFT_RETURN_IF_ERROR(ParseObjCorner(tokens[t], path, ln, &state, out));
       }
       out->EndFace();
-      face_lines.push_back(ln);
+      out->face_lines.push_back(ln);  // where each face came from, for the deferred checks.
     }
     // Everything else (o, g, s, usemtl, mtllib, l, p, vp, ...) does not affect the mesh.
   }
-
-  // Deferred range checks against the final counts.
-  const int num_vertices = static_cast<int>(out->positions.size());
-  for (int f = 0; f < out->num_faces(); ++f) {
-    for (int c = out->face_offsets[f]; c < out->face_offsets[f + 1]; ++c) {
-      const int v = out->corner_vertices[c];
-      if (v >= num_vertices) {
-        return Status::Error(LinePrefix(path, face_lines[f]) + ": vertex index " +
-                             std::to_string(v + 1) + " out of range (" +
-                             std::to_string(num_vertices) + " vertices)");
-      }
-      if (out->corner_uvs[c] >= static_cast<int>(out->uvs.size())) {
-        return Status::Error(LinePrefix(path, face_lines[f]) + ": texture coordinate index " +
-                             std::to_string(out->corner_uvs[c] + 1) + " out of range (" +
-                             std::to_string(out->uvs.size()) + " texture coordinates)");
-      }
-    }
-  }
-  for (const PendingNormal& n : positive_normals) {
-    if (n.index >= num_normals) {
-      return Status::Error(LinePrefix(path, n.line) + ": normal index " +
-                           std::to_string(n.index + 1) + " out of range (" +
-                           std::to_string(num_normals) + " normals)");
-    }
-  }
-  return Status::Ok();
+  return CheckObjIndices(path, state, *out);
 }
 
 Status WriteObj(const std::string& path, const TriMesh& mesh) {

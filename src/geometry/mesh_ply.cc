@@ -18,6 +18,7 @@
 
 namespace sft {
 namespace mesh_internal {
+namespace {
 
 enum class PlyType { kInt8, kUint8, kInt16, kUint16, kInt32, kUint32, kFloat32, kFloat64 };
 
@@ -142,221 +143,305 @@ class PlyBodyReader {
   Format format_;
 };
 
-Status ParsePly(const std::string& path, const std::string& text, ParsedMesh* out) {
-  // Header: lines up to "end_header".
+// The header: body format, elements with their properties, and where the body starts.
+struct PlyHeader {
+  PlyBodyReader::Format format = PlyBodyReader::Format::kAscii;
+  std::vector<PlyElement> elements;
+  size_t body_start = 0;
+};
+
+// Whitespace-separated tokens of a header line. Comments start with the keyword "comment", not
+// '#', so nothing is stripped.
+void TokenizeHeaderLine(std::string_view line, std::vector<std::string_view>* tokens) {
+  tokens->clear();
+  size_t i = 0;
+  while (i < line.size()) {
+    while (i < line.size() && IsSpace(line[i])) ++i;
+    const size_t s = i;
+    while (i < line.size() && !IsSpace(line[i])) ++i;
+    if (i > s) tokens->push_back(line.substr(s, i - s));
+  }
+}
+
+Status ParsePlyProperty(const std::vector<std::string_view>& tokens, const std::string& where,
+                        PlyProperty* property) {
+  if (tokens.size() == 5 && tokens[1] == "list") {
+    property->is_list = true;
+    if (!ParsePlyType(tokens[2], &property->count_type) ||
+        !ParsePlyType(tokens[3], &property->type) || property->count_type == PlyType::kFloat32 ||
+        property->count_type == PlyType::kFloat64) {
+      return Status::Error(where + ": malformed list property");
+    }
+    property->name = std::string(tokens[4]);
+  } else if (tokens.size() == 3 && ParsePlyType(tokens[1], &property->type)) {
+    property->name = std::string(tokens[2]);
+  } else {
+    return Status::Error(where + ": malformed property line");
+  }
+  return Status::Ok();
+}
+
+// A "format", "element" or "property" line (`where` = "PATH: line N").
+Status ParsePlyHeaderLine(const std::vector<std::string_view>& tokens, const std::string& where,
+                          PlyHeader* header, bool* have_format) {
+  const std::string_view key = tokens[0];
+  if (key == "format") {
+    if (tokens.size() < 2) return Status::Error(where + ": malformed format");
+    if (tokens[1] == "ascii") {
+      header->format = PlyBodyReader::Format::kAscii;
+    } else if (tokens[1] == "binary_little_endian") {
+      header->format = PlyBodyReader::Format::kBinaryLittle;
+    } else if (tokens[1] == "binary_big_endian") {
+      header->format = PlyBodyReader::Format::kBinaryBig;
+    } else {
+      return Status::Error(where + ": unknown PLY format '" + std::string(tokens[1]) + "'");
+    }
+    *have_format = true;
+  } else if (key == "element") {
+    long long count = 0;
+    if (tokens.size() != 3 || !ParseInt(tokens[2], &count) || count < 0 ||
+        count > std::numeric_limits<int>::max()) {
+      return Status::Error(where + ": malformed element line");
+    }
+    header->elements.push_back({std::string(tokens[1]), count, {}});
+  } else if (key == "property") {
+    if (header->elements.empty()) return Status::Error(where + ": property before any element");
+    PlyProperty property;
+    SFT_RETURN_IF_ERROR(ParsePlyProperty(tokens, where, &property));
+    header->elements.back().properties.push_back(property);
+  } else {
+    return Status::Error(where + ": unknown PLY header line '" + std::string(key) + "'");
+  }
+  return Status::Ok();
+}
+
+// Lines up to "end_header".
+Status ParsePlyHeader(const std::string& path, const std::string& text, PlyHeader* header) {
   LineReader reader(text);
   std::string_view line;
   std::vector<std::string_view> tokens;
   if (!reader.Next(&line) || (Tokenize(line, &tokens), tokens.size() != 1 || tokens[0] != "ply")) {
     return Status::Error(path + ": not a PLY file (first line must be 'ply')");
   }
-  PlyBodyReader::Format format = PlyBodyReader::Format::kAscii;
   bool have_format = false, have_end = false;
-  std::vector<PlyElement> elements;
-  size_t body_start = 0;
   while (reader.Next(&line)) {
-    const int ln = reader.line_number();
-    // Comments start with the keyword "comment", not '#': tokenize without comment stripping.
-    tokens.clear();
-    {
-      size_t i = 0;
-      while (i < line.size()) {
-        while (i < line.size() && IsSpace(line[i])) ++i;
-        const size_t s = i;
-        while (i < line.size() && !IsSpace(line[i])) ++i;
-        if (i > s) tokens.push_back(line.substr(s, i - s));
-      }
-    }
-    if (tokens.empty()) continue;
-    const std::string_view key = tokens[0];
-    if (key == "comment" || key == "obj_info") continue;
-    if (key == "end_header") {
+    TokenizeHeaderLine(line, &tokens);
+    if (tokens.empty() || tokens[0] == "comment" || tokens[0] == "obj_info") continue;
+    if (tokens[0] == "end_header") {
       have_end = true;
-      body_start = static_cast<size_t>(line.data() + line.size() - text.data()) + 1;
+      header->body_start = static_cast<size_t>(line.data() + line.size() - text.data()) + 1;
       break;
     }
-    if (key == "format") {
-      if (tokens.size() < 2) return Status::Error(LinePrefix(path, ln) + ": malformed format");
-      if (tokens[1] == "ascii") {
-        format = PlyBodyReader::Format::kAscii;
-      } else if (tokens[1] == "binary_little_endian") {
-        format = PlyBodyReader::Format::kBinaryLittle;
-      } else if (tokens[1] == "binary_big_endian") {
-        format = PlyBodyReader::Format::kBinaryBig;
-      } else {
-        return Status::Error(LinePrefix(path, ln) + ": unknown PLY format '" +
-                             std::string(tokens[1]) + "'");
-      }
-      have_format = true;
-    } else if (key == "element") {
-      long long count = 0;
-      if (tokens.size() != 3 || !ParseInt(tokens[2], &count) || count < 0 ||
-          count > std::numeric_limits<int>::max()) {
-        return Status::Error(LinePrefix(path, ln) + ": malformed element line");
-      }
-      elements.push_back({std::string(tokens[1]), count, {}});
-    } else if (key == "property") {
-      if (elements.empty()) {
-        return Status::Error(LinePrefix(path, ln) + ": property before any element");
-      }
-      PlyProperty property;
-      if (tokens.size() == 5 && tokens[1] == "list") {
-        property.is_list = true;
-        if (!ParsePlyType(tokens[2], &property.count_type) ||
-            !ParsePlyType(tokens[3], &property.type) || property.count_type == PlyType::kFloat32 ||
-            property.count_type == PlyType::kFloat64) {
-          return Status::Error(LinePrefix(path, ln) + ": malformed list property");
-        }
-        property.name = std::string(tokens[4]);
-      } else if (tokens.size() == 3 && ParsePlyType(tokens[1], &property.type)) {
-        property.name = std::string(tokens[2]);
-      } else {
-        return Status::Error(LinePrefix(path, ln) + ": malformed property line");
-      }
-      elements.back().properties.push_back(property);
-    } else {
-      return Status::Error(LinePrefix(path, ln) + ": unknown PLY header line '" + std::string(key) +
-                           "'");
-    }
+    SFT_RETURN_IF_ERROR(
+        ParsePlyHeaderLine(tokens, LinePrefix(path, reader.line_number()), header, &have_format));
   }
   if (!have_format) return Status::Error(path + ": PLY header has no format line");
   if (!have_end) return Status::Error(path + ": PLY header has no end_header");
-  if (body_start > text.size()) body_start = text.size();
+  if (header->body_start > text.size()) header->body_start = text.size();
+  return Status::Ok();
+}
 
-  // Which properties carry what we need.
-  const PlyElement* vertex_element = nullptr;
-  const PlyElement* face_element = nullptr;
-  for (const PlyElement& e : elements) {
-    if (e.name == "vertex") vertex_element = &e;
-    if (e.name == "face") face_element = &e;
-  }
-  if (vertex_element == nullptr) return Status::Error(path + ": PLY has no vertex element");
-  if (face_element == nullptr || face_element->count == 0) {
-    return Status::Error(path + ": no faces");
-  }
-  auto find = [](const PlyElement& e, std::initializer_list<const char*> names, bool list) {
-    for (const char* name : names) {
-      for (size_t i = 0; i < e.properties.size(); ++i) {
-        if (e.properties[i].name == name && e.properties[i].is_list == list) {
-          return static_cast<int>(i);
-        }
+// Which elements and properties carry what the mesh needs (property indices, -1 = absent).
+struct PlyLayout {
+  const PlyElement* vertex = nullptr;
+  const PlyElement* face = nullptr;
+  int px = -1, py = -1, pz = -1, pu = -1, pv = -1;
+  int pindices = -1;   // the face's vertex index list.
+  int ptexcoord = -1;  // MeshLab's per-corner UV list.
+  bool vertex_uvs() const { return pu >= 0 && pv >= 0; }
+};
+
+int FindPlyProperty(const PlyElement& e, std::initializer_list<const char*> names, bool list) {
+  for (const char* name : names) {
+    for (size_t i = 0; i < e.properties.size(); ++i) {
+      if (e.properties[i].name == name && e.properties[i].is_list == list) {
+        return static_cast<int>(i);
       }
     }
-    return -1;
-  };
-  const int px = find(*vertex_element, {"x"}, false);
-  const int py = find(*vertex_element, {"y"}, false);
-  const int pz = find(*vertex_element, {"z"}, false);
-  if (px < 0 || py < 0 || pz < 0) {
+  }
+  return -1;
+}
+
+Status FindPlyLayout(const std::string& path, const PlyHeader& header, PlyLayout* layout) {
+  for (const PlyElement& e : header.elements) {
+    if (e.name == "vertex") layout->vertex = &e;
+    if (e.name == "face") layout->face = &e;
+  }
+  if (layout->vertex == nullptr) return Status::Error(path + ": PLY has no vertex element");
+  if (layout->face == nullptr || layout->face->count == 0) {
+    return Status::Error(path + ": no faces");
+  }
+  const PlyElement& vertex = *layout->vertex;
+  layout->px = FindPlyProperty(vertex, {"x"}, false);
+  layout->py = FindPlyProperty(vertex, {"y"}, false);
+  layout->pz = FindPlyProperty(vertex, {"z"}, false);
+  if (layout->px < 0 || layout->py < 0 || layout->pz < 0) {
     return Status::Error(path + ": PLY vertex element lacks scalar x, y, z properties");
   }
-  const int pu = find(*vertex_element, {"u", "s", "texture_u", "texture_s"}, false);
-  const int pv = find(*vertex_element, {"v", "t", "texture_v", "texture_t"}, false);
-  const bool vertex_uvs = pu >= 0 && pv >= 0;
-  const int pindices = find(*face_element, {"vertex_indices", "vertex_index"}, true);
-  if (pindices < 0) {
+  layout->pu = FindPlyProperty(vertex, {"u", "s", "texture_u", "texture_s"}, false);
+  layout->pv = FindPlyProperty(vertex, {"v", "t", "texture_v", "texture_t"}, false);
+  layout->pindices = FindPlyProperty(*layout->face, {"vertex_indices", "vertex_index"}, true);
+  if (layout->pindices < 0) {
     return Status::Error(path + ": PLY face element lacks a vertex_indices list property");
   }
-  const int ptexcoord = find(*face_element, {"texcoord"}, true);  // MeshLab per-corner UVs.
+  layout->ptexcoord = FindPlyProperty(*layout->face, {"texcoord"}, true);
+  return Status::Ok();
+}
 
-  PlyBodyReader body(text, body_start, format);
-  const long long num_vertices = vertex_element->count;
+// Reads one property of an element instance: a scalar as values = {v}, a list as its items.
+// False on truncated or malformed data (a list count that is negative, fractional or > 10⁶).
+bool ReadPlyProperty(PlyBodyReader* body, const PlyProperty& prop, std::vector<double>* values) {
+  if (!prop.is_list) {
+    values->resize(1);
+    return body->Read(prop.type, &(*values)[0]);
+  }
+  double count_value = 0.0;
+  if (!body->Read(prop.count_type, &count_value)) return false;
+  if (count_value < 0 || count_value != std::floor(count_value) || count_value > 1e6) {
+    return false;
+  }
+  values->resize(static_cast<int>(count_value));
+  for (double& v : *values) {
+    if (!body->Read(prop.type, &v)) return false;
+  }
+  return true;
+}
+
+// One face being read: its corners go straight to `out`; its per-corner UVs (texcoord list) are
+// appended to the UV pool and attached once the face is complete.
+struct PlyFace {
+  int uv_begin = 0;
+  int uv_count = -1;  // -1: no texcoord list.
+};
+
+// A list property `pi` of face `n`: the vertex indices or the per-corner UVs.
+Status ReadPlyFaceList(const std::string& path, long long n, int pi,
+                       const std::vector<double>& values, const PlyLayout& layout, PlyFace* face,
+                       ParsedMesh* out) {
+  const int count = static_cast<int>(values.size());
+  if (pi == layout.pindices) {
+    if (count < 3) {
+      return Status::Error(path + ": face " + std::to_string(n) + " has " + std::to_string(count) +
+                           " vertices (at least 3 needed)");
+    }
+    const long long num_vertices = layout.vertex->count;
+    for (const double v : values) {
+      if (v != std::floor(v) || v < 0 || v >= static_cast<double>(num_vertices)) {
+        return Status::Error(path + ": face " + std::to_string(n) + ": vertex index " +
+                             std::to_string(static_cast<long long>(v)) + " out of range (" +
+                             std::to_string(num_vertices) + " vertices)");
+      }
+      out->corner_vertices.push_back(static_cast<int>(v));
+    }
+  } else if (pi == layout.ptexcoord) {
+    face->uv_begin = static_cast<int>(out->uvs.size());
+    face->uv_count = count / 2;
+    for (int k = 0; k + 1 < count; k += 2) {
+      const Eigen::Vector2d uv(values[k], values[k + 1]);
+      if (!uv.allFinite()) {
+        return Status::Error(path + ": face " + std::to_string(n) +
+                             ": non-finite texture coordinate");
+      }
+      out->uvs.push_back(uv);
+    }
+  }
+  return Status::Ok();
+}
+
+// Ends a face: attaches its UVs (per corner, or the vertices' own) and closes it.
+void EndPlyFace(const PlyLayout& layout, const PlyFace& face, ParsedMesh* out) {
+  const int begin = out->face_offsets.back();
+  const int corners = static_cast<int>(out->corner_vertices.size()) - begin;
+  out->corner_uvs.resize(out->corner_vertices.size(), -1);
+  if (layout.ptexcoord >= 0) {
+    // A face whose UV count differs from its corner count gets none (and BuildMesh then drops
+    // the UVs of the whole mesh with a warning).
+    if (face.uv_count == corners) {
+      for (int k = 0; k < corners; ++k) out->corner_uvs[begin + k] = face.uv_begin + k;
+    }
+  } else if (layout.vertex_uvs()) {
+    for (int k = 0; k < corners; ++k) {
+      out->corner_uvs[begin + k] = out->corner_vertices[begin + k];
+    }
+  }
+  out->EndFace();
+}
+
+// Reads vertex `n` (its scalar properties; lists are read and ignored) into `out`.
+Status ReadPlyVertex(const std::string& path, long long n, PlyBodyReader* body,
+                     const PlyLayout& layout, std::vector<double>* values, ParsedMesh* out) {
+  const PlyElement& e = *layout.vertex;
+  Eigen::Vector3d p = Eigen::Vector3d::Zero();
+  Eigen::Vector2d uv = Eigen::Vector2d::Zero();
+  for (size_t pi = 0; pi < e.properties.size(); ++pi) {
+    const PlyProperty& prop = e.properties[pi];
+    if (!ReadPlyProperty(body, prop, values)) {
+      return Status::Error(path + ": truncated or malformed data in element '" + e.name + "' " +
+                           std::to_string(n) + ", property '" + prop.name + "'");
+    }
+    if (prop.is_list) continue;
+    const int i = static_cast<int>(pi);
+    const double value = (*values)[0];
+    if (i == layout.px) p.x() = value;
+    if (i == layout.py) p.y() = value;
+    if (i == layout.pz) p.z() = value;
+    if (i == layout.pu) uv.x() = value;
+    if (i == layout.pv) uv.y() = value;
+  }
+  if (!p.allFinite()) {
+    return Status::Error(path + ": vertex " + std::to_string(n) + ": non-finite coordinate");
+  }
+  out->positions.push_back(p);
+  if (layout.vertex_uvs()) {
+    if (!uv.allFinite()) {
+      return Status::Error(path + ": vertex " + std::to_string(n) +
+                           ": non-finite texture coordinate");
+    }
+    if (layout.ptexcoord < 0) out->uvs.push_back(uv);
+  }
+  return Status::Ok();
+}
+
+// Reads instance `n` of element `e` other than the vertices: faces go to `out`, anything else is
+// read and dropped.
+Status ReadPlyOther(const std::string& path, const PlyElement& e, long long n, PlyBodyReader* body,
+                    const PlyLayout& layout, std::vector<double>* values, ParsedMesh* out) {
+  const bool is_face = &e == layout.face;
+  PlyFace face;
+  for (size_t pi = 0; pi < e.properties.size(); ++pi) {
+    const PlyProperty& prop = e.properties[pi];
+    if (!ReadPlyProperty(body, prop, values)) {
+      return Status::Error(path + ": truncated or malformed data in element '" + e.name + "' " +
+                           std::to_string(n) + ", property '" + prop.name + "'");
+    }
+    if (is_face && prop.is_list) {
+      SFT_RETURN_IF_ERROR(
+          ReadPlyFaceList(path, n, static_cast<int>(pi), *values, layout, &face, out));
+    }
+  }
+  if (is_face) EndPlyFace(layout, face, out);
+  return Status::Ok();
+}
+
+}  // namespace
+
+Status ParsePly(const std::string& path, const std::string& text, ParsedMesh* out) {
+  PlyHeader header;
+  SFT_RETURN_IF_ERROR(ParsePlyHeader(path, text, &header));
+  PlyLayout layout;
+  SFT_RETURN_IF_ERROR(FindPlyLayout(path, header, &layout));
+  PlyBodyReader body(text, header.body_start, header.format);
   std::vector<double> values;
-  for (const PlyElement& e : elements) {
+  for (const PlyElement& e : header.elements) {
     // An element without properties occupies no bytes, whatever its count: skipping it keeps the
     // loop below bounded by the file's size (a count of 2^31 - 1 would otherwise spin for
     // minutes on nothing).
     if (e.properties.empty()) continue;
     for (long long n = 0; n < e.count; ++n) {
-      Eigen::Vector3d p = Eigen::Vector3d::Zero();
-      Eigen::Vector2d uv = Eigen::Vector2d::Zero();
-      int face_uv_begin = 0, face_uv_count = -1;  // This face's per-corner UVs in the pool.
-      for (size_t pi = 0; pi < e.properties.size(); ++pi) {
-        const PlyProperty& prop = e.properties[pi];
-        auto truncated = [&]() {
-          return Status::Error(path + ": truncated or malformed data in element '" + e.name + "' " +
-                               std::to_string(n) + ", property '" + prop.name + "'");
-        };
-        if (!prop.is_list) {
-          double value = 0.0;
-          if (!body.Read(prop.type, &value)) return truncated();
-          if (&e == vertex_element) {
-            const int i = static_cast<int>(pi);
-            if (i == px) p.x() = value;
-            if (i == py) p.y() = value;
-            if (i == pz) p.z() = value;
-            if (i == pu) uv.x() = value;
-            if (i == pv) uv.y() = value;
-          }
-          continue;
-        }
-        double count_value = 0.0;
-        if (!body.Read(prop.count_type, &count_value)) return truncated();
-        if (count_value < 0 || count_value != std::floor(count_value) || count_value > 1e6) {
-          return truncated();
-        }
-        const int count = static_cast<int>(count_value);
-        values.resize(count);
-        for (int k = 0; k < count; ++k) {
-          if (!body.Read(prop.type, &values[k])) return truncated();
-        }
-        if (&e != face_element) continue;
-        if (static_cast<int>(pi) == pindices) {
-          if (count < 3) {
-            return Status::Error(path + ": face " + std::to_string(n) + " has " +
-                                 std::to_string(count) + " vertices (at least 3 needed)");
-          }
-          for (int k = 0; k < count; ++k) {
-            const double v = values[k];
-            if (v != std::floor(v) || v < 0 || v >= static_cast<double>(num_vertices)) {
-              return Status::Error(path + ": face " + std::to_string(n) + ": vertex index " +
-                                   std::to_string(static_cast<long long>(v)) + " out of range (" +
-                                   std::to_string(num_vertices) + " vertices)");
-            }
-            out->corner_vertices.push_back(static_cast<int>(v));
-          }
-        } else if (static_cast<int>(pi) == ptexcoord) {
-          // Appended to the pool now; attached to the corners once the face is complete.
-          face_uv_begin = static_cast<int>(out->uvs.size());
-          face_uv_count = count / 2;
-          for (int k = 0; k + 1 < count; k += 2) {
-            const Eigen::Vector2d uv(values[k], values[k + 1]);
-            if (!uv.allFinite()) {
-              return Status::Error(path + ": face " + std::to_string(n) +
-                                   ": non-finite texture coordinate");
-            }
-            out->uvs.push_back(uv);
-          }
-        }
-      }
-      if (&e == vertex_element) {
-        if (!p.allFinite()) {
-          return Status::Error(path + ": vertex " + std::to_string(n) + ": non-finite coordinate");
-        }
-        out->positions.push_back(p);
-        if (vertex_uvs) {
-          if (!uv.allFinite()) {
-            return Status::Error(path + ": vertex " + std::to_string(n) +
-                                 ": non-finite texture coordinate");
-          }
-          if (ptexcoord < 0) out->uvs.push_back(uv);
-        }
-      } else if (&e == face_element) {
-        const int begin = out->face_offsets.back();
-        const int corners = static_cast<int>(out->corner_vertices.size()) - begin;
-        out->corner_uvs.resize(out->corner_vertices.size(), -1);
-        if (ptexcoord >= 0) {
-          // A face whose UV count differs from its corner count gets none (and BuildMesh then
-          // drops the UVs of the whole mesh with a warning).
-          if (face_uv_count == corners) {
-            for (int k = 0; k < corners; ++k) out->corner_uvs[begin + k] = face_uv_begin + k;
-          }
-        } else if (vertex_uvs) {
-          for (int k = 0; k < corners; ++k) {
-            out->corner_uvs[begin + k] = out->corner_vertices[begin + k];
-          }
-        }
-        out->EndFace();
+      if (&e == layout.vertex) {
+        SFT_RETURN_IF_ERROR(ReadPlyVertex(path, n, &body, layout, &values, out));
+      } else {
+        SFT_RETURN_IF_ERROR(ReadPlyOther(path, e, n, &body, layout, &values, out));
       }
     }
   }
