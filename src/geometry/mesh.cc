@@ -18,6 +18,7 @@
 
 #include <glog/logging.h>
 
+#include <array>
 #include <charconv>
 #include <cmath>
 #include <cstdint>
@@ -105,6 +106,78 @@ constexpr double kDegenerateRelativeArea = 1e-12;
 
 // ---- Building the TriMesh -----------------------------------------------------------------------
 
+// A face that repeats a vertex cannot be represented in a halfedge mesh.
+bool RepeatsVertex(const ParsedMesh& parsed, int begin, int end) {
+  for (int a = begin; a < end; ++a) {
+    for (int b = a + 1; b < end; ++b) {
+      if (parsed.corner_vertices[a] == parsed.corner_vertices[b]) return true;
+    }
+  }
+  return false;
+}
+
+// Adds the triangle of parsed corners `corners` (with their UVs when `with_uvs`); a non-manifold
+// one gets private copies of its vertices and counts in `non_manifold_faces`.
+void AddTriangle(const ParsedMesh& parsed, const int corners[3],
+                 const std::vector<TriMesh::VertexHandle>& handles, bool with_uvs, TriMesh* mesh,
+                 int* non_manifold_faces) {
+  TriMesh::VertexHandle vh[3];
+  for (int c = 0; c < 3; ++c) vh[c] = handles[parsed.corner_vertices[corners[c]]];
+  TriMesh::FaceHandle fh = mesh->add_face(vh[0], vh[1], vh[2]);
+  if (!fh.is_valid()) {
+    ++*non_manifold_faces;
+    for (int c = 0; c < 3; ++c) vh[c] = mesh->add_vertex(TriMesh::Point(mesh->point(vh[c])));
+    fh = mesh->add_face(vh[0], vh[1], vh[2]);
+    CHECK(fh.is_valid()) << "adding an isolated triangle cannot fail";
+  }
+  // Keep the face's vertex order (fv iteration starts at the first corner), since the mesh
+  // colors layout depends on it.
+  for (TriMesh::HalfedgeHandle h : mesh->fh_range(fh)) {
+    if (mesh->to_vertex_handle(h) == vh[0]) {
+      mesh->set_halfedge_handle(fh, h);
+      break;
+    }
+  }
+  if (!with_uvs) return;
+  // A halfedge's texcoord is the UV of its to-vertex in its face.
+  for (TriMesh::HalfedgeHandle h : mesh->fh_range(fh)) {
+    const TriMesh::VertexHandle to = mesh->to_vertex_handle(h);
+    for (int c = 0; c < 3; ++c) {
+      if (to == vh[c]) {
+        const Eigen::Vector2d& uv = parsed.uvs[parsed.corner_uvs[corners[c]]];
+        mesh->set_texcoord2D(h, TriMesh::TexCoord2D(uv.x(), uv.y()));
+      }
+    }
+  }
+}
+
+// Sizes, UVs, and the degenerate faces (`repeated_vertex_faces` left out, plus those of
+// negligible area) and isolated vertices of a built mesh.
+MeshReport SummarizeMesh(const TriMesh& mesh, bool with_uvs, int repeated_vertex_faces) {
+  MeshReport report;
+  report.num_vertices = static_cast<int>(mesh.n_vertices());
+  report.num_faces = static_cast<int>(mesh.n_faces());
+  report.has_texcoords = with_uvs;
+  report.num_degenerate_faces = repeated_vertex_faces;
+  Eigen::Vector3d lo, hi;
+  MeshBounds(mesh, &lo, &hi);
+  const double diagonal2 = (hi - lo).squaredNorm();
+  for (TriMesh::FaceHandle fh : mesh.faces()) {
+    Eigen::Vector3d p[3];
+    int c = 0;
+    for (TriMesh::VertexHandle vh : mesh.fv_range(fh)) {
+      const TriMesh::Point& q = mesh.point(vh);
+      p[c++] = Eigen::Vector3d(q[0], q[1], q[2]);
+    }
+    const double area = 0.5 * (p[1] - p[0]).cross(p[2] - p[0]).norm();
+    if (!(area > kDegenerateRelativeArea * diagonal2)) ++report.num_degenerate_faces;
+  }
+  for (TriMesh::VertexHandle vh : mesh.vertices()) {
+    if (mesh.is_isolated(vh)) ++report.num_isolated_vertices;
+  }
+  return report;
+}
+
 Status BuildMesh(const std::string& path, const ParsedMesh& parsed, TriMesh* mesh,
                  MeshReport* report) {
   if (parsed.num_faces() == 0) return Status::Error(path + ": no faces");
@@ -133,18 +206,8 @@ Status BuildMesh(const std::string& path, const ParsedMesh& parsed, TriMesh* mes
     ScopedOpenMeshQuiet quiet;
     for (int f = 0; f < parsed.num_faces(); ++f) {
       const int begin = parsed.face_offsets[f], end = parsed.face_offsets[f + 1];
-      // A face that repeats a vertex cannot be represented in a halfedge mesh: count it as
-      // degenerate and leave it out (OpenMesh's importer drops it too).
-      bool repeated = false;
-      for (int a = begin; a < end && !repeated; ++a) {
-        for (int b = a + 1; b < end; ++b) {
-          if (parsed.corner_vertices[a] == parsed.corner_vertices[b]) {
-            repeated = true;
-            break;
-          }
-        }
-      }
-      if (repeated) {
+      // Counted as degenerate and left out (OpenMesh's importer drops it too).
+      if (RepeatsVertex(parsed, begin, end)) {
         ++repeated_vertex_faces;
         continue;
       }
@@ -164,36 +227,7 @@ Status BuildMesh(const std::string& path, const ParsedMesh& parsed, TriMesh* mes
       }
       for (const std::array<int, 3>& triangle : triangles) {
         const int corners[3] = {begin + triangle[0], begin + triangle[1], begin + triangle[2]};
-        TriMesh::VertexHandle vh[3];
-        for (int c = 0; c < 3; ++c) vh[c] = handles[parsed.corner_vertices[corners[c]]];
-        TriMesh::FaceHandle fh = mesh->add_face(vh[0], vh[1], vh[2]);
-        if (!fh.is_valid()) {
-          // Non-manifold: give the face private copies of its vertices.
-          ++non_manifold_faces;
-          for (int c = 0; c < 3; ++c) vh[c] = mesh->add_vertex(TriMesh::Point(mesh->point(vh[c])));
-          fh = mesh->add_face(vh[0], vh[1], vh[2]);
-          CHECK(fh.is_valid()) << "adding an isolated triangle cannot fail";
-        }
-        // Keep the face's vertex order (fv iteration starts at the first corner), since the mesh
-        // colors layout depends on it.
-        for (TriMesh::HalfedgeHandle h : mesh->fh_range(fh)) {
-          if (mesh->to_vertex_handle(h) == vh[0]) {
-            mesh->set_halfedge_handle(fh, h);
-            break;
-          }
-        }
-        if (with_uvs) {
-          // A halfedge's texcoord is the UV of its to-vertex in its face.
-          for (TriMesh::HalfedgeHandle h : mesh->fh_range(fh)) {
-            const TriMesh::VertexHandle to = mesh->to_vertex_handle(h);
-            for (int c = 0; c < 3; ++c) {
-              if (to == vh[c]) {
-                const Eigen::Vector2d& uv = parsed.uvs[parsed.corner_uvs[corners[c]]];
-                mesh->set_texcoord2D(h, TriMesh::TexCoord2D(uv.x(), uv.y()));
-              }
-            }
-          }
-        }
+        AddTriangle(parsed, corners, handles, with_uvs, mesh, &non_manifold_faces);
       }
     }
   }
@@ -211,29 +245,7 @@ Status BuildMesh(const std::string& path, const ParsedMesh& parsed, TriMesh* mes
     LOG(WARNING) << path << ": " << non_manifold_faces
                  << " non-manifold faces were given their own copies of their vertices";
   }
-
-  MeshReport local;
-  local.num_vertices = static_cast<int>(mesh->n_vertices());
-  local.num_faces = static_cast<int>(mesh->n_faces());
-  local.has_texcoords = with_uvs;
-  local.num_degenerate_faces = repeated_vertex_faces;
-  Eigen::Vector3d lo, hi;
-  MeshBounds(*mesh, &lo, &hi);
-  const double diagonal2 = (hi - lo).squaredNorm();
-  for (TriMesh::FaceHandle fh : mesh->faces()) {
-    Eigen::Vector3d p[3];
-    int c = 0;
-    for (TriMesh::VertexHandle vh : mesh->fv_range(fh)) {
-      const TriMesh::Point& q = mesh->point(vh);
-      p[c++] = Eigen::Vector3d(q[0], q[1], q[2]);
-    }
-    const double area = 0.5 * (p[1] - p[0]).cross(p[2] - p[0]).norm();
-    if (!(area > kDegenerateRelativeArea * diagonal2)) ++local.num_degenerate_faces;
-  }
-  for (TriMesh::VertexHandle vh : mesh->vertices()) {
-    if (mesh->is_isolated(vh)) ++local.num_isolated_vertices;
-  }
-  if (report != nullptr) *report = local;
+  if (report != nullptr) *report = SummarizeMesh(*mesh, with_uvs, repeated_vertex_faces);
   return Status::Ok();
 }
 }  // namespace
