@@ -246,9 +246,12 @@ TEST(VideoImportLongTest, SyntheticVideoWithProbeAndAutoMasksToDatasetAndHull) {
       iou_min, init_seconds, metrics.f1, metrics.precision, metrics.recall, metrics.chamfer);
   EXPECT_LT(fit.max_angle_deg, 0.5);
   EXPECT_LT(fit.max_position, 0.01);
-  EXPECT_LT(probe_error, 2.0);
-  EXPECT_GT(iou_mean, 0.0);  // THRESHOLDS TBD after measuring
-  EXPECT_GT(metrics.f1, 0.0);
+  EXPECT_LT(probe_error, 2.0);  // issue 12; measured 0.17°.
+  // Measured (docs/design-notes.md): IoU mean 0.833, min 0.727; F1@0.01 0.609 (0.961 with
+  // synth's masks: the automatic masks' errors carve the hull).
+  EXPECT_GT(iou_mean, 0.75);
+  EXPECT_GT(iou_min, 0.6);
+  EXPECT_GT(metrics.f1, 0.5);
 }
 
 }  // namespace
