@@ -11,6 +11,26 @@
 namespace sft {
 namespace {
 
+// The --masks auto and --probe lines of a summary (nothing when neither ran).
+void PrintMasksAndProbe(const char* command, const ColmapImportReport& report) {
+  const NormalizationResult& n = report.normalization;
+  if (n.plane.found) {
+    std::fprintf(stderr, "%s: support plane: %d sparse points on or beyond it left out\n", command,
+                 n.plane.off_object);
+  }
+  if (report.auto_masks > 0) {
+    std::fprintf(stderr, "%s: %d automatic masks (GrabCut) in masks/\n", command,
+                 report.auto_masks);
+  }
+  if (report.probe_aligned) {
+    const ProbeAlignmentResult& a = report.alignment;
+    std::fprintf(stderr,
+                 "%s: probe aligned: rotation %.2f deg; %d inliers of %d matches; median "
+                 "residual %.3f deg\n",
+                 command, a.rotation_angle_deg, a.inliers, a.matches, a.median_residual_deg);
+  }
+}
+
 int RunImportColmap(const ColmapImportOptions& opts) {
   ColmapImportReport report;
   const Status status = ImportColmap(opts, &report);
@@ -27,17 +47,7 @@ int RunImportColmap(const ColmapImportOptions& opts) {
         report.dense_points.empty() ? ""
                                     : ("dense points from " + report.dense_points + "; ").c_str(),
         report.seconds);
-    if (report.auto_masks > 0) {
-      std::fprintf(stderr, "sft import colmap: %d automatic masks (GrabCut) in masks/\n",
-                   report.auto_masks);
-    }
-    if (report.probe_aligned) {
-      const ProbeAlignmentResult& a = report.alignment;
-      std::fprintf(stderr,
-                   "sft import colmap: probe aligned: rotation %.2f deg; %d inliers of %d "
-                   "matches; median residual %.3f deg\n",
-                   a.rotation_angle_deg, a.inliers, a.matches, a.median_residual_deg);
-    }
+    PrintMasksAndProbe("sft import colmap", report);
   }
   return 0;
 }
@@ -55,8 +65,20 @@ int RunImportVideo(const VideoImportOptions& opts) {
                  report.matcher.c_str(), report.models, report.reprojection_error,
                  report.seconds_frames, report.seconds_features, report.seconds_matching,
                  report.seconds_mapping, report.seconds);
+    PrintMasksAndProbe("sft import video", report.import);
   }
   return 0;
+}
+
+// --no-support-plane and --plane-distance (src/io/support_plane.h), for both imports.
+void AddSupportPlaneFlags(CLI::App* app, SupportPlaneOptions* plane) {
+  app->add_flag("!--no-support-plane", plane->enabled,
+                "Without masks: keep the points of a dominant plane (table top, floor) as "
+                "object candidates instead of leaving them out");
+  app->add_option("--plane-distance", plane->distance,
+                  "Support plane band half-width, as a fraction of the median viewing distance, "
+                  "(0, 0.2]")
+      ->capture_default_str();
 }
 
 void SetupImportVideo(CLI::App* video, VideoImportOptions* opts) {
@@ -69,7 +91,8 @@ void SetupImportVideo(CLI::App* video, VideoImportOptions* opts) {
                    "Mean 32x32 thumbnail difference below which a frame is a near-duplicate")
       ->capture_default_str();
   video->add_option("--probe", opts->probe,
-                    "Equirectangular probe, added as an environment light (not yet aligned)");
+                    "Equirectangular probe (.exr/.hdr linear, or an 8-bit sRGB panorama), added "
+                    "as an environment light and aligned to the frames as by `import colmap`");
   video->add_option("--masks", opts->masks,
                     "Folder of masks named like the frames (frame_NNNNNN.png), or auto (GrabCut)");
   video
@@ -83,6 +106,7 @@ void SetupImportVideo(CLI::App* video, VideoImportOptions* opts) {
   video->add_option("--camera-model", opts->camera_model, "Shared COLMAP camera model")
       ->capture_default_str();
   video->add_option("--colmap", opts->colmap, "COLMAP executable")->capture_default_str();
+  AddSupportPlaneFlags(video, &opts->normalization.plane);
   video->add_flag("--overwrite", opts->overwrite, "Replace an existing output folder");
   video->add_flag("--quiet", opts->quiet, "No progress or summary line");
 }
@@ -119,6 +143,7 @@ CommandRunner SetupImportCommand(CLI::App* app) {
       ->add_option("--percentile", opts->normalization.percentile,
                    "Without masks: robust bounding-box percentile per axis, [0, 50)")
       ->capture_default_str();
+  AddSupportPlaneFlags(colmap, &opts->normalization.plane);
   colmap->add_flag("!--no-dense", opts->import_dense,
                    "Ignore fused.ply / meshed-*.ply beside the model");
   colmap->add_flag("--overwrite", opts->overwrite, "Replace an existing output folder");

@@ -118,12 +118,8 @@ struct SynthOptions {
   }
 };
 
-Status RunSynth(const SynthOptions& opts) {
-  std::string why;
-  if (!opts.Check(&why)) return Status::Error(why);
-  RenderOptions render = opts.render;
-  if (!Effects::Parse(opts.effects, &render.effects, &why)) return Status::Error("--" + why);
-  if (!render.Check(&why)) return Status::Error("--" + why);
+// The output checks: OUT and OUT.partial are safe to write, OUT is empty unless --overwrite.
+Status CheckSynthOutput(const SynthOptions& opts) {
   // --overwrite removes OUT: it must never hold the mesh, material or probe being read.
   const RunInputs inputs{{}, {opts.mesh, MaterialFile(opts.material), opts.envmap}};
   SFT_RETURN_IF_ERROR(CheckOutputDirectory(opts.out, inputs, "--out"));
@@ -132,44 +128,38 @@ Status RunSynth(const SynthOptions& opts) {
   if (fs::exists(opts.out, ec) && !fs::is_empty(opts.out, ec) && !opts.overwrite) {
     return Status::Error(opts.out + ": output exists and is not empty (use --overwrite)");
   }
+  return Status::Ok();
+}
 
-  TriMesh mesh;
-  SFT_RETURN_IF_ERROR(ReadMesh(opts.mesh, &mesh));
+// The object: the mesh (z up, normalised unless --no-normalize) and its material.
+Status LoadObject(const SynthOptions& opts, TriMesh* mesh, Material* material) {
+  SFT_RETURN_IF_ERROR(ReadMesh(opts.mesh, mesh));
   if (opts.up_axis == "y") {
-    for (auto vh : mesh.vertices()) {
-      const auto p = mesh.point(vh);
-      mesh.set_point(vh, TriMesh::Point(p[0], -p[2], p[1]));
+    for (auto vh : mesh->vertices()) {
+      const auto p = mesh->point(vh);
+      mesh->set_point(vh, TriMesh::Point(p[0], -p[2], p[1]));
     }
   }
   if (opts.normalize) {
     Eigen::Vector3d lo, hi;
-    MeshBounds(mesh, &lo, &hi);
+    MeshBounds(*mesh, &lo, &hi);
     const Eigen::Vector3d centre = 0.5 * (lo + hi);
     const double diagonal = (hi - lo).norm();
     if (!(diagonal > 0)) return Status::Error(opts.mesh + ": mesh has zero extent");
-    for (auto vh : mesh.vertices()) {
-      const auto p = mesh.point(vh);
-      mesh.set_point(vh,
-                     TriMesh::Point((p[0] - centre.x()) / diagonal, (p[1] - centre.y()) / diagonal,
-                                    (p[2] - centre.z()) / diagonal));
+    for (auto vh : mesh->vertices()) {
+      const auto p = mesh->point(vh);
+      mesh->set_point(vh,
+                      TriMesh::Point((p[0] - centre.x()) / diagonal, (p[1] - centre.y()) / diagonal,
+                                     (p[2] - centre.z()) / diagonal));
     }
   }
-  Material material;
-  SFT_RETURN_IF_ERROR(LoadMaterial(opts.material, mesh, &material));
+  return LoadMaterial(opts.material, *mesh, material);
+}
 
-  Eigen::Vector3d lo, hi;
-  MeshBounds(mesh, &lo, &hi);
-  const Eigen::Vector3d target = 0.5 * (lo + hi);
-  const double radius = 0.5 * (hi - lo).norm();
-  const double focal = OrbitFocal(opts.res, opts.fov_deg);
-  const double distance = OrbitDistance(radius, opts.fov_deg, opts.fill);
-
-  const std::string partial = opts.out + ".partial";
-  fs::remove_all(partial, ec);
-  SFT_RETURN_IF_ERROR(MakeDirectories(partial));
-
-  Dataset dataset;
-  dataset.root = partial;
+// One pinhole camera per zoom, and the light: the camera-attached point light, or the probe
+// (copied to PARTIAL/probes/ as EXR).
+Status AddCamerasAndLight(const SynthOptions& opts, double focal, double distance,
+                          const std::string& partial, Dataset* dataset) {
   for (size_t z = 0; z < opts.zooms.size(); ++z) {
     Camera camera;
     camera.id = "zoom" + std::to_string(z);
@@ -177,10 +167,10 @@ Status RunSynth(const SynthOptions& opts) {
     camera.width = camera.height = opts.res;
     const double f = focal * opts.zooms[z];
     camera.params = {f, f, 0.5 * opts.res, 0.5 * opts.res};
-    dataset.cameras.push_back(camera);
+    dataset->cameras.push_back(camera);
   }
+  LightSpec light;
   if (opts.envmap.empty()) {
-    LightSpec light;
     light.id = "flash";
     light.type = LightType::kPoint;
     light.frame = LightFrame::kCamera;
@@ -189,20 +179,25 @@ Status RunSynth(const SynthOptions& opts) {
     const double intensity =
         opts.light_intensity_given ? opts.light_intensity : 0.5 * M_PI * distance * distance;
     light.intensity = Eigen::Vector3d::Constant(intensity);
-    dataset.lights.push_back(light);
   } else {
     Image probe;
     SFT_RETURN_IF_ERROR(ReadImage(opts.envmap, &probe));
     const std::string probe_name = "probes/" + fs::path(opts.envmap).stem().string() + ".exr";
     SFT_RETURN_IF_ERROR(WriteExr(JoinPath(partial, probe_name), probe));
-    LightSpec light;
     light.id = "probe";
     light.type = LightType::kEnvironment;
     light.image = probe_name;
     light.scale = opts.envmap_scale;
-    dataset.lights.push_back(light);
-    if (opts.environment_background) dataset.background = Background::kEnvironment;
+    if (opts.environment_background) dataset->background = Background::kEnvironment;
   }
+  dataset->lights.push_back(light);
+  return Status::Ok();
+}
+
+// The views: per zoom, --cameras positions on the Fibonacci sphere or the orbit, looking at
+// `target` with +z up. With --ground every camera must be above the plane at height `ground_z`.
+Status AddViews(const SynthOptions& opts, const Eigen::Vector3d& target, double distance,
+                double ground_z, Dataset* dataset) {
   const Eigen::Vector3d up(0, 0, 1);
   const std::vector<Eigen::Vector3d> orbit =
       OrbitPath(opts.cameras, target, distance, opts.elevation[0], opts.elevation[1]);
@@ -218,25 +213,30 @@ Status RunSynth(const SynthOptions& opts) {
       std::snprintf(name, sizeof(name), "%03d", index);
       view.image = std::string("images/") + name + ".exr";
       view.mask = std::string("masks/") + name + ".png";
-      view.camera_id = dataset.cameras[z].id;
+      view.camera_id = dataset->cameras[z].id;
       view.camera = static_cast<int>(z);
-      view.light_ids = {dataset.lights[0].id};
+      view.light_ids = {dataset->lights[0].id};
       view.lights = {0};
       // Object-only masks assume the plane never hides the object: every camera above it.
-      if (opts.ground && !(centre.z() > lo.z() + 1e-6)) {
-        fs::remove_all(partial, ec);
+      if (opts.ground && !(centre.z() > ground_z + 1e-6)) {
         return Status::Error("--ground: camera " + std::to_string(index) +
                              " is not above the ground plane (use --path orbit with a positive "
                              "--elevation range)");
       }
       view.cam_from_world = LookAt(centre, target, up);
-      dataset.views.push_back(view);
+      dataset->views.push_back(view);
     }
   }
+  return Status::Ok();
+}
+
+// Renders every view to PARTIAL: the image (EXR) and the object's mask (PNG). With --ground the
+// images show object + plane; masks come from a coverage pass of the object alone (the plane,
+// below every camera, never hides the object: src/io/synth_scene.h).
+Status RenderImages(const SynthOptions& opts, const RenderOptions& render, const TriMesh& mesh,
+                    const Material& material, const Dataset& dataset, const std::string& partial) {
   DatasetViews views;
   SFT_RETURN_IF_ERROR(MakeDatasetViews(dataset, &views));
-  // With --ground the images show object + plane; masks come from a coverage pass of the object
-  // alone (the plane, below every camera, never hides the object: src/io/synth_scene.h).
   TriMesh scene_mesh;
   Material scene_material;
   if (opts.ground) {
@@ -264,21 +264,62 @@ Status RunSynth(const SynthOptions& opts) {
     progress.Advance();
   }
   progress.Finish();
+  return Status::Ok();
+}
 
+// The ground truth (gt/mesh.ply, gt/material.json), scene.json, and PARTIAL renamed to OUT.
+Status FinishDataset(const SynthOptions& opts, const RenderOptions& render, const TriMesh& mesh,
+                     const Material& material, Dataset* dataset, const std::string& partial) {
   SFT_RETURN_IF_ERROR(WriteMesh(JoinPath(partial, "gt/mesh.ply"), mesh));
   SFT_RETURN_IF_ERROR(SaveMaterial(JoinPath(partial, "gt/material.json"), material));
-  dataset.gt_mesh = "gt/mesh.ply";
-  dataset.ground_truth = {{"mesh", "gt/mesh.ply"},     {"material", "gt/material.json"},
-                          {"renderer", "sft"},         {"samples", render.spp},
-                          {"bounces", render.bounces}, {"seed", render.seed},
-                          {"source_mesh", opts.mesh}};
-  SFT_RETURN_IF_ERROR(WriteSceneJson(dataset, partial));
+  dataset->gt_mesh = "gt/mesh.ply";
+  dataset->ground_truth = {{"mesh", "gt/mesh.ply"},     {"material", "gt/material.json"},
+                           {"renderer", "sft"},         {"samples", render.spp},
+                           {"bounces", render.bounces}, {"seed", render.seed},
+                           {"source_mesh", opts.mesh}};
+  SFT_RETURN_IF_ERROR(WriteSceneJson(*dataset, partial));
+  std::error_code ec;
   if (fs::exists(opts.out, ec)) fs::remove_all(opts.out, ec);
   fs::rename(partial, opts.out, ec);
-  if (ec)
+  if (ec) {
     return Status::Error(opts.out + ": cannot move the finished dataset in place (" + ec.message() +
                          ")");
+  }
   return Status::Ok();
+}
+
+Status RunSynth(const SynthOptions& opts) {
+  std::string why;
+  if (!opts.Check(&why)) return Status::Error(why);
+  RenderOptions render = opts.render;
+  if (!Effects::Parse(opts.effects, &render.effects, &why)) return Status::Error("--" + why);
+  if (!render.Check(&why)) return Status::Error("--" + why);
+  SFT_RETURN_IF_ERROR(CheckSynthOutput(opts));
+
+  TriMesh mesh;
+  Material material;
+  SFT_RETURN_IF_ERROR(LoadObject(opts, &mesh, &material));
+  Eigen::Vector3d lo, hi;
+  MeshBounds(mesh, &lo, &hi);
+  const Eigen::Vector3d target = 0.5 * (lo + hi);
+  const double radius = 0.5 * (hi - lo).norm();
+  const double focal = OrbitFocal(opts.res, opts.fov_deg);
+  const double distance = OrbitDistance(radius, opts.fov_deg, opts.fill);
+
+  const std::string partial = opts.out + ".partial";
+  std::error_code ec;
+  fs::remove_all(partial, ec);
+  SFT_RETURN_IF_ERROR(MakeDirectories(partial));
+  Dataset dataset;
+  dataset.root = partial;
+  SFT_RETURN_IF_ERROR(AddCamerasAndLight(opts, focal, distance, partial, &dataset));
+  const Status views = AddViews(opts, target, distance, lo.z(), &dataset);
+  if (!views.ok()) {
+    fs::remove_all(partial, ec);
+    return views;
+  }
+  SFT_RETURN_IF_ERROR(RenderImages(opts, render, mesh, material, dataset, partial));
+  return FinishDataset(opts, render, mesh, material, &dataset, partial);
 }
 
 }  // namespace

@@ -320,6 +320,29 @@ Status AutoMasksAndProbe(const ColmapImportOptions& opts,
   return WriteSceneJson(*dataset, dataset->root);
 }
 
+// The probe as the environment light of every view (aligned later), or "lighting": "unknown".
+Status AddProbeLight(const ColmapImportOptions& opts, const std::string& root, Dataset* dataset) {
+  if (!opts.probe.empty()) {
+    Image probe;
+    SFT_RETURN_IF_ERROR(LoadProbeImage(opts.probe, &probe));
+    LightSpec light;
+    light.id = "probe";
+    light.type = LightType::kEnvironment;
+    light.image = "probes/" + fs::path(opts.probe).stem().string() + ".exr";
+    SFT_RETURN_IF_ERROR(WriteExr(JoinPath(root, light.image), probe));
+    dataset->lights.push_back(light);
+    for (ViewSpec& view : dataset->views) {
+      view.lights = {0};
+      view.light_ids = {light.id};
+    }
+    dataset->background = Background::kEnvironment;
+    dataset->lighting = "probe not yet aligned (world_from_env = identity)";
+  } else {
+    dataset->lighting = "unknown";
+  }
+  return Status::Ok();
+}
+
 Status ImportInto(const ColmapImportOptions& opts, const std::string& root,
                   ColmapImportReport* report) {
   ColmapModel model;
@@ -354,10 +377,14 @@ Status ImportInto(const ColmapImportOptions& opts, const std::string& root,
     pose.translation = (pose.translation + (pose.rotation * norm.centre)) / norm.diagonal;
   }
 
+  // The sparse points in the normalised world; those not on or beyond the support plane seed
+  // --masks auto.
   PointCloud sparse;
+  std::vector<Eigen::Vector3d> seeds;
   for (const ColmapPoint3D& point : model.points) {
     sparse.positions.push_back((point.xyz - norm.centre) / norm.diagonal);
     sparse.colors.push_back(point.rgb);
+    if (!norm.plane.OffObject(point.xyz)) seeds.push_back(sparse.positions.back());
   }
   dataset.sparse_points = "sparse/points3D.ply";
   SFT_RETURN_IF_ERROR(WritePointCloudPly(JoinPath(root, dataset.sparse_points), sparse));
@@ -367,41 +394,25 @@ Status ImportInto(const ColmapImportOptions& opts, const std::string& root,
     SFT_RETURN_IF_ERROR(ImportDense(report->dense_mesh, report->dense_points, s, root, &dataset));
   }
 
-  if (!opts.probe.empty()) {
-    Image probe;
-    SFT_RETURN_IF_ERROR(LoadProbeImage(opts.probe, &probe));
-    LightSpec light;
-    light.id = "probe";
-    light.type = LightType::kEnvironment;
-    light.image = "probes/" + fs::path(opts.probe).stem().string() + ".exr";
-    SFT_RETURN_IF_ERROR(WriteExr(JoinPath(root, light.image), probe));
-    dataset.lights.push_back(light);
-    for (ViewSpec& view : dataset.views) {
-      view.lights = {0};
-      view.light_ids = {light.id};
-    }
-    dataset.background = Background::kEnvironment;
-    dataset.lighting = "probe not yet aligned (world_from_env = identity)";
-  } else {
-    dataset.lighting = "unknown";
-  }
+  SFT_RETURN_IF_ERROR(AddProbeLight(opts, root, &dataset));
 
   std::string encoding;
   for (const std::string& e : encodings) encoding += (encoding.empty() ? "" : "; ") + e;
   dataset.image_encoding = encoding;
+  nlohmann::json normalization = {{"method", norm.method},
+                                  {"points_total", norm.points_total},
+                                  {"points_used", norm.points_used}};
+  if (norm.plane.found) normalization["support_plane_points"] = norm.plane.off_object;
   dataset.extra["import"] = {{"from", "colmap"},
                              {"model", opts.model},
                              {"model_format", report->format},
-                             {"normalization",
-                              {{"method", norm.method},
-                               {"points_total", norm.points_total},
-                               {"points_used", norm.points_used}}}};
+                             {"normalization", normalization}};
   report->cameras = static_cast<int>(dataset.cameras.size());
   report->views = static_cast<int>(dataset.views.size());
   SFT_RETURN_IF_ERROR(WriteSceneJson(dataset, root));
   Dataset check;
   SFT_RETURN_IF_ERROR(ReadDataset(root, &check));
-  return AutoMasksAndProbe(opts, sparse.positions, &check, report);
+  return AutoMasksAndProbe(opts, seeds, &check, report);
 }
 
 }  // namespace

@@ -16,15 +16,34 @@
 #include <vector>
 
 #include "src/core/file_util.h"
+#include "src/io/dataset_internal.h"
 #include "src/io/image_io.h"
 
 namespace sft {
+namespace dataset_internal {
+
+std::string IndexPath(const std::string& prefix, size_t i) {
+  return prefix + "[" + std::to_string(i) + "]";
+}
+
+std::string StripJsonExceptionId(const std::string& what) {
+  if (!what.empty() && what[0] == '[') {
+    const size_t end = what.find("] ");
+    if (end != std::string::npos) return what.substr(end + 2);
+  }
+  return what;
+}
+
+}  // namespace dataset_internal
+
 namespace {
 
 using json = nlohmann::json;
+using dataset_internal::IndexPath;
+using dataset_internal::kFormatTag;
+using dataset_internal::kSceneFile;
+using dataset_internal::StripJsonExceptionId;
 
-constexpr char kFormatTag[] = "sft-dataset/1";
-constexpr char kSceneFile[] = "scene.json";
 // Largest deviation of world_from_env^T world_from_env from the identity that still counts as a
 // rotation (the file holds decimal numbers written by other tools).
 constexpr double kRotationTolerance = 1e-3;
@@ -52,21 +71,8 @@ json UnknownKeys(const json& obj, Keys known) {
   return extra;
 }
 
-// Appends the members of `extra` (when it is an object) to `entry`, except keys `entry` already
-// has: documented keys win over same-named extras.
-void AppendExtra(const json& extra, nlohmann::ordered_json* entry) {
-  if (!extra.is_object()) return;
-  for (const auto& [key, value] : extra.items()) {
-    if (!entry->contains(key)) (*entry)[key] = value;
-  }
-}
-
 std::string Field(const std::string& prefix, const std::string& key) {
   return prefix.empty() ? key : prefix + "." + key;
-}
-
-std::string Index(const std::string& prefix, size_t i) {
-  return prefix + "[" + std::to_string(i) + "]";
 }
 
 std::string SizeText(int width, int height) {
@@ -192,7 +198,7 @@ class SceneParser {
     }
     out->assign(value.size(), 0.0);
     for (size_t i = 0; i < value.size(); ++i) {
-      SFT_RETURN_IF_ERROR(Number(value[i], Index(path, i), &(*out)[i]));
+      SFT_RETURN_IF_ERROR(Number(value[i], IndexPath(path, i), &(*out)[i]));
     }
     return Status::Ok();
   }
@@ -232,13 +238,13 @@ class SceneParser {
     std::map<std::string, size_t> seen;
     for (size_t i = 0; i < cameras->size(); ++i) {
       const json& entry = (*cameras)[i];
-      const std::string path = Index("cameras", i);
+      const std::string path = IndexPath("cameras", i);
       if (!entry.is_object()) return Error(path, "expected an object, got " + Describe(entry));
       Camera camera;
       SFT_RETURN_IF_ERROR(RequiredString(entry, path, "id", &camera.id));
       if (const auto it = seen.find(camera.id); it != seen.end()) {
         return Error(Field(path, "id"), "duplicate camera id \"" + camera.id + "\" (also " +
-                                            Index("cameras", it->second) + ")");
+                                            IndexPath("cameras", it->second) + ")");
       }
       seen[camera.id] = i;
       std::string model;
@@ -309,7 +315,7 @@ class SceneParser {
       }
       for (int r = 0; r < 3; ++r) {
         std::vector<double> row;
-        SFT_RETURN_IF_ERROR(Numbers((*matrix)[r], Index(matrix_path, r), 3, &row));
+        SFT_RETURN_IF_ERROR(Numbers((*matrix)[r], IndexPath(matrix_path, r), 3, &row));
         for (int c = 0; c < 3; ++c) light->world_from_env(r, c) = row[c];
       }
       const Eigen::Matrix3d& m = light->world_from_env;
@@ -332,13 +338,13 @@ class SceneParser {
     std::map<std::string, size_t> seen;
     for (size_t i = 0; i < lights->size(); ++i) {
       const json& entry = (*lights)[i];
-      const std::string path = Index("lights", i);
+      const std::string path = IndexPath("lights", i);
       if (!entry.is_object()) return Error(path, "expected an object, got " + Describe(entry));
       LightSpec light;
       SFT_RETURN_IF_ERROR(RequiredString(entry, path, "id", &light.id));
       if (const auto it = seen.find(light.id); it != seen.end()) {
         return Error(Field(path, "id"), "duplicate light id \"" + light.id + "\" (also " +
-                                            Index("lights", it->second) + ")");
+                                            IndexPath("lights", it->second) + ")");
       }
       seen[light.id] = i;
       std::string type;
@@ -398,7 +404,7 @@ class SceneParser {
     if (views->empty()) return Error("views", "expected at least one view");
     for (size_t i = 0; i < views->size(); ++i) {
       const json& entry = (*views)[i];
-      const std::string path = Index("views", i);
+      const std::string path = IndexPath("views", i);
       if (!entry.is_object()) return Error(path, "expected an object, got " + Describe(entry));
       ViewSpec view;
       SFT_RETURN_IF_ERROR(RequiredString(entry, path, "image", &view.image));
@@ -421,15 +427,15 @@ class SceneParser {
         }
         for (size_t k = 0; k < lights->size(); ++k) {
           std::string id;
-          SFT_RETURN_IF_ERROR(String((*lights)[k], Index(lights_path, k), false, &id));
+          SFT_RETURN_IF_ERROR(String((*lights)[k], IndexPath(lights_path, k), false, &id));
           int index = -1;
           for (size_t l = 0; l < dataset->lights.size(); ++l) {
             if (dataset->lights[l].id == id) index = static_cast<int>(l);
           }
-          if (index < 0) return Error(Index(lights_path, k), "unknown light \"" + id + "\"");
+          if (index < 0) return Error(IndexPath(lights_path, k), "unknown light \"" + id + "\"");
           for (const std::string& other : view.light_ids) {
             if (other == id)
-              return Error(Index(lights_path, k), "light \"" + id + "\" listed twice");
+              return Error(IndexPath(lights_path, k), "light \"" + id + "\" listed twice");
           }
           view.light_ids.push_back(id);
           view.lights.push_back(index);
@@ -521,15 +527,6 @@ class SceneParser {
   std::string file_;
 };
 
-// "[json.exception.parse_error.101] parse error at ..." -> "parse error at ...".
-std::string StripJsonExceptionId(const std::string& what) {
-  if (!what.empty() && what[0] == '[') {
-    const size_t end = what.find("] ");
-    if (end != std::string::npos) return what.substr(end + 2);
-  }
-  return what;
-}
-
 Status CheckSize(const std::string& path, const char* what, const Image& image,
                  const Camera& camera) {
   if (image.width != camera.width || image.height != camera.height) {
@@ -603,7 +600,7 @@ Status ParseSceneJson(std::string text, const std::string& dir, Dataset* dataset
 Status CheckViewsHaveLights(const Dataset& dataset) {
   for (size_t i = 0; i < dataset.views.size(); ++i) {
     if (dataset.views[i].lights.empty()) {
-      return Status::Error(ScenePath(dataset) + ": " + Index("views", i) +
+      return Status::Error(ScenePath(dataset) + ": " + IndexPath("views", i) +
                            ".lights: empty (unknown lighting" +
                            (dataset.lighting.empty() ? "" : ": \"" + dataset.lighting + "\"") +
                            "); rendering needs every view's lights (estimating unknown lighting "
@@ -627,134 +624,6 @@ Status CheckDatasetFiles(const Dataset& dataset) {
   return Status::Ok();
 }
 
-Status WriteSceneJson(const Dataset& dataset, const std::string& dir) {
-  const std::string file = JoinPath(dir, kSceneFile);
-  try {
-    nlohmann::ordered_json root;
-    root["format"] = kFormatTag;
-    nlohmann::ordered_json cameras = nlohmann::ordered_json::array();
-    for (size_t i = 0; i < dataset.cameras.size(); ++i) {
-      const Camera& camera = dataset.cameras[i];
-      nlohmann::ordered_json entry;
-      entry["id"] = camera.id;
-      entry["model"] = CameraModelName(camera.model);
-      entry["width"] = camera.width;
-      entry["height"] = camera.height;
-      entry["params"] = camera.params;
-      if (i < dataset.camera_extra.size()) AppendExtra(dataset.camera_extra[i], &entry);
-      cameras.push_back(std::move(entry));
-    }
-    root["cameras"] = std::move(cameras);
-
-    nlohmann::ordered_json lights = nlohmann::ordered_json::array();
-    for (const LightSpec& light : dataset.lights) {
-      nlohmann::ordered_json entry;
-      entry["id"] = light.id;
-      if (light.type == LightType::kPoint) {
-        entry["type"] = "point";
-        entry["frame"] = light.frame == LightFrame::kCamera ? "camera" : "world";
-        entry["position"] = {light.position.x(), light.position.y(), light.position.z()};
-        entry["intensity"] = {light.intensity.x(), light.intensity.y(), light.intensity.z()};
-      } else {
-        entry["type"] = "environment";
-        entry["image"] = light.image;
-        nlohmann::ordered_json matrix = nlohmann::ordered_json::array();
-        for (int r = 0; r < 3; ++r) {
-          matrix.push_back(
-              {light.world_from_env(r, 0), light.world_from_env(r, 1), light.world_from_env(r, 2)});
-        }
-        entry["world_from_env"] = std::move(matrix);
-        entry["scale"] = light.scale;
-      }
-      AppendExtra(light.extra, &entry);
-      lights.push_back(std::move(entry));
-    }
-    root["lights"] = std::move(lights);
-
-    nlohmann::ordered_json views = nlohmann::ordered_json::array();
-    for (size_t i = 0; i < dataset.views.size(); ++i) {
-      const ViewSpec& view = dataset.views[i];
-      const std::string path = Index("views", i);
-      // A view built in code may carry indices or ids: use whichever is set, refuse to guess when
-      // they disagree, and never write a reference that ReadDataset would reject.
-      std::string camera_id = view.camera_id;
-      if (view.camera >= 0 && view.camera < static_cast<int>(dataset.cameras.size())) {
-        const std::string& by_index = dataset.cameras[view.camera].id;
-        if (!camera_id.empty() && camera_id != by_index) {
-          return Status::Error(file + ": " + path + ".camera: camera_id \"" + camera_id +
-                               "\" disagrees with camera index " + std::to_string(view.camera));
-        }
-        camera_id = by_index;
-      }
-      bool camera_known = false;
-      for (const Camera& camera : dataset.cameras)
-        camera_known = camera_known || camera.id == camera_id;
-      if (!camera_known) {
-        return Status::Error(file + ": " + path + ".camera: unknown camera \"" + camera_id + "\"");
-      }
-      std::vector<std::string> light_ids;
-      for (int l : view.lights) {
-        if (l < 0 || l >= static_cast<int>(dataset.lights.size())) {
-          return Status::Error(file + ": " + path + ".lights: light index " + std::to_string(l) +
-                               " out of range");
-        }
-        light_ids.push_back(dataset.lights[l].id);
-      }
-      if (view.lights.empty()) {
-        light_ids = view.light_ids;
-      } else if (!view.light_ids.empty() && view.light_ids != light_ids) {
-        return Status::Error(file + ": " + path + ".lights: light_ids disagree with light indices");
-      }
-      for (const std::string& id : light_ids) {
-        bool known = false;
-        for (const LightSpec& light : dataset.lights) known = known || light.id == id;
-        if (!known) {
-          return Status::Error(file + ": " + path + ".lights: unknown light \"" + id + "\"");
-        }
-      }
-      nlohmann::ordered_json entry;
-      entry["image"] = view.image;
-      if (!view.mask.empty()) entry["mask"] = view.mask;
-      entry["camera"] = camera_id;
-      entry["lights"] = light_ids;
-      const Eigen::Quaterniond& q = view.cam_from_world.rotation;
-      const Eigen::Vector3d& t = view.cam_from_world.translation;
-      entry["cam_from_world"]["rotation"] = {q.w(), q.x(), q.y(), q.z()};
-      entry["cam_from_world"]["translation"] = {t.x(), t.y(), t.z()};
-      AppendExtra(view.cam_from_world_extra, &entry["cam_from_world"]);
-      AppendExtra(view.extra, &entry);
-      views.push_back(std::move(entry));
-    }
-    root["views"] = std::move(views);
-    root["background"] = dataset.background == Background::kEnvironment ? "environment" : "black";
-
-    nlohmann::ordered_json ground_truth;
-    if (dataset.ground_truth.is_object()) ground_truth = dataset.ground_truth;
-    if (!dataset.gt_mesh.empty()) ground_truth["mesh"] = dataset.gt_mesh;
-    if (!ground_truth.is_null()) root["ground_truth"] = std::move(ground_truth);
-    if (!dataset.sparse_points.empty()) root["sparse_points"] = dataset.sparse_points;
-    if (!dataset.initial_mesh.empty()) root["initial_mesh"] = dataset.initial_mesh;
-    if (!dataset.dense_points.empty()) root["dense_points"] = dataset.dense_points;
-    if (dataset.has_source_from_world) {
-      const Similarity3d& s = dataset.source_from_world;
-      nlohmann::ordered_json entry;
-      entry["scale"] = s.scale;
-      entry["rotation"] = {s.rotation.w(), s.rotation.x(), s.rotation.y(), s.rotation.z()};
-      entry["translation"] = {s.translation.x(), s.translation.y(), s.translation.z()};
-      AppendExtra(s.extra, &entry);
-      root["source_from_world"] = std::move(entry);
-    }
-    if (!dataset.image_encoding.empty()) root["image_encoding"] = dataset.image_encoding;
-    if (!dataset.lighting.empty()) root["lighting"] = dataset.lighting;
-
-    AppendExtra(dataset.extra, &root);
-    return WriteTextFile(file, root.dump(1, ' ', false, json::error_handler_t::replace) + "\n");
-  } catch (const std::exception& e) {
-    return Status::Error(file + ": cannot serialize scene (" + StripJsonExceptionId(e.what()) +
-                         ")");
-  }
-}
-
 Status LoadViewImage(const Dataset& dataset, int index, Image* rgb) {
   const Camera& camera = ViewCamera(dataset, index);
   const std::string path = JoinPath(dataset.root, dataset.views[index].image);
@@ -769,7 +638,7 @@ Status LoadViewMask(const Dataset& dataset, int index, Image* mask) {
   const Camera& camera = ViewCamera(dataset, index);
   const ViewSpec& view = dataset.views[index];
   if (view.mask.empty()) {
-    return Status::Error(ScenePath(dataset) + ": " + Index("views", index) +
+    return Status::Error(ScenePath(dataset) + ": " + IndexPath("views", index) +
                          ".mask: view has no mask");
   }
   const std::string path = JoinPath(dataset.root, view.mask);

@@ -37,6 +37,23 @@ double Percentile(std::vector<double>* values, double q) {
   return (*values)[k];
 }
 
+// The support plane among the points that registered views observe (docs/import.md).
+SupportPlane FindPlane(const ColmapModel& model,
+                       const std::unordered_map<uint32_t, ObservingView>& views,
+                       const SupportPlaneOptions& options) {
+  std::vector<Eigen::Vector3d> points, centres;
+  for (const ColmapPoint3D& point : model.points) {
+    for (const ColmapTrackElement& e : point.track) {
+      if (views.count(e.image_id) > 0) {
+        points.push_back(point.xyz);
+        break;
+      }
+    }
+  }
+  for (const auto& [id, view] : views) centres.push_back(view.cam_from_world.Inverse().translation);
+  return FindSupportPlane(points, centres, options);
+}
+
 std::string Text(double value) {
   char buffer[32];
   std::snprintf(buffer, sizeof(buffer), "%g", value);
@@ -58,7 +75,7 @@ bool NormalizationOptions::Check(std::string* why) const {
     *why = "min_points: must be >= 1, got " + std::to_string(min_points);
     return false;
   }
-  return true;
+  return plane.Check(why);
 }
 
 Status ComputeNormalization(const ColmapModel& model,
@@ -71,6 +88,7 @@ Status ComputeNormalization(const ColmapModel& model,
   *result = NormalizationResult();
   result->method = masks ? "masks" : "optical_axes";
   result->used.assign(model.points.size(), false);
+  if (!masks) result->plane = FindPlane(model, views, options.plane);
   std::vector<Eigen::Vector3d> kept;
   for (size_t i = 0; i < model.points.size(); ++i) {
     const ColmapPoint3D& point = model.points[i];
@@ -85,7 +103,8 @@ Status ComputeNormalization(const ColmapModel& model,
     if (observing == 0) continue;
     ++result->points_total;
     // Masks: a strict majority; optical axes: at least half (docs/import.md).
-    const bool object = masks ? 2 * votes > observing : 2 * votes >= observing;
+    const bool object = masks ? 2 * votes > observing
+                              : 2 * votes >= observing && !result->plane.OffObject(point.xyz);
     if (!object) continue;
     result->used[i] = true;
     kept.push_back(point.xyz);

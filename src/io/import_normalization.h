@@ -7,7 +7,9 @@
 // Without masks: a view sees a point "near its optical axis" when the point lies in front of the
 // camera and its normalised image coordinates (x/z, y/z) fall inside the ellipse whose semi-axes
 // are `axis_cone` times the half-image's extent (w/(2 fx), h/(2 fy)); a point belongs to the
-// object when at least half of its observing views see it that way; the box runs from the
+// object when at least half of its observing views see it that way, unless it lies on or beyond
+// the support plane (src/io/support_plane.h: a table top or floor under the object, whose points
+// every view also sees near its axis); the box runs from the
 // `percentile`-th to the (100 − percentile)-th percentile of those points on each axis, so stray
 // points do not stretch it.
 #ifndef SFT_IO_IMPORT_NORMALIZATION_H_
@@ -21,6 +23,7 @@
 
 #include "src/core/status.h"
 #include "src/io/colmap_model.h"
+#include "src/io/support_plane.h"
 #include "src/render/camera.h"
 
 namespace sft {
@@ -46,6 +49,8 @@ struct NormalizationOptions {
   double percentile = 2.0;
   // Fewest object points accepted, >= 1.
   int min_points = 8;
+  // Without masks: the support plane whose points are not the object.
+  SupportPlaneOptions plane;
 
   // Errors name the command-line flags of `sft import colmap` (--axis-cone, --percentile).
   bool Check(std::string* why) const;
@@ -58,6 +63,7 @@ struct NormalizationResult {
   int points_total = 0;                              // sparse points with a non-empty track.
   int points_used = 0;                               // object points that define the box.
   std::vector<bool> used;                            // parallel to model.points.
+  SupportPlane plane;  // without masks: the support plane, in the model's frame (or not found).
 };
 
 // `views` maps COLMAP image ids to views; track elements of other images are ignored. Errors:

@@ -47,31 +47,116 @@ double MeanReprojectionError(const ColmapModel& model) {
 
 Status RunColmap(const VideoImportOptions& opts, const std::string& work, int frames,
                  VideoImportReport* report) {
-  const std::string log = JoinPath(work, "log.txt");
-  const std::string database = JoinPath(work, "database.db");
-  const std::string images = JoinPath(work, "frames");
-  const bool progress = !opts.quiet;
-  SFT_RETURN_IF_ERROR(RunColmapStage(
-      opts.colmap, "feature_extractor",
-      {"--database_path", database, "--image_path", images, "--ImageReader.single_camera", "1",
-       "--ImageReader.camera_model", opts.camera_model, "--SiftExtraction.use_gpu", "0"},
-      log, frames, progress, &report->seconds_features));
-  report->matcher = frames <= opts.exhaustive_limit ? "exhaustive_matcher" : "sequential_matcher";
-  // Exhaustive matching in blocks of 10 images (COLMAP's default 50 reports a single block for a
-  // small video, so the progress line would not move).
-  std::vector<std::string> match_args = {"--database_path", database, "--SiftMatching.use_gpu",
-                                         "0"};
-  if (report->matcher == "exhaustive_matcher") {
-    match_args.insert(match_args.end(), {"--ExhaustiveMatching.block_size", "10"});
+  const std::vector<ColmapStage> stages = PlanColmapStages(opts, work, frames);
+  report->matcher = stages[1].name;
+  SFT_RETURN_IF_ERROR(MakeDirectories(JoinPath(work, "sparse")));
+  double* seconds[] = {&report->seconds_features, &report->seconds_matching,
+                       &report->seconds_mapping};
+  for (size_t i = 0; i < stages.size(); ++i) {
+    SFT_RETURN_IF_ERROR(RunColmapStage(opts.colmap, stages[i].name, stages[i].args,
+                                       JoinPath(work, "log.txt"), frames, !opts.quiet, seconds[i]));
   }
-  SFT_RETURN_IF_ERROR(RunColmapStage(opts.colmap, report->matcher, match_args, log, frames,
-                                     progress, &report->seconds_matching));
-  const std::string sparse = JoinPath(work, "sparse");
-  SFT_RETURN_IF_ERROR(MakeDirectories(sparse));
-  return RunColmapStage(
-      opts.colmap, "mapper",
-      {"--database_path", database, "--image_path", images, "--output_path", sparse}, log, frames,
-      progress, &report->seconds_mapping);
+  return Status::Ok();
+}
+
+// Checks the inputs and the output folders before anything is written.
+Status CheckInputsAndOutputs(const VideoImportOptions& opts, const std::string& work) {
+  std::string why;
+  if (!opts.Check(&why)) return Status::Error(why);
+  // "auto": GrabCut masks from the imported sparse points, as `sft import colmap --masks auto`.
+  const bool mask_folder = !opts.masks.empty() && opts.masks != "auto";
+  std::error_code ec;
+  if (mask_folder && !fs::is_directory(opts.masks, ec)) {
+    return Status::Error("--masks: " + opts.masks + ": folder not found");
+  }
+  if (!opts.probe.empty() && !FileExists(opts.probe)) {
+    return Status::Error("--probe: " + opts.probe + ": file not found");
+  }
+  const RunInputs inputs{{mask_folder ? opts.masks : std::string()}, {opts.video, opts.probe}};
+  SFT_RETURN_IF_ERROR(CheckOutputDirectory(opts.out, inputs, "--out"));
+  SFT_RETURN_IF_ERROR(CheckOutputDirectory(work, inputs, "--out (OUT.video-work)"));
+  if (fs::exists(opts.out, ec) && !fs::is_empty(opts.out, ec) && !opts.overwrite) {
+    return Status::Error(opts.out + ": output exists and is not empty (use --overwrite)");
+  }
+  return Status::Ok();
+}
+
+// The frames picked from the video (step 1).
+struct SelectedFrames {
+  std::vector<FrameScore> scores;  // every decoded frame.
+  std::vector<int> picked;         // indices into scores.
+  int width = 0, height = 0;       // frame size, pixels.
+};
+
+// Scores the video's frames, selects them and writes them to WORK/frames (a fresh WORK).
+Status SelectAndWriteFrames(const VideoImportOptions& opts, const std::string& work,
+                            SelectedFrames* frames, VideoImportReport* report) {
+  const auto start = std::chrono::steady_clock::now();
+  SFT_RETURN_IF_ERROR(
+      ScoreVideoFrames(opts.video, &frames->scores, &frames->width, &frames->height, !opts.quiet));
+  report->frames_decoded = static_cast<int>(frames->scores.size());
+  frames->picked = SelectFrames(frames->scores, opts.selection);
+  if (frames->picked.size() < 2) {
+    return Status::Error("--video: " + opts.video + ": fewer than 2 distinct frames (" +
+                         std::to_string(frames->scores.size()) + " decoded)");
+  }
+  std::vector<int> frame_numbers;
+  for (int i : frames->picked) frame_numbers.push_back(frames->scores[i].index);
+  report->frames_selected = static_cast<int>(frame_numbers.size());
+  std::error_code ec;
+  fs::remove_all(work, ec);
+  SFT_RETURN_IF_ERROR(MakeDirectories(work));
+  std::vector<std::string> names;
+  SFT_RETURN_IF_ERROR(
+      WriteVideoFrames(opts.video, frame_numbers, JoinPath(work, "frames"), &names));
+  report->seconds_frames =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return Status::Ok();
+}
+
+// Imports COLMAP's model `model_dir` as `sft import colmap` would (step 3).
+Status ImportModel(const VideoImportOptions& opts, const std::string& work,
+                   const std::string& model_dir, VideoImportReport* report) {
+  ColmapImportOptions import;
+  import.model = model_dir;
+  import.images = JoinPath(work, "frames");
+  import.masks = opts.masks;
+  import.probe = opts.probe;
+  import.out = opts.out;
+  import.normalization = opts.normalization;
+  import.import_dense = false;
+  import.overwrite = opts.overwrite;
+  import.quiet = opts.quiet;
+  return ImportColmap(import, &report->import);
+}
+
+// OUT/colmap/frames.json (the selection and COLMAP's summary) and OUT/colmap/log.txt.
+Status WriteFramesRecord(const VideoImportOptions& opts, const std::string& work,
+                         const SelectedFrames& selected, const VideoImportReport& report) {
+  nlohmann::json frames = nlohmann::json::object();
+  frames["video"] = opts.video;
+  frames["frames_decoded"] = report.frames_decoded;
+  frames["width"] = selected.width;
+  frames["height"] = selected.height;
+  nlohmann::json list = nlohmann::json::array();
+  for (int i : selected.picked) {
+    const FrameScore& score = selected.scores[i];
+    list.push_back({{"frame", score.index},
+                    {"image", VideoFrameName(score.index)},
+                    {"sharpness", score.sharpness}});
+  }
+  frames["selected"] = list;
+  frames["matcher"] = report.matcher;
+  frames["registered"] = report.registered;
+  frames["reprojection_error_px"] = report.reprojection_error;
+  const std::string colmap_dir = JoinPath(opts.out, "colmap");
+  SFT_RETURN_IF_ERROR(MakeDirectories(colmap_dir));
+  SFT_RETURN_IF_ERROR(WriteTextFile(JoinPath(colmap_dir, "frames.json"), frames.dump(2) + "\n"));
+  std::error_code ec;
+  fs::copy_file(JoinPath(work, "log.txt"), JoinPath(colmap_dir, "log.txt"),
+                fs::copy_options::overwrite_existing, ec);
+  if (ec) return Status::Error(JoinPath(colmap_dir, "log.txt") + ": cannot write");
+  return Status::Ok();
 }
 
 }  // namespace
@@ -99,103 +184,65 @@ bool VideoImportOptions::Check(std::string* why) const {
   return false;
 }
 
+std::vector<ColmapStage> PlanColmapStages(const VideoImportOptions& opts, const std::string& work,
+                                          int frames) {
+  const std::string database = JoinPath(work, "database.db");
+  const std::string images = JoinPath(work, "frames");
+  std::vector<ColmapStage> stages;
+  stages.push_back(
+      {"feature_extractor",
+       {"--database_path", database, "--image_path", images, "--ImageReader.single_camera", "1",
+        "--ImageReader.camera_model", opts.camera_model, "--SiftExtraction.use_gpu", "0"}});
+  ColmapStage match{frames <= opts.exhaustive_limit ? "exhaustive_matcher" : "sequential_matcher",
+                    {"--database_path", database, "--SiftMatching.use_gpu", "0"}};
+  // COLMAP's default block of 50 images reports a single block for a small video, so the
+  // progress line would not move.
+  if (match.name == "exhaustive_matcher") {
+    match.args.insert(match.args.end(), {"--ExhaustiveMatching.block_size", "10"});
+  }
+  stages.push_back(match);
+  stages.push_back({"mapper",
+                    {"--database_path", database, "--image_path", images, "--output_path",
+                     JoinPath(work, "sparse")}});
+  return stages;
+}
+
+Status CheckRegistered(int registered, int selected, bool has_model, double min_registered,
+                       const std::string& log_path) {
+  const double fraction = selected > 0 ? static_cast<double>(registered) / selected : 0.0;
+  if (has_model && fraction >= min_registered) return Status::Ok();
+  char text[512];
+  std::snprintf(text, sizeof(text),
+                "COLMAP registered %d of %d frames (%.0f%%, --min-registered %.0f%%); try a "
+                "scene with more texture near the object, more frames (--frames), or slower "
+                "camera motion (log: %s)",
+                has_model ? registered : 0, selected, has_model ? 100 * fraction : 0.0,
+                100 * min_registered, log_path.c_str());
+  return Status::Error(text);
+}
+
 Status ImportVideo(const VideoImportOptions& opts, VideoImportReport* report) {
   const auto start = std::chrono::steady_clock::now();
   *report = VideoImportReport();
-  std::string why;
-  if (!opts.Check(&why)) return Status::Error(why);
-  // "auto": GrabCut masks from the imported sparse points, as `sft import colmap --masks auto`.
-  const bool mask_folder = !opts.masks.empty() && opts.masks != "auto";
-  std::error_code ec;
-  if (mask_folder && !fs::is_directory(opts.masks, ec)) {
-    return Status::Error("--masks: " + opts.masks + ": folder not found");
-  }
-  if (!opts.probe.empty() && !FileExists(opts.probe)) {
-    return Status::Error("--probe: " + opts.probe + ": file not found");
-  }
   const std::string work = opts.out + ".video-work";
-  const RunInputs inputs{{mask_folder ? opts.masks : std::string()}, {opts.video, opts.probe}};
-  SFT_RETURN_IF_ERROR(CheckOutputDirectory(opts.out, inputs, "--out"));
-  SFT_RETURN_IF_ERROR(CheckOutputDirectory(work, inputs, "--out (OUT.video-work)"));
-  if (fs::exists(opts.out, ec) && !fs::is_empty(opts.out, ec) && !opts.overwrite) {
-    return Status::Error(opts.out + ": output exists and is not empty (use --overwrite)");
-  }
-
+  SFT_RETURN_IF_ERROR(CheckInputsAndOutputs(opts, work));
   // 1. Frames.
-  auto t0 = std::chrono::steady_clock::now();
-  std::vector<FrameScore> scores;
-  int width = 0, height = 0;
-  SFT_RETURN_IF_ERROR(ScoreVideoFrames(opts.video, &scores, &width, &height, !opts.quiet));
-  report->frames_decoded = static_cast<int>(scores.size());
-  const std::vector<int> picked = SelectFrames(scores, opts.selection);
-  if (picked.size() < 2) {
-    return Status::Error("--video: " + opts.video + ": fewer than 2 distinct frames (" +
-                         std::to_string(scores.size()) + " decoded)");
-  }
-  std::vector<int> frame_numbers;
-  for (int i : picked) frame_numbers.push_back(scores[i].index);
-  report->frames_selected = static_cast<int>(frame_numbers.size());
-  fs::remove_all(work, ec);
-  SFT_RETURN_IF_ERROR(MakeDirectories(work));
-  std::vector<std::string> names;
-  SFT_RETURN_IF_ERROR(
-      WriteVideoFrames(opts.video, frame_numbers, JoinPath(work, "frames"), &names));
-  report->seconds_frames =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-
-  // 2. COLMAP.
+  SelectedFrames selected;
+  SFT_RETURN_IF_ERROR(SelectAndWriteFrames(opts, work, &selected, report));
+  // 2. COLMAP, then the --min-registered rule on its largest model.
   SFT_RETURN_IF_ERROR(RunColmap(opts, work, report->frames_selected, report));
   std::string model_dir;
   ColmapModel model;
   SFT_RETURN_IF_ERROR(LargestModel(JoinPath(work, "sparse"), &model_dir, &model, &report->models));
   report->registered = static_cast<int>(model.images.size());
   report->reprojection_error = MeanReprojectionError(model);
-  const double fraction = static_cast<double>(report->registered) / report->frames_selected;
-  if (model_dir.empty() || fraction < opts.min_registered) {
-    char text[512];
-    std::snprintf(text, sizeof(text),
-                  "COLMAP registered %d of %d frames (%.0f%%, --min-registered %.0f%%); try a "
-                  "scene with more texture near the object, more frames (--frames), or slower "
-                  "camera motion (log: %s)",
-                  report->registered, report->frames_selected, 100 * fraction,
-                  100 * opts.min_registered, JoinPath(work, "log.txt").c_str());
-    return Status::Error(text);
-  }
-
-  // 3. Import as `sft import colmap`.
-  ColmapImportOptions import;
-  import.model = model_dir;
-  import.images = JoinPath(work, "frames");
-  import.masks = opts.masks;
-  import.probe = opts.probe;
-  import.out = opts.out;
-  import.normalization = opts.normalization;
-  import.import_dense = false;
-  import.overwrite = opts.overwrite;
-  import.quiet = opts.quiet;
-  SFT_RETURN_IF_ERROR(ImportColmap(import, &report->import));
-
-  nlohmann::json frames = nlohmann::json::object();
-  frames["video"] = opts.video;
-  frames["frames_decoded"] = report->frames_decoded;
-  frames["width"] = width;
-  frames["height"] = height;
-  nlohmann::json list = nlohmann::json::array();
-  for (int i : picked) {
-    list.push_back({{"frame", scores[i].index},
-                    {"image", VideoFrameName(scores[i].index)},
-                    {"sharpness", scores[i].sharpness}});
-  }
-  frames["selected"] = list;
-  frames["matcher"] = report->matcher;
-  frames["registered"] = report->registered;
-  frames["reprojection_error_px"] = report->reprojection_error;
-  const std::string colmap_dir = JoinPath(opts.out, "colmap");
-  SFT_RETURN_IF_ERROR(MakeDirectories(colmap_dir));
-  SFT_RETURN_IF_ERROR(WriteTextFile(JoinPath(colmap_dir, "frames.json"), frames.dump(2) + "\n"));
-  fs::copy_file(JoinPath(work, "log.txt"), JoinPath(colmap_dir, "log.txt"),
-                fs::copy_options::overwrite_existing, ec);
-  if (ec) return Status::Error(JoinPath(colmap_dir, "log.txt") + ": cannot write");
+  SFT_RETURN_IF_ERROR(CheckRegistered(report->registered, report->frames_selected,
+                                      !model_dir.empty(), opts.min_registered,
+                                      JoinPath(work, "log.txt")));
+  // 3. Import as `sft import colmap`, then the record of the selection and COLMAP's log.
+  SFT_RETURN_IF_ERROR(ImportModel(opts, work, model_dir, report));
+  SFT_RETURN_IF_ERROR(WriteFramesRecord(opts, work, selected, *report));
+  std::error_code ec;
   fs::remove_all(work, ec);
   report->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return Status::Ok();

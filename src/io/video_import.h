@@ -10,6 +10,7 @@
 #define SFT_IO_VIDEO_IMPORT_H_
 
 #include <string>
+#include <vector>
 
 #include "src/core/status.h"
 #include "src/io/colmap_import.h"
@@ -22,7 +23,7 @@ struct VideoImportOptions {
   std::string out;                  // output dataset folder.
   FrameSelectionOptions selection;  // how many frames, duplicate rule.
   std::string probe;                // optional equirectangular probe (as `sft import colmap`).
-  std::string masks;                // "" (none), "auto" (not yet), or a folder of frame masks.
+  std::string masks;                // "" (none), "auto" (GrabCut) or a folder of frame masks.
   double min_registered = 0.8;      // fraction of the selected frames COLMAP must register, [0, 1].
   int exhaustive_limit = 150;       // exhaustive matching up to this many frames, [2, 10000].
   std::string camera_model = "SIMPLE_RADIAL";  // shared COLMAP camera model sft supports.
@@ -47,6 +48,26 @@ struct VideoImportReport {
 };
 
 Status ImportVideo(const VideoImportOptions& options, VideoImportReport* report);
+
+// One COLMAP program run: `colmap name args...`.
+struct ColmapStage {
+  std::string name;  // feature_extractor, exhaustive_matcher, sequential_matcher or mapper.
+  std::vector<std::string> args;
+};
+
+// The COLMAP runs for `frames` selected frames in workspace `work` (frames in WORK/frames, the
+// database WORK/database.db, models under WORK/sparse): feature extraction with one shared camera
+// of options.camera_model; exhaustive matching when frames <= options.exhaustive_limit (in blocks
+// of 10 images, so its progress line moves), else sequential matching (no vocabulary tree offline,
+// so no loop detection); mapping. GPU off everywhere (COLMAP aborts headless otherwise).
+std::vector<ColmapStage> PlanColmapStages(const VideoImportOptions& options,
+                                          const std::string& work, int frames);
+
+// The --min-registered rule: an error when COLMAP wrote no model or registered fewer than
+// min_registered × selected frames. The one-line message says how many registered, of how many,
+// the threshold, what to try and where COLMAP's log is.
+Status CheckRegistered(int registered, int selected, bool has_model, double min_registered,
+                       const std::string& log_path);
 
 }  // namespace sft
 
