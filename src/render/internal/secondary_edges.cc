@@ -27,7 +27,7 @@ constexpr int kSecondaryCandidates = 16;
 constexpr double kSecondaryTexelProbability = 0.25;
 // (B)'s shadow pools: attempts per expected secondary sample of the view (pixels × spp × rate),
 // clamped; entries weighed per (B) sample. See docs/design-notes.md for the measured choice.
-constexpr double kShadowPoolAttemptsPerSample = 0.25;
+constexpr double kShadowPoolAttemptsPerSample = 0.015625;
 constexpr int64_t kMinShadowPoolAttempts = 256;
 constexpr int64_t kMaxShadowPoolAttempts = 65536;
 constexpr int kShadowPoolCandidates = 8;
