@@ -326,31 +326,31 @@ void SampleShadowBoundary(const SecondaryVertex& v, double u_light, Sampler* sam
                     -m_row);
 }
 
-// The shadow pool of the light at `light` (ShadowPool); rays counted in *stats.
-ShadowPool BuildShadowPool(const Context& ctx, const Eigen::Vector3d& light, int64_t attempts,
-                           uint64_t key, RenderStats* stats) {
+// The shadow pool of the light at `light` (ShadowPool), drawn with `pool_sampler`; rays counted
+// in *stats.
+ShadowPool BuildShadowPool(const RenderScene& scene, const Eigen::Vector3d& light, int64_t attempts,
+                           const Sampler& pool_sampler, RenderStats* stats) {
   ShadowPool pool;
   const std::shared_ptr<const std::vector<EdgeCandidate>> shared =
-      ShadowEdgeCandidates(ctx.scene, light);
+      ShadowEdgeCandidates(scene, light);
   const std::vector<EdgeCandidate>& candidates = *shared;
   std::vector<double> angles;
   for (const EdgeCandidate& c : candidates) angles.push_back(c.weight);
   const DiscreteDistribution by_angle(angles);
   if (by_angle.empty()) return pool;
   pool.attempts = attempts;
-  Sampler sampler(ctx.options.seed, ctx.view.view_index, key, 0);
+  Sampler sampler = pool_sampler;
   for (int64_t j = 0; j < attempts; ++j) {
     // Stratified over the edges' cumulative angle: every edge of a large angle gets its share.
     const int c = by_angle.SampleInverse((j + sampler.Next1D()) / attempts);
     ShadowPoolEntry e;
     e.edge = candidates[c].edge;
     e.s = sampler.Next1D();
-    const MeshEdge& edge = ctx.scene.edges()[e.edge];
-    if (!CastShadowPoint(ctx, light, edge, e.s, stats, &e.shadow)) continue;
+    const MeshEdge& edge = scene.edges()[e.edge];
+    if (!CastShadowPoint(scene, light, edge, e.s, stats, &e.shadow)) continue;
     ShadowPoolPoint p;
     p.y = e.shadow.y;
-    p.dy_ds =
-        e.shadow.d_y_d_point * (ctx.scene.positions()[edge.v1] - ctx.scene.positions()[edge.v0]);
+    p.dy_ds = e.shadow.d_y_d_point * (scene.positions()[edge.v1] - scene.positions()[edge.v0]);
     p.inverse_probability = by_angle.InverseProbability(c);
     p.receiver = e.shadow.receiver;
     pool.points.push_back(p);
@@ -372,17 +372,15 @@ SecondaryEdges BuildSecondaryEdges(const RenderScene& scene, const Material& mat
   out.environment = environment && options.effects.shadows;
   out.mesh_edges = MeshEdgeTable::Of(scene);
   if (options.effects.shadows && max_segments > 1) {
-    // CastShadowPoint reads only the scene of its context.
-    const Context ctx{scene, material, material, view,    options, nullptr,
-                      1,     1.0,      nullptr,  nullptr, nullptr};
     const double expected = static_cast<double>(view.camera.width) * view.camera.height *
                             options.spp * request.secondary_edge_samples;
     const int64_t attempts = std::clamp<int64_t>(
         static_cast<int64_t>(std::ceil(expected * kShadowPoolAttemptsPerSample)),
         kMinShadowPoolAttempts, kMaxShadowPoolAttempts);
     for (size_t l = 0; l < view.point_lights.size(); ++l) {
+      const Sampler pool_sampler(options.seed, view.view_index, kShadowPoolKey + l, 0);
       out.shadow_pools.push_back(
-          BuildShadowPool(ctx, view.point_lights[l].position, attempts, kShadowPoolKey + l, stats));
+          BuildShadowPool(scene, view.point_lights[l].position, attempts, pool_sampler, stats));
     }
   }
   return out;

@@ -57,9 +57,8 @@ std::vector<EdgeCandidate> BuildShadowEdgeCandidates(const RenderScene& scene,
 
 }  // namespace
 
-bool CastShadowPoint(const Context& ctx, const Eigen::Vector3d& light, const MeshEdge& edge,
+bool CastShadowPoint(const RenderScene& scene, const Eigen::Vector3d& light, const MeshEdge& edge,
                      double s, RenderStats* stats, ShadowPoint* out) {
-  const RenderScene& scene = ctx.scene;
   const Eigen::Vector3d& a = scene.positions()[edge.v0];
   const Eigen::Vector3d& b = scene.positions()[edge.v1];
   const Eigen::Vector3d point = a + s * (b - a);
@@ -154,7 +153,7 @@ void AddShadowEdgeTerms(const EdgeView& view, std::vector<EdgeEntry>* entries) {
       RenderStats& local = view.thread_stats.local();
       const MeshEdge& edge = scene.edges()[candidate.edge];
       ShadowPoint shadow;
-      if (!CastShadowPoint(ctx, light, edge, s, &local, &shadow)) return;
+      if (!CastShadowPoint(scene, light, edge, s, &local, &shadow)) return;
       EmitCurveSample(
           view, shadow.y, inv_pdf, options.spp,
           [&](const Eigen::Matrix<double, 2, 3>& d_q) {

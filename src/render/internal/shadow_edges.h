@@ -30,7 +30,7 @@ struct ShadowPoint {
 // light does not reach the edge point, nothing lies behind it, or the receiver is grazed.
 // y = light + τ·d on the receiver's plane, d = point − light, τ = (|d| + t)/|d|:
 //   ∂y/∂point = τ(I − d̂ n_rᵀ/(n_r·d̂)),  ∂y/∂p_j = b_j·d̂ n_rᵀ/(n_r·d̂).
-bool CastShadowPoint(const Context& ctx, const Eigen::Vector3d& light, const MeshEdge& edge,
+bool CastShadowPoint(const RenderScene& scene, const Eigen::Vector3d& light, const MeshEdge& edge,
                      double s, RenderStats* stats, ShadowPoint* out);
 
 // The vertices that move a shadow point of `edge` at parameter s, and rows_j = (∂y/∂p_j)ᵀ·row for
