@@ -76,7 +76,7 @@ for t in "${targets[@]}"; do
   # that relative paths inside fuzzed JSON resolve to nothing else.
   work=$(mktemp -d)
   cp fuzz/seeds/mesh_colors/albedo.meshcolors "$work"/
-  # tinyexr 1.0.1 leaks on most corrupt EXR inputs (fuzz/lsan.supp), and libFuzzer then runs a
+  # tinyexr 1.0.1 leaks on most corrupt EXR inputs (scripts/lsan.supp), and libFuzzer then runs a
   # full leak scan after each of them (~25 exec/s instead of thousands): no leak checking for the
   # EXR target; our EXR code owns tinyexr's buffers through RAII (src/io/image_io.cc, ExrHolder).
   extra=()
@@ -93,7 +93,7 @@ for t in "${targets[@]}"; do
   while [[ $left -gt 0 && $status -eq 0 ]]; do
     this=$(( left < chunk ? left : chunk ))
     (cd "$work" && ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
-       LSAN_OPTIONS="suppressions=$root/fuzz/lsan.supp" \
+       LSAN_OPTIONS="suppressions=$root/scripts/lsan.supp" \
        "$bin" -max_total_time="$this" -timeout=10 -rss_limit_mb=2048 -max_len=65536 \
        -print_final_stats=1 ${extra[@]+"${extra[@]}"} \
        -artifact_prefix="$build_dir/fuzz-artifacts/$t-" "$corpus") >>"$log" 2>&1 || status=$?
