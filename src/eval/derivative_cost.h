@@ -96,13 +96,15 @@ struct DerivativeCostReport {
 
   // With noise_seeds: the vertex gradient's noise √(T/S) over the N seeds' vertex gradients g_k,
   // T = Σ_k ‖g_k − ḡ‖²/(N − 1) (the trace of one seed's covariance) and S = ‖ḡ‖² − T/N (the
-  // unbiased estimate of ‖E g‖²; 0 when that is not positive), the mean adjoint
-  // seconds of those passes, and the efficiency (mean seconds / forward seconds) × noise²: the
+  // unbiased estimate of ‖E g‖²; 0 when that is not positive), the mean seconds of those adjoint
+  // passes and of a forward pass run with each seed between them, and the efficiency
+  // (mean adjoint seconds / mean forward seconds) × noise²: the
   // time, in forward passes, to reach unit relative variance (lower is better; halving it halves
   // the time to reach any given noise).
   int noise_seeds = 0;
   double vertex_noise = 0.0;
   double noise_adjoint_seconds = 0.0;
+  double noise_forward_seconds = 0.0;
   double cost_times_variance = 0.0;
 };
 

@@ -123,8 +123,9 @@ TEST(DerivativeCostTest, NoiseFallsWithSamples) {
     EXPECT_GT(report.vertex_noise, 0.0);
     EXPECT_TRUE(std::isfinite(report.vertex_noise));
     EXPECT_GT(report.noise_adjoint_seconds, 0.0);
+    EXPECT_GT(report.noise_forward_seconds, 0.0);
     EXPECT_NEAR(report.cost_times_variance,
-                report.noise_adjoint_seconds / report.forward.seconds * report.vertex_noise *
+                report.noise_adjoint_seconds / report.noise_forward_seconds * report.vertex_noise *
                     report.vertex_noise,
                 1e-9 * report.cost_times_variance);
     EXPECT_TRUE(DerivativeCostReportToJson(report).contains("noise"));

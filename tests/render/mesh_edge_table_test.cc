@@ -22,37 +22,24 @@ TriMesh Bunny() {
   return mesh;
 }
 
-// Every non-coplanar edge is a record; records are drawn ∝ length, and InverseProbability is the
-// inverse of that probability (to float precision).
-TEST(MeshEdgeTableTest, RecordsAreTheNonCoplanarEdgesDrawnInProportionToLength) {
+// Every non-coplanar edge is a record, in the tree's order, with its faces and length.
+TEST(MeshEdgeTableTest, RecordsAreTheNonCoplanarEdgesInTreeOrder) {
   const RenderScene scene(Bunny());
   const MeshEdgeTable table(scene);
   ASSERT_FALSE(table.empty());
   EXPECT_LE(table.size(), static_cast<int>(scene.edges().size()));
-  double total_length = 0.0, probability_sum = 0.0;
+  EXPECT_EQ(table.tree().order().size(), static_cast<size_t>(table.size()));
+  std::set<int> edges;
   for (int i = 0; i < table.size(); ++i) {
     const MeshEdge& edge = scene.edges()[table.edge(i)];
-    total_length += (scene.positions()[edge.v1] - scene.positions()[edge.v0]).norm();
-    probability_sum += 1.0 / table.InverseProbability(i);
+    edges.insert(table.edge(i));
+    const double length = (scene.positions()[edge.v1] - scene.positions()[edge.v0]).norm();
+    EXPECT_NEAR(table.record(i).length, length, 1e-6 * length);
     EXPECT_EQ(table.record(i).f0, edge.f0);
     EXPECT_EQ(table.record(i).f1, edge.f1);
+    EXPECT_LT((table.record(i).a.cast<double>() - scene.positions()[edge.v0]).norm(), 1e-6);
   }
-  EXPECT_NEAR(probability_sum, 1.0, 1e-4);
-  const int n = 1 << 20;
-  std::vector<int> counts(table.size(), 0);
-  std::vector<double> u(32);
-  int out[32];
-  for (int i = 0; i < n; i += 32) {
-    for (int k = 0; k < 32; ++k) u[k] = (i + k + 0.5) / n;  // stratified
-    table.SampleBatch(u.data(), 32, out);
-    for (int k = 0; k < 32; ++k) ++counts[out[k]];
-  }
-  for (int i = 0; i < table.size(); i += 97) {
-    const MeshEdge& edge = scene.edges()[table.edge(i)];
-    const double length = (scene.positions()[edge.v1] - scene.positions()[edge.v0]).norm();
-    // Stratified u over the alias cells: within 2 draws of the expected count.
-    EXPECT_NEAR(counts[i], n * length / total_length, 2.0) << i;
-  }
+  EXPECT_EQ(edges.size(), static_cast<size_t>(table.size()));  // each edge once.
 }
 
 // A face's near records are exactly the edges at its corners that are not its own.
@@ -74,29 +61,56 @@ TEST(MeshEdgeTableTest, NearRecordsAreTheEdgesAtTheFacesCorners) {
   }
 }
 
-// The mixture's probabilities sum to 1 and match its draws.
+// The mixture's probabilities sum to 1 and match its draws, and every record with a point
+// above x's plane has a positive probability.
 TEST(MeshEdgeTableTest, NearEdgeMixtureProbabilitiesMatchItsDraws) {
   const RenderScene scene(Bunny());
   const MeshEdgeTable table(scene);
   const int face = 1234;
-  const NearEdgeMixture mixture(table, face);
+  const Eigen::Vector3i& corners = scene.faces()[face];
+  const Eigen::Vector3d x = (scene.positions()[corners[0]] + scene.positions()[corners[1]] +
+                             scene.positions()[corners[2]]) /
+                            3.0;
+  const Eigen::Vector3d n = scene.FaceNormal(face);
+  const NearEdgeMixture mixture(table, face, x, n);
+  std::vector<double> p(table.size());
   double sum = 0.0;
-  for (int i = 0; i < table.size(); ++i) sum += 1.0 / mixture.InverseProbability(i);
-  EXPECT_NEAR(sum, 1.0, 1e-4);
-  const int n = 1 << 20;
+  for (int i = 0; i < table.size(); ++i) {
+    p[i] = 1.0 / mixture.InverseProbability(i);
+    sum += p[i];
+    const MeshEdgeTable::Record& r = table.record(i);
+    const bool above = n.dot(r.a.cast<double>() - x) > 1e-6 || n.dot(r.b.cast<double>() - x) > 1e-6;
+    if (above) {
+      EXPECT_GT(p[i], 0.0) << i;
+    }
+  }
+  EXPECT_LE(sum, 1.0 + 1e-9);  // the rest is the tree's empty draw (all below x's plane).
+  const int draws = 1 << 20;
   std::vector<int> counts(table.size(), 0);
-  double u[32];
-  int out[32];
-  for (int i = 0; i < n; i += 32) {
-    for (int k = 0; k < 32; ++k) u[k] = (i + k + 0.5) / n;
-    mixture.SampleBatch(u, 32, out);
-    for (int k = 0; k < 32; ++k) ++counts[out[k]];
+  double u[32], inverse_probability[32];
+  int out[32], empty = 0;
+  for (int i = 0; i < draws; i += 32) {
+    for (int k = 0; k < 32; ++k) u[k] = (i + k + 0.5) / draws;
+    mixture.SampleBatch(u, 32, out, inverse_probability);
+    for (int k = 0; k < 32; ++k) {
+      if (out[k] < 0) {
+        ++empty;
+        continue;
+      }
+      ++counts[out[k]];
+      ASSERT_NEAR(1.0 / inverse_probability[k], p[out[k]], 1e-9 * p[out[k]]);
+    }
   }
   for (const int* it = table.near_begin(face); it != table.near_end(face); ++it) {
-    const double p = 1.0 / mixture.InverseProbability(*it);
-    EXPECT_GT(p, NearEdgeMixture::kNearFraction / 64);
-    EXPECT_NEAR(counts[*it], n * p, 2.0) << *it;
+    EXPECT_GT(p[*it], NearEdgeMixture::kNearFraction / 64);
   }
+  // Stratified u: the counts follow the probabilities (5 standard deviations, at least 3 draws).
+  for (int i = 0; i < table.size(); ++i) {
+    const double expected = draws * p[i];
+    EXPECT_NEAR(counts[i], expected, 5.0 * std::sqrt(expected) + 3.0) << i;
+  }
+  const double expected_empty = draws * std::max(0.0, 1.0 - sum);
+  EXPECT_NEAR(empty, expected_empty, 5.0 * std::sqrt(expected_empty) + 3.0);
 }
 
 // The table follows the mesh state: a moved vertex gives a new table with the new positions.

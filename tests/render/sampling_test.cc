@@ -126,6 +126,54 @@ TEST(SamplingTest, ResampledPointIsUnbiased) {
   EXPECT_NEAR(sum / n, reference, 0.01 * reference);
 }
 
+// Systematic picks from one candidate draw (what secondary edges (A) keep several of): the mean
+// of the M picks' estimates is unbiased too, and equal picks are adjacent.
+TEST(SamplingTest, SystematicPicksAreUnbiased) {
+  const Eigen::Vector3d x(0, 0, 0);
+  const std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> segments = {
+      {{1, -1, 0}, {1, 1, 0}}, {{-1, 2, 0}, {-3, 0.5, 0}}, {{0, -2, 0.5}, {0.5, -2, -0.5}}};
+  const DiscreteDistribution table({2.0, 1.0, 0.5});
+  auto ends = [&](int c, Eigen::Vector3d* a, Eigen::Vector3d* b) {
+    *a = segments[c].first;
+    *b = segments[c].second;
+    return c != 1 || a->x() < 0;  // all weighted
+  };
+  auto target = [](const Eigen::Vector3d& omega) { return 1.5 + omega.x() + 0.5 * omega.y(); };
+  // The integrand: the target times a factor the target does not know.
+  auto integrand = [&](const Eigen::Vector3d& omega) { return target(omega) * (1.0 + omega.y()); };
+  double reference = 0.0;
+  for (const auto& [a, b] : segments) {
+    const int steps = 20000;
+    double s, subtended;
+    for (int i = 0; i < steps; ++i) {
+      ASSERT_TRUE(AngleUniformEdgePoint(a, b, x, (i + 0.5) / steps, &s, &subtended));
+      reference += integrand((a + s * (b - a) - x).normalized()) * subtended / steps;
+    }
+  }
+  const int kPicks = 3;
+  double sum = 0.0;
+  const int n = 40000;
+  for (int i = 0; i < n; ++i) {
+    Sampler sampler(11, 0, static_cast<uint64_t>(i), 0);
+    const double u_index = sampler.Next1D(), u_point = sampler.Next1D();
+    const SegmentCandidates candidates =
+        DrawSegmentCandidates(table, 4, x, u_index, u_point, &sampler, ends, target);
+    ASSERT_GT(candidates.num_weighted, 0);
+    const double u = sampler.Next1D();
+    int previous = -1;
+    for (int j = 0; j < kPicks; ++j) {
+      const int entry = candidates.PickEntry((j + u) / kPicks);
+      ASSERT_GE(entry, previous);  // equal picks are adjacent
+      previous = entry;
+      const ResampledPoint kept = candidates.Point(entry);
+      const Eigen::Vector3d& a = segments[kept.index].first;
+      const Eigen::Vector3d& b = segments[kept.index].second;
+      sum += integrand((a + kept.s * (b - a) - x).normalized()) * kept.inv_pdf / kPicks;
+    }
+  }
+  EXPECT_NEAR(sum / n, reference, 0.01 * reference);
+}
+
 }  // namespace
 }  // namespace render_internal
 }  // namespace sft

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <mutex>
 
 #include "src/render/internal/edge_sampling.h"
@@ -40,21 +41,31 @@ MeshEdgeTable::MeshEdgeTable(const RenderScene& scene) {
     edges_.push_back(static_cast<int>(e));
     lengths.push_back(length);
   }
-  const DiscreteDistribution by_length(lengths);
-  if (by_length.empty()) {
-    records_.clear();
-    edges_.clear();
+  if (records_.empty()) {
     near_offsets_.assign(scene.faces().size() + 1, 0);
     return;
   }
-  BuildNearLists(scene);
-  cells_.resize(records_.size());
+  std::vector<Eigen::Vector3f> a(records_.size()), b(records_.size());
+  std::vector<float> float_lengths(records_.size());
   for (size_t i = 0; i < records_.size(); ++i) {
-    const int index = static_cast<int>(i);
-    cells_[i] = {static_cast<float>(by_length.cell(index).probability),
-                 by_length.cell(index).alias};
-    records_[i].inverse_probability = static_cast<float>(by_length.InverseProbability(index));
+    a[i] = records_[i].a;
+    b[i] = records_[i].b;
+    // Clamped into float's range: the tree divides by sums of these.
+    float_lengths[i] = static_cast<float>(std::clamp<double>(
+        lengths[i], std::numeric_limits<float>::min(), std::numeric_limits<float>::max()));
+    records_[i].length = float_lengths[i];
   }
+  tree_ = EdgeTree(a, b, float_lengths);
+  // Records in the tree's order: record i is tree position i.
+  std::vector<Record> records(records_.size());
+  std::vector<int> edges(edges_.size());
+  for (size_t j = 0; j < records.size(); ++j) {
+    records[j] = records_[tree_.order()[j]];
+    edges[j] = edges_[tree_.order()[j]];
+  }
+  records_.swap(records);
+  edges_.swap(edges);
+  BuildNearLists(scene);
 }
 
 void MeshEdgeTable::BuildNearLists(const RenderScene& scene) {

@@ -8,6 +8,7 @@
 #include <memory>
 #include <vector>
 
+#include "src/render/internal/edge_tree.h"
 #include "src/render/internal/sampling.h"
 #include "src/render/scene.h"
 
@@ -15,12 +16,12 @@ namespace sft {
 namespace render_internal {
 
 // The mesh edges where radiance can jump seen from some point — every edge except those between
-// coplanar, consistently oriented faces — with a length-proportional alias table. A secondary
+// coplanar, consistently oriented faces — in the order of an EdgeTree over them. A secondary
 // edge sample draws 16 candidates per path vertex from all of the mesh's edges (75k for a
 // 50k-face mesh: far more than the caches hold), so a candidate reads one cache line instead of
-// the edge, both ends and both face normals scattered over the scene's arrays. The table
-// depends on the mesh state only: MeshEdgeTable::Of returns the last build while
-// scene.state_id() is unchanged.
+// the edge, both ends and both face normals scattered over the scene's arrays, and the tree's
+// order keeps nearby edges in nearby lines. The table depends on the mesh state only:
+// MeshEdgeTable::Of returns the last build while scene.state_id() is unchanged.
 class MeshEdgeTable {
  public:
   // One cache line per edge: what deciding whether a candidate can be a jump seen from x, and
@@ -31,8 +32,8 @@ class MeshEdgeTable {
     Eigen::Vector3f n0, n1;  // the faces' consistently oriented unit normals; both zero for an
                              // edge that is always a jump (boundary, non-manifold, degenerate).
     int f0 = -1, f1 = -1;    // the edge's faces (f1 = −1 for a boundary edge).
-    float inverse_probability = 0.0f;  // 1 / this record's probability.
-    float crease = 0.0f;               // 1 when the neighbours are not coplanar (a crease), else 0.
+    float length = 0.0f;     // |b − a|.
+    float crease = 0.0f;     // 1 when the neighbours are not coplanar (a crease), else 0.
   };
 
   // The table of `scene`'s current mesh state (built on first use, then shared).
@@ -44,23 +45,9 @@ class MeshEdgeTable {
   int size() const { return static_cast<int>(records_.size()); }
   const Record& record(int i) const { return records_[i]; }
   int edge(int i) const { return edges_[i]; }  // index into scene.edges().
-  // Alias-table draws of record indices ∝ edge length for u[0 … n) ∈ [0, 1). The cells are kept
-  // apart from the records (8 bytes each), and all n cells, then all n records, are prefetched
-  // before any is used, so that a vertex's candidates wait for memory together, not in turn.
-  void SampleBatch(const double* u, int n, int* out) const {
-    const int size = static_cast<int>(cells_.size());
-    for (int k = 0; k < n; ++k) {
-      out[k] = std::min(static_cast<int>(u[k] * size), size - 1);
-      __builtin_prefetch(&cells_[out[k]]);
-    }
-    for (int k = 0; k < n; ++k) {
-      const Cell& cell = cells_[out[k]];
-      if (!(u[k] * size - out[k] < cell.keep)) out[k] = cell.alias;
-      Prefetch(out[k]);
-    }
-  }
+  // The hierarchy over the records (record i is tree position i).
+  const EdgeTree& tree() const { return tree_; }
   void Prefetch(int i) const { __builtin_prefetch(&records_[i]); }
-  double InverseProbability(int i) const { return records_[i].inverse_probability; }
 
   // The records of the edges that share a vertex with `face` but are not its own, sorted.
   const int* near_begin(int face) const { return near_records_.data() + near_offsets_[face]; }
@@ -79,63 +66,72 @@ class MeshEdgeTable {
  private:
   void BuildNearLists(const RenderScene& scene);
 
-  struct Cell {
-    float keep = 1.0f;  // probability of keeping index i in cell i, else `alias`.
-    int alias = 0;
-  };
   std::vector<Record> records_;
-  std::vector<Cell> cells_;
+  EdgeTree tree_;
   std::vector<int> edges_;
   std::vector<int> near_offsets_;  // per face (+1), into near_records_.
   std::vector<int> near_records_;
 };
 
-// The candidate proposal of (A) at a path vertex on face `face`: with probability kNearFraction
-// one of the edges around the face (MeshEdgeTable::near_begin/end) uniformly, else the table's
-// length-proportional draw. Edges next to the vertex subtend the largest angles at it, so their
-// weights Θ/p under the length-proportional draw alone are the heaviest (their probability is
-// ~1/#edges whatever their angle); the mixture bounds them. Same interface as
-// DiscreteDistribution for ResampleSegmentPoint.
+// The candidate proposal of (A) at a path vertex x (normal n) on face `face`: with probability
+// kNearFraction one of the edges around the face (MeshEdgeTable::near_begin/end) uniformly, else
+// the EdgeTree's draw ∝ length/distance². Edges next to the vertex subtend the largest angles at
+// it and the tree's clusters around x are coarse, so the ring bounds their weights Θ/p. The
+// interface of DiscreteDistribution for DrawSegmentCandidates: SampleBatch writes each draw's
+// inverse probability under the mixture (index −1: nothing to draw, every edge below x's plane).
 class NearEdgeMixture {
  public:
   static constexpr double kNearFraction = 0.25;
 
-  NearEdgeMixture(const MeshEdgeTable& table, int face)
-      : table_(table), near_begin_(table.near_begin(face)), near_end_(table.near_end(face)) {
+  NearEdgeMixture(const MeshEdgeTable& table, int face, const Eigen::Vector3d& x,
+                  const Eigen::Vector3d& n)
+      : table_(table),
+        x_(x),
+        n_(n),
+        near_begin_(table.near_begin(face)),
+        near_end_(table.near_end(face)) {
     const int count = static_cast<int>(near_end_ - near_begin_);
     near_fraction_ = count > 0 ? kNearFraction : 0.0;
     near_probability_ = near_fraction_ > 0 ? kNearFraction / count : 0.0;
   }
 
-  void SampleBatch(const double* u, int n, int* out) const {
-    double global_u[kMaxResampleCandidates];
-    int global_k[kMaxResampleCandidates];
-    int num_global = 0;
+  void SampleBatch(const double* u, int n, int* out, double* inverse_probability) const {
     const int count = static_cast<int>(near_end_ - near_begin_);
     for (int k = 0; k < n; ++k) {
+      double p = 0.0;
       if (u[k] < near_fraction_) {
         out[k] = near_begin_[std::min(static_cast<int>(u[k] / near_fraction_ * count), count - 1)];
-        table_.Prefetch(out[k]);
+        p = near_probability_ + (1.0 - near_fraction_) * table_.tree().Probability(x_, n_, out[k]);
       } else {
-        global_u[num_global] = (u[k] - near_fraction_) / (1.0 - near_fraction_);
-        global_k[num_global++] = k;
+        double p_tree = 0.0;
+        out[k] =
+            table_.tree().Sample(x_, n_, (u[k] - near_fraction_) / (1.0 - near_fraction_), &p_tree);
+        if (out[k] < 0) {
+          inverse_probability[k] = 0.0;
+          continue;
+        }
+        p = (1.0 - near_fraction_) * p_tree + NearProbability(out[k]);
       }
+      table_.Prefetch(out[k]);
+      inverse_probability[k] = 1.0 / p;
     }
-    int drawn[kMaxResampleCandidates];
-    table_.SampleBatch(global_u, num_global, drawn);
-    for (int i = 0; i < num_global; ++i) out[global_k[i]] = drawn[i];
   }
 
+  // 1 / the probability of record c (tests; the sampler's own draws carry theirs).
   double InverseProbability(int c) const {
-    double p = (1.0 - near_fraction_) / table_.InverseProbability(c);
-    if (near_probability_ > 0.0 && std::binary_search(near_begin_, near_end_, c)) {
-      p += near_probability_;
-    }
-    return 1.0 / p;
+    return 1.0 /
+           ((1.0 - near_fraction_) * table_.tree().Probability(x_, n_, c) + NearProbability(c));
   }
 
  private:
+  double NearProbability(int c) const {
+    return near_probability_ > 0.0 && std::binary_search(near_begin_, near_end_, c)
+               ? near_probability_
+               : 0.0;
+  }
+
   const MeshEdgeTable& table_;
+  const Eigen::Vector3d x_, n_;
   const int* near_begin_;
   const int* near_end_;
   double near_fraction_ = 0.0;

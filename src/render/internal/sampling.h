@@ -30,9 +30,13 @@ class DiscreteDistribution {
   int size() const { return static_cast<int>(cumulative_.size()); }
   double total() const { return total_; }
   double weight(int i) const { return weights_[i]; }
-  // Sample for each of u[0 … n): the interface ResampleSegmentPoint's proposals share.
-  void SampleBatch(const double* u, int n, int* out) const {
-    for (int k = 0; k < n; ++k) out[k] = Sample(u[k]);
+  // Sample for each of u[0 … n), with each draw's inverse probability: the interface
+  // DrawSegmentCandidates' proposals share.
+  void SampleBatch(const double* u, int n, int* out, double* inverse_probability) const {
+    for (int k = 0; k < n; ++k) {
+      out[k] = Sample(u[k]);
+      inverse_probability[k] = InverseProbability(out[k]);
+    }
   }
   // Σw / w_i: the inverse of index i's probability.
   double InverseProbability(int i) const { return total_ / weights_[i]; }
@@ -76,12 +80,13 @@ bool ClipSegment(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Frust
 bool AngleUniformEdgePoint(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                            const Eigen::Vector3d& x, double xi, double* s, double* subtended);
 
-// One (segment, point) pair drawn by resampled importance sampling (Talbot et al. 2005):
-// `num_candidates` segments drawn from `proposal` (any type with `SampleBatch(u, n, out)` and
-// `double InverseProbability(int c)`, e.g. DiscreteDistribution), each with a point uniform in
-// the angle it subtends at x, weighted w_k = p̂_k·Θ_k/p_k with p̂ = `target`(ω_k), one kept ∝ w_k.
-// `ends(c, &a, &b)` gives candidate c's endpoints, or false where it cannot be a jump seen from
-// x (p̂ = 0). The first candidate uses (u_index, u_point), the rest `sampler`.
+// (Segment, point) pairs drawn by resampled importance sampling (Talbot et al. 2005):
+// `num_candidates` segments drawn from `proposal` (any type with `SampleBatch(u, n, out,
+// inverse_probability)`, an index −1 for an empty draw, e.g. DiscreteDistribution, or
+// NearEdgeMixture), each with a point uniform in
+// the angle it subtends at x, weighted w_k = p̂_k·Θ_k/p_k with p̂ = `target`(ω_k); Pick keeps one
+// ∝ w_k. `ends(c, &a, &b)` gives candidate c's endpoints, or false where it cannot be a jump seen
+// from x (p̂ = 0). The first candidate uses (u_index, u_point), the rest `sampler`.
 struct ResampledPoint {
   int index = -1;        // the kept candidate; −1 when none had a positive weight.
   double s = 0.0;        // its point a + s(b − a).
@@ -91,42 +96,82 @@ struct ResampledPoint {
 // At most this many candidates per draw.
 constexpr int kMaxResampleCandidates = 32;
 
+// The weighed candidates of one draw (those of positive weight, in draw order).
+struct SegmentCandidates {
+  int num_drawn = 0;     // K, zero-weight candidates included.
+  int num_weighted = 0;  // entries below.
+  int index[kMaxResampleCandidates];
+  double s[kMaxResampleCandidates];
+  double target[kMaxResampleCandidates];
+  double cumulative[kMaxResampleCandidates];  // Σ_{j≤k} w_j.
+
+  double weight_sum() const { return num_weighted > 0 ? cumulative[num_weighted - 1] : 0.0; }
+
+  // The entry whose cumulative-weight interval holds u·Σw (u ∈ [0, 1)): candidate k with
+  // probability w_k/Σw. Picks at u_j = (j + u)/M, j < M (systematic resampling), are each
+  // candidate k w_k/Σw·M times in expectation, so the mean of their estimates is unbiased too;
+  // equal picks are adjacent in j. Entry −1 when no candidate has a positive weight.
+  int PickEntry(double u) const {
+    if (num_weighted == 0) return -1;
+    const double level = u * weight_sum();
+    int k = 0;
+    while (k + 1 < num_weighted && !(level < cumulative[k])) ++k;
+    return k;
+  }
+  ResampledPoint Point(int entry) const {
+    ResampledPoint out;
+    if (entry < 0) return out;
+    out.index = index[entry];
+    out.s = s[entry];
+    out.inv_pdf = weight_sum() / (target[entry] * num_drawn);
+    return out;
+  }
+};
+
+template <typename Proposal, typename Ends, typename Target>
+SegmentCandidates DrawSegmentCandidates(const Proposal& proposal, int num_candidates,
+                                        const Eigen::Vector3d& x, double u_index, double u_point,
+                                        Sampler* sampler, const Ends& ends, const Target& target) {
+  // All candidates are drawn (and their data prefetched) before any is weighed, so that their
+  // memory loads overlap.
+  SegmentCandidates out;
+  out.num_drawn = std::min(num_candidates, kMaxResampleCandidates);
+  int index[kMaxResampleCandidates];
+  double index_u[kMaxResampleCandidates], point_u[kMaxResampleCandidates];
+  double inverse_probability[kMaxResampleCandidates];
+  for (int k = 0; k < out.num_drawn; ++k) {
+    index_u[k] = k == 0 ? u_index : sampler->Next1D();
+    point_u[k] = k == 0 ? u_point : sampler->Next1D();
+  }
+  proposal.SampleBatch(index_u, out.num_drawn, index, inverse_probability);
+  double w_sum = 0.0;
+  for (int k = 0; k < out.num_drawn; ++k) {
+    const int c = index[k];
+    Eigen::Vector3d a, b;
+    if (c < 0 || !ends(c, &a, &b)) continue;
+    double s_k = 0.0, subtended = 0.0;
+    if (!AngleUniformEdgePoint(a, b, x, point_u[k], &s_k, &subtended)) continue;
+    const double p_hat = target((a + s_k * (b - a) - x).normalized());
+    const double w = p_hat * subtended * inverse_probability[k];
+    if (!(w > 0.0) || !std::isfinite(w)) continue;
+    w_sum += w;
+    const int e = out.num_weighted++;
+    out.index[e] = c;
+    out.s[e] = s_k;
+    out.target[e] = p_hat;
+    out.cumulative[e] = w_sum;
+  }
+  return out;
+}
+
+// One kept pair: DrawSegmentCandidates, then a pick with the sampler's next number.
 template <typename Proposal, typename Ends, typename Target>
 ResampledPoint ResampleSegmentPoint(const Proposal& proposal, int num_candidates,
                                     const Eigen::Vector3d& x, double u_index, double u_point,
                                     Sampler* sampler, const Ends& ends, const Target& target) {
-  // All candidates are drawn (and their data prefetched) before any is weighed, so that their
-  // memory loads overlap; the random numbers are consumed in the same order either way.
-  int index[kMaxResampleCandidates];
-  double point_u[kMaxResampleCandidates], pick_u[kMaxResampleCandidates];
-  num_candidates = std::min(num_candidates, kMaxResampleCandidates);
-  double index_u[kMaxResampleCandidates];
-  for (int k = 0; k < num_candidates; ++k) {
-    index_u[k] = k == 0 ? u_index : sampler->Next1D();
-    point_u[k] = k == 0 ? u_point : sampler->Next1D();
-    pick_u[k] = sampler->Next1D();
-  }
-  proposal.SampleBatch(index_u, num_candidates, index);
-  ResampledPoint out;
-  double w_sum = 0.0, kept_target = 0.0;
-  for (int k = 0; k < num_candidates; ++k) {
-    const int c = index[k];
-    Eigen::Vector3d a, b;
-    if (!ends(c, &a, &b)) continue;
-    double s_k = 0.0, subtended = 0.0;
-    if (!AngleUniformEdgePoint(a, b, x, point_u[k], &s_k, &subtended)) continue;
-    const double p_hat = target((a + s_k * (b - a) - x).normalized());
-    const double w = p_hat * subtended * proposal.InverseProbability(c);
-    if (!(w > 0.0) || !std::isfinite(w)) continue;
-    w_sum += w;
-    if (pick_u[k] * w_sum < w) {
-      out.index = c;
-      out.s = s_k;
-      kept_target = p_hat;
-    }
-  }
-  if (out.index >= 0) out.inv_pdf = w_sum / (kept_target * num_candidates);
-  return out;
+  const SegmentCandidates candidates =
+      DrawSegmentCandidates(proposal, num_candidates, x, u_index, u_point, sampler, ends, target);
+  return candidates.Point(candidates.PickEntry(sampler->Next1D()));
 }
 
 }  // namespace render_internal

@@ -20,7 +20,10 @@ constexpr uint64_t kSecondaryEdgeKey = 0x5EC0DE0000000000ull;
 constexpr double kHiddenMargin = 1e-3;
 // (Edge, point) pairs drawn per secondary sample before one is kept (resampled importance
 // sampling); see docs/design-notes.md for the measured choice.
-constexpr int kSecondaryCandidates = 16;
+constexpr int kSecondaryCandidates = 4;
+// (A)'s points kept per candidate draw (systematic resampling); see docs/design-notes.md.
+constexpr int kSecondaryKeptPoints = 4;
+constexpr uint64_t kKeptPointKey = 64;  // side paths of kept point k: Fork(kKeptPointKey + k).
 // Probability that a secondary sample also samples a texel boundary (C) (weighted by its
 // inverse): (C) traces two paths where it is seen, and the indirect light's texel jumps are
 // usually a small part of the derivative (docs/design-notes.md).
@@ -148,34 +151,12 @@ bool TwoSidedJump(const SecondaryVertex& v, const SphereCurvePoint& point, const
   return !jump->isZero();
 }
 
-// (A) Silhouettes (and creases) of mesh edges seen from x. The (edge, point) pair is chosen by
-// resampled importance sampling (Talbot et al. 2005): kSecondaryCandidates pairs are drawn, the
-// edge from NearEdgeMixture (pdf p_k) and the point uniformly in the angle Θ_k the edge subtends at
-// x (not uniformly in s: the sphere arc length |dω/ds| ds is then Θ_k·dξ, where uniform s would
-// weight points near x by 1/r — infinite variance for edges touching x's face). Each pair gets the
-// target p̂_k = Σ_rgb f·(n·ω_k) at its direction where the edge can be a jump seen from x
-// (silhouette or crease test) and 0 elsewhere, the weight w_k = p̂_k·Θ_k/p_k, and one is kept
-// ∝ w_k. The estimate g_jump·Θ/(p̂·Θ)·(1/K)Σ_k w_k is unbiased because p̂ > 0 wherever the
-// integrand g = f·(n·ω)·L can be non-zero. The BSDF factor in p̂ matters for glossy lobes:
-// without it, the few points that land in a narrow lobe carry heavy-tailed weights.
-void SampleMeshEdge(const SecondaryVertex& v, double u_index, double u_point, Sampler* sampler,
-                    PathDerivatives* path, RenderStats* stats) {
-  const MeshEdgeTable& table = *v.ctx.secondary->mesh_edges;
+// (A)'s estimate at one kept (edge, point) pair, times `scale`: "two sides, two rays, two
+// paths, jump" at the point, credited to the edge's ends and to x.
+void AddMeshEdgePoint(const SecondaryVertex& v, const ResampledPoint& kept, double scale,
+                      const Sampler& sampler, PathDerivatives* path, RenderStats* stats) {
   const RenderScene& scene = v.ctx.scene;
-  if (table.empty()) return;
-  auto edge_ends = [&](int c, Eigen::Vector3d* a, Eigen::Vector3d* b) {
-    const MeshEdgeTable::Record& r = table.record(c);
-    if (r.f0 == v.face || r.f1 == v.face) return false;
-    *a = r.a.cast<double>();
-    *b = r.b.cast<double>();
-    if (!(std::max(v.n.dot(*a - v.x), v.n.dot(*b - v.x)) > 0.0)) return false;
-    return table.IsDiscontinuity(c, v.x, /*creases=*/v.indirect);
-  };
-  const ResampledPoint kept = ResampleSegmentPoint(
-      NearEdgeMixture(table, v.face), kSecondaryCandidates, v.x, u_index, u_point, sampler,
-      edge_ends, [&](const Eigen::Vector3d& omega) { return v.BsdfCosine(omega); });
-  if (kept.index < 0) return;
-  const MeshEdge& edge = scene.edges()[table.edge(kept.index)];
+  const MeshEdge& edge = scene.edges()[v.ctx.secondary->mesh_edges->edge(kept.index)];
   const Eigen::Vector3d& a = scene.positions()[edge.v0];
   const Eigen::Vector3d& b = scene.positions()[edge.v1];
   const Eigen::Vector3d y = a + kept.s * (b - a);
@@ -196,13 +177,59 @@ void SampleMeshEdge(const SecondaryVertex& v, double u_index, double u_point, Sa
            hit.t < (1.0 - kHiddenMargin) * point.r;
   };
   Eigen::Vector3d jump;
-  if (!TwoSidedJump(v, point, *sampler, hidden, accept, stats, &jump)) return;
-  const double inv_pdf = kept.inv_pdf / v.num_samples;
+  if (!TwoSidedJump(v, point, sampler, hidden, accept, stats, &jump)) return;
+  const double inv_pdf = kept.inv_pdf * scale / v.num_samples;
   const Eigen::Vector3d m_row = point.m / point.r;  // m·∂ω/∂y.
   BoundaryRows rows;
   AddEdgePointRows(scene, edge, kept.s, m_row, &rows);
   path->AddBoundary(v.throughput.cwiseProduct(jump) * inv_pdf, rows.vertices, rows.rows, rows.count,
                     -m_row);
+}
+
+// (A) Silhouettes (and creases) of mesh edges seen from x. (Edge, point) pairs are chosen by
+// resampled importance sampling (Talbot et al. 2005): kSecondaryCandidates pairs are drawn, the
+// edge from NearEdgeMixture (pdf p_k) and the point uniformly in the angle Θ_k the edge subtends at
+// x (not uniformly in s: the sphere arc length |dω/ds| ds is then Θ_k·dξ, where uniform s would
+// weight points near x by 1/r — infinite variance for edges touching x's face). Each pair gets the
+// target p̂_k = Σ_rgb f·(n·ω_k) at its direction where the edge can be a jump seen from x
+// (silhouette or crease test) and 0 elsewhere, the weight w_k = p̂_k·Θ_k/p_k, and
+// kSecondaryKeptPoints are kept ∝ w_k by systematic resampling, each estimate weighted by 1/M.
+// The estimate g_jump·Θ/(p̂·Θ)·(1/K)Σ_k w_k is unbiased because p̂ > 0 wherever the integrand
+// g = f·(n·ω)·L can be non-zero. The BSDF factor in p̂ matters for glossy lobes: without it, the
+// few points that land in a narrow lobe carry heavy-tailed weights. Several kept points share
+// one candidate draw: most kept points are hidden from x (the target does not know visibility),
+// and a hidden one costs one ray, where the draw costs 16 scattered table reads.
+void SampleMeshEdge(const SecondaryVertex& v, double u_index, double u_point, Sampler* sampler,
+                    PathDerivatives* path, RenderStats* stats) {
+  const MeshEdgeTable& table = *v.ctx.secondary->mesh_edges;
+  if (table.empty()) return;
+  auto edge_ends = [&](int c, Eigen::Vector3d* a, Eigen::Vector3d* b) {
+    const MeshEdgeTable::Record& r = table.record(c);
+    if (r.f0 == v.face || r.f1 == v.face) return false;
+    *a = r.a.cast<double>();
+    *b = r.b.cast<double>();
+    if (!(std::max(v.n.dot(*a - v.x), v.n.dot(*b - v.x)) > 0.0)) return false;
+    return table.IsDiscontinuity(c, v.x, /*creases=*/v.indirect);
+  };
+  const SegmentCandidates candidates = DrawSegmentCandidates(
+      NearEdgeMixture(table, v.face, v.x, v.n), kSecondaryCandidates, v.x, u_index, u_point,
+      sampler, edge_ends, [&](const Eigen::Vector3d& omega) { return v.BsdfCosine(omega); });
+  if (candidates.num_weighted == 0) return;
+  const double u_pick = sampler->Next1D();
+  // Equal picks are adjacent: each distinct one is evaluated once, weighted by its count.
+  int entry = candidates.PickEntry(u_pick / kSecondaryKeptPoints), count = 1;
+  for (int j = 1; j <= kSecondaryKeptPoints; ++j) {
+    const int next =
+        j < kSecondaryKeptPoints ? candidates.PickEntry((j + u_pick) / kSecondaryKeptPoints) : -2;
+    if (next == entry) {
+      ++count;
+      continue;
+    }
+    AddMeshEdgePoint(v, candidates.Point(entry), static_cast<double>(count) / kSecondaryKeptPoints,
+                     sampler->Fork(kKeptPointKey + entry), path, stats);
+    entry = next;
+    count = 1;
+  }
 }
 
 // (C) Texel boundaries on the surfaces a further bounce sees: L_in jumps where the material of
