@@ -17,10 +17,10 @@ namespace render_internal {
 
 // The mesh edges where radiance can jump seen from some point — every edge except those between
 // coplanar, consistently oriented faces — in the order of an EdgeTree over them. A secondary
-// edge sample draws 16 candidates per path vertex from all of the mesh's edges (75k for a
-// 50k-face mesh: far more than the caches hold), so a candidate reads one cache line instead of
-// the edge, both ends and both face normals scattered over the scene's arrays, and the tree's
-// order keeps nearby edges in nearby lines. The table depends on the mesh state only:
+// edge sample draws its candidates from all of the mesh's edges (75k for a 50k-face mesh: far
+// more than the caches hold), so a candidate reads one cache line instead of the edge, both
+// ends and both face normals scattered over the scene's arrays, and the tree's order keeps
+// nearby edges in nearby lines. The table depends on the mesh state only:
 // MeshEdgeTable::Of returns the last build while scene.state_id() is unchanged.
 class MeshEdgeTable {
  public:

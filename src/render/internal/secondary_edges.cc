@@ -18,11 +18,13 @@ constexpr uint64_t kSecondaryEdgeKey = 0x5EC0DE0000000000ull;
 // A hit closer than (1 − this)·r hides a curve point at distance r (faces through the point
 // itself are hit at r up to float rounding).
 constexpr double kHiddenMargin = 1e-3;
-// (Edge, point) pairs drawn per secondary sample before one is kept (resampled importance
-// sampling); see docs/design-notes.md for the measured choice.
+// (A): (edge, point) candidates drawn per secondary sample, and the points kept from them by
+// systematic resampling; see docs/design-notes.md for the measured choice.
 constexpr int kSecondaryCandidates = 4;
-// (A)'s points kept per candidate draw (systematic resampling); see docs/design-notes.md.
 constexpr int kSecondaryKeptPoints = 4;
+// (C): (texel segment, point) candidates drawn before one is kept (its proposal knows no
+// distance, so it needs more than (A)).
+constexpr int kTexelCandidates = 16;
 constexpr uint64_t kKeptPointKey = 64;  // side paths of kept point k: Fork(kKeptPointKey + k).
 // Probability that a secondary sample also samples a texel boundary (C) (weighted by its
 // inverse): (C) traces two paths where it is seen, and the indirect light's texel jumps are
@@ -197,8 +199,8 @@ void AddMeshEdgePoint(const SecondaryVertex& v, const ResampledPoint& kept, doub
 // The estimate g_jump·Θ/(p̂·Θ)·(1/K)Σ_k w_k is unbiased because p̂ > 0 wherever the integrand
 // g = f·(n·ω)·L can be non-zero. The BSDF factor in p̂ matters for glossy lobes: without it, the
 // few points that land in a narrow lobe carry heavy-tailed weights. Several kept points share
-// one candidate draw: most kept points are hidden from x (the target does not know visibility),
-// and a hidden one costs one ray, where the draw costs 16 scattered table reads.
+// one candidate draw: about three in four kept points are hidden from x (the target does not
+// know visibility), and a hidden one costs one ray, less than a draw's tree descents.
 void SampleMeshEdge(const SecondaryVertex& v, double u_index, double u_point, Sampler* sampler,
                     PathDerivatives* path, RenderStats* stats) {
   const MeshEdgeTable& table = *v.ctx.secondary->mesh_edges;
@@ -233,7 +235,7 @@ void SampleMeshEdge(const SecondaryVertex& v, double u_index, double u_point, Sa
 }
 
 // (C) Texel boundaries on the surfaces a further bounce sees: L_in jumps where the material of
-// the surface hit along ω does. Sampled like (A): kSecondaryCandidates (segment, point) pairs,
+// the surface hit along ω does. Sampled like (A): kTexelCandidates (segment, point) pairs,
 // the segment ∝ 3D length × material jump, the point uniform in its subtended angle, one kept by
 // resampling with target f·(n·ω); the jump counts only where the two side rays see the
 // segment's faces (one each; both the same face for a grid line inside a face).
@@ -249,7 +251,7 @@ void SampleTexelBoundary(const SecondaryVertex& v, Sampler* texel_sampler, PathD
   };
   const double u_index = texel_sampler->Next1D(), u_point = texel_sampler->Next1D();
   const ResampledPoint kept = ResampleSegmentPoint(
-      secondary.texels_by_weight, kSecondaryCandidates, v.x, u_index, u_point, texel_sampler,
+      secondary.texels_by_weight, kTexelCandidates, v.x, u_index, u_point, texel_sampler,
       texel_ends, [&](const Eigen::Vector3d& omega) { return v.BsdfCosine(omega); });
   if (kept.index < 0) return;
   const TexelSegment& segment = secondary.texels[kept.index];

@@ -14,9 +14,10 @@
 // Boundary term: ∂H/∂θ += ∫_curve (g(ω⁻) − g(ω⁺))·(m·∂ω/∂θ) dl, g = f·(n·ω)·L_in, m the unit
 // normal of the curve on the sphere and ω± = normalize(ω ± εm). For a curve point y seen from x,
 // ω = (y − x)/r and m·∂ω/∂θ = mᵀ(∂y/∂θ − ∂x/∂θ)/r; dl = |dω/ds| ds along the curve parameter s.
-// Estimator per sample: (A) an edge chosen by resampling among candidates drawn from a mixture
-// of the edges around x's face and all edges ∝ length (NearEdgeMixture), a point uniform in the
-// angle it subtends at x; (B) a light uniformly, a
+// Estimator per sample: (A) edges chosen by resampling among candidates drawn from a mixture
+// of the edges around x's face and an edge hierarchy's draw ∝ length·cosine/distance²
+// (NearEdgeMixture, EdgeTree), a point uniform in the angle each subtends at x, several kept
+// from one draw; (B) a light uniformly, a
 // pool entry chosen by resampling with target f·(n·ω)·|dω/ds|/p; weight (g⁻ − g⁺)·(arc
 // length)/pdf, times the path throughput, credited to the path's pixel. Both sides trace with the
 // same random numbers. Other radiance leaving the next vertex is continuous along ω (its own
