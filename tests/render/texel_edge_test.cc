@@ -222,8 +222,11 @@ TEST(TexelEdgeTest, GlossyRoughnessCheckerboard) {
 // step), so h is long (0.1; the irradiance is smooth in the boundary's position) and the samples
 // many. Block error with the term sampled at every secondary sample: 4.8%, 5.0%, 5.6%, 5.0% for
 // seeds 0–3 at 2048 spp; 4.1% at 4096 and 3.4% at 8192 spp (seed 0); at h = 0.05: 13% (1024 spp),
-// 5.3% (4096); at a quarter of them (the default, kSecondaryTexelProbability) 5.2% at 2048 spp.
-// Hence 8% at 2048 spp (~7 s on 2 cores), above the 5% because of that noise.
+// 5.3% (4096); at a quarter of them (the default, kSecondaryTexelProbability) 6.0%–8.3% over
+// seeds 0–4 at 2048 spp (one seed had given 5.2% before the random streams of the secondary
+// samples changed; no other term contributes here: the moving vertices carry no mesh edge),
+// and 7.0% at 4096, 3.7% at 8192 spp (seed 0). Hence 10% at 2048 spp (~7 s on 2 cores), above
+// the 5% because of that noise.
 TEST(TexelEdgeTest, BoundarySeenThroughABounce) {
   PlaneScene s = MakePlane();
   s.delta.clear();
@@ -270,7 +273,7 @@ TEST(TexelEdgeTest, BoundarySeenThroughABounce) {
               c.without, c.fd_norm);
   EXPECT_GT(c.fd_norm, 0.0);
   EXPECT_GT(c.without, 0.9);
-  EXPECT_LT(c.with, 0.08);
+  EXPECT_LT(c.with, 0.10);
 }
 
 TEST(TexelEdgeTest, NoJumpsNoSamples) {
