@@ -6,6 +6,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
+#include <opencv2/videoio/registry.hpp>
 
 #include "src/core/file_util.h"
 #include "src/core/progress.h"
@@ -49,13 +50,19 @@ FrameScore ScoreFrame(const cv::Mat& frame, int index) {
 
 namespace {
 
-// Opens `video` with OpenCV's FFmpeg backend (then any other), with OpenCV's own log silenced so
-// that a file it cannot decode gives only our one error line.
+// Opens `video` with OpenCV's FFmpeg backend, then the other backends that read files, with
+// OpenCV's own log silenced so that a file it cannot decode gives only our one error line. Not
+// libgphoto2: given a path it enumerates the USB cameras attached (loading its ~60 camera
+// driver modules), which a video file never needs.
 bool OpenVideo(const std::string& video, cv::VideoCapture* capture) {
   const auto level = cv::utils::logging::getLogLevel();
   cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_SILENT);
   bool opened = capture->open(video, cv::CAP_FFMPEG) && capture->isOpened();
-  if (!opened) opened = capture->open(video, cv::CAP_ANY) && capture->isOpened();
+  for (const cv::VideoCaptureAPIs api : cv::videoio_registry::getStreamBackends()) {
+    if (opened) break;
+    if (api == cv::CAP_FFMPEG || api == cv::CAP_GPHOTO2) continue;
+    opened = capture->open(video, api) && capture->isOpened();
+  }
   cv::utils::logging::setLogLevel(level);
   return opened;
 }

@@ -107,8 +107,9 @@ Status ReconstructionProblem::Build(RenderCache* cache, SceneParameters* params,
   std::vector<std::vector<PixelBlocks>> supersets;
   if (image_term) CollectSupersets(cache, *params, options.superset_renders, &supersets);
 
+  // The problem owns every cost function: the pixel costs below and the regularizers that
+  // SolverHooks::add_regularizers adds later.
   ceres::Problem::Options problem_options;
-  problem_options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   problem_options.evaluation_callback = cache;
   result->problem_ = std::make_unique<ceres::Problem>(problem_options);
   ceres::Problem* problem = result->problem_.get();
@@ -145,11 +146,10 @@ Status ReconstructionProblem::Build(RenderCache* cache, SceneParameters* params,
             }
           }
         }
-        auto cost = std::make_unique<PyramidPixelCost>(&cache->level(v, l), cache->finite(),
-                                                       static_cast<int>(p), offsets, sizes);
-        problem->AddResidualBlock(cost.get(), nullptr, blocks);
-        result->residuals_.push_back({v, l, static_cast<int>(p), cost.get()});
-        result->costs_.push_back(std::move(cost));
+        auto* cost = new PyramidPixelCost(&cache->level(v, l), cache->finite(), static_cast<int>(p),
+                                          offsets, sizes);
+        problem->AddResidualBlock(cost, nullptr, blocks);
+        result->residuals_.push_back({v, l, static_cast<int>(p), cost});
         std::vector<int>().swap(offsets);
       }
     }

@@ -54,10 +54,9 @@ class ReconstructionProblem {
  private:
   struct Residual {
     int view, level, pixel;
-    const PyramidPixelCost* cost;
+    const PyramidPixelCost* cost;  // owned by problem_.
   };
   std::unique_ptr<ceres::Problem> problem_;
-  std::vector<std::unique_ptr<ceres::CostFunction>> costs_;
   std::vector<Residual> residuals_;
   ProblemStats stats_;
 };
