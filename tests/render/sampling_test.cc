@@ -87,6 +87,22 @@ TEST(SamplingTest, AngleUniformEdgePointSplitsTheSubtendedAngle) {
   EXPECT_FALSE(AngleUniformEdgePoint(a, b, Eigen::Vector3d(1, 5, 0), 0.5, &s, &subtended));
 }
 
+// Σ_segments ∫ f(ω) dθ over the angle each segment subtends at x (midpoint rule).
+template <typename F>
+double AngleIntegral(const std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>>& segments,
+                     const Eigen::Vector3d& x, const F& f) {
+  double integral = 0.0;
+  for (const auto& [a, b] : segments) {
+    const int steps = 20000;
+    double s, subtended;
+    for (int i = 0; i < steps; ++i) {
+      EXPECT_TRUE(AngleUniformEdgePoint(a, b, x, (i + 0.5) / steps, &s, &subtended));
+      integral += f((a + s * (b - a) - x).normalized()) * subtended / steps;
+    }
+  }
+  return integral;
+}
+
 // E[target(ω_kept)·inv_pdf] = Σ_segments ∫ target dθ (angle at x), the resampling estimator's
 // defining property (its weight makes it unbiased for any integrand that is zero where the target
 // is, here the target itself).
@@ -101,16 +117,7 @@ TEST(SamplingTest, ResampledPointIsUnbiased) {
     return true;
   };
   auto target = [](const Eigen::Vector3d& omega) { return 1.5 + omega.x() + 0.5 * omega.y(); };
-  // Reference: midpoint rule in the angle along each segment.
-  double reference = 0.0;
-  for (const auto& [a, b] : segments) {
-    const int steps = 20000;
-    double s, subtended;
-    for (int i = 0; i < steps; ++i) {
-      ASSERT_TRUE(AngleUniformEdgePoint(a, b, x, (i + 0.5) / steps, &s, &subtended));
-      reference += target((a + s * (b - a) - x).normalized()) * subtended / steps;
-    }
-  }
+  const double reference = AngleIntegral(segments, x, target);
   double sum = 0.0;
   const int n = 40000;
   for (int i = 0; i < n; ++i) {
@@ -141,15 +148,7 @@ TEST(SamplingTest, SystematicPicksAreUnbiased) {
   auto target = [](const Eigen::Vector3d& omega) { return 1.5 + omega.x() + 0.5 * omega.y(); };
   // The integrand: the target times a factor the target does not know.
   auto integrand = [&](const Eigen::Vector3d& omega) { return target(omega) * (1.0 + omega.y()); };
-  double reference = 0.0;
-  for (const auto& [a, b] : segments) {
-    const int steps = 20000;
-    double s, subtended;
-    for (int i = 0; i < steps; ++i) {
-      ASSERT_TRUE(AngleUniformEdgePoint(a, b, x, (i + 0.5) / steps, &s, &subtended));
-      reference += integrand((a + s * (b - a) - x).normalized()) * subtended / steps;
-    }
-  }
+  const double reference = AngleIntegral(segments, x, integrand);
   const int kPicks = 3;
   double sum = 0.0;
   const int n = 40000;

@@ -88,6 +88,21 @@ int EdgeTree::Build(const std::vector<Eigen::Vector3f>& a, const std::vector<Eig
   return index;
 }
 
+double EdgeTree::LeftProbability(int node, const Eigen::Vector3f& x,
+                                 const Eigen::Vector3f& n) const {
+  const double i_left = Importance(nodes_[node + 1], x, n);
+  const double i_right = Importance(nodes_[nodes_[node].right], x, n);
+  const double total = i_left + i_right;
+  if (!(total > 0.0) || !std::isfinite(total)) return -1.0;
+  return i_left / total;
+}
+
+double EdgeTree::LeafLength(const Node& leaf) const {
+  double sum = 0.0;
+  for (int j = leaf.begin; j < leaf.end; ++j) sum += lengths_[j];
+  return sum;
+}
+
 int EdgeTree::Sample(const Eigen::Vector3d& x_in, const Eigen::Vector3d& n_in, double u,
                      double* probability) const {
   *probability = 0.0;
@@ -97,11 +112,8 @@ int EdgeTree::Sample(const Eigen::Vector3d& x_in, const Eigen::Vector3d& n_in, d
   int node = 0;
   while (nodes_[node].right >= 0) {
     const int left = node + 1, right = nodes_[node].right;
-    const double i_left = Importance(nodes_[left], x, n);
-    const double i_right = Importance(nodes_[right], x, n);
-    const double total = i_left + i_right;
-    if (!(total > 0.0) || !std::isfinite(total)) return -1;
-    const double p_left = i_left / total;
+    const double p_left = LeftProbability(node, x, n);
+    if (p_left < 0.0) return -1;
     if (u < p_left) {
       u /= p_left;
       p *= p_left;
@@ -114,8 +126,7 @@ int EdgeTree::Sample(const Eigen::Vector3d& x_in, const Eigen::Vector3d& n_in, d
     u = std::min(u, kOneMinus);
   }
   const Node& leaf = nodes_[node];
-  double sum = 0.0;
-  for (int j = leaf.begin; j < leaf.end; ++j) sum += lengths_[j];
+  const double sum = LeafLength(leaf);
   const double level = u * sum;
   double cumulative = 0.0;
   int j = leaf.begin;
@@ -135,11 +146,8 @@ double EdgeTree::Probability(const Eigen::Vector3d& x_in, const Eigen::Vector3d&
   int node = 0;
   while (nodes_[node].right >= 0) {
     const int left = node + 1, right = nodes_[node].right;
-    const double i_left = Importance(nodes_[left], x, n);
-    const double i_right = Importance(nodes_[right], x, n);
-    const double total = i_left + i_right;
-    if (!(total > 0.0) || !std::isfinite(total)) return 0.0;
-    const double p_left = i_left / total;
+    const double p_left = LeftProbability(node, x, n);
+    if (p_left < 0.0) return 0.0;
     if (position < nodes_[left].end) {
       p *= p_left;
       node = left;
@@ -148,10 +156,7 @@ double EdgeTree::Probability(const Eigen::Vector3d& x_in, const Eigen::Vector3d&
       node = right;
     }
   }
-  const Node& leaf = nodes_[node];
-  double sum = 0.0;
-  for (int j = leaf.begin; j < leaf.end; ++j) sum += lengths_[j];
-  return p * lengths_[position] / sum;
+  return p * lengths_[position] / LeafLength(nodes_[node]);
 }
 
 }  // namespace render_internal

@@ -52,6 +52,11 @@ class EdgeTree {
   int Build(const std::vector<Eigen::Vector3f>& a, const std::vector<Eigen::Vector3f>& b,
             const std::vector<Eigen::Vector3f>& mid, int begin, int end);
   double Importance(const Node& node, const Eigen::Vector3f& x, const Eigen::Vector3f& n) const;
+  // The probability of descending from internal node `node` to its first child; −1 when both
+  // children are wholly below x's plane (the draw ends empty).
+  double LeftProbability(int node, const Eigen::Vector3f& x, const Eigen::Vector3f& n) const;
+  // Σ lengths of a leaf's segments, in position order (Sample and Probability sum alike).
+  double LeafLength(const Node& leaf) const;
 
   std::vector<Node> nodes_;     // depth-first: node 0 is the root.
   std::vector<int> order_;      // tree position → input index.
