@@ -144,7 +144,9 @@ Status Reconstruction::RunOuter(int outer,
   if (options_.phases != PhaseSchedule::kTexture) phases.push_back({"geometry", GeometryPhase()});
   bool stop = false;
   for (size_t k = 0; k < phases.size() && !stop; ++k) {
-    const auto& [name, active] = phases[k];
+    // Named references, not a structured binding: C++17 lambdas cannot capture bindings (clang).
+    const std::string& name = phases[k].first;
+    const ActiveParameters& active = phases[k].second;
     cache_->SetActive(active);
     cache_->SetSeed(options_.seed * 7919ull + 2ull * static_cast<uint64_t>(outer) + k);
     const TriMesh rest = Mesh();

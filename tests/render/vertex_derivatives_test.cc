@@ -262,7 +262,9 @@ TEST(VertexDerivativesTest, SilhouetteAgainstBackgroundMatchesExactAreaDerivativ
   }
   const std::vector<std::pair<const char*, std::vector<double>>> fields = {
       {"scaling", scaling}, {"smooth", SmoothDisplacementField(sphere.positions, 3)}};
-  for (const auto& [name, delta] : fields) {
+  for (const auto& field : fields) {
+    const char* name = field.first;
+    const std::vector<double>& delta = field.second;  // a lambda cannot capture a binding.
     auto area = [&](double t) {
       std::vector<Eigen::Vector3d> p = sphere.positions;
       for (size_t v = 0; v < p.size(); ++v) {
