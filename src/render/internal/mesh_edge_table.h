@@ -75,9 +75,9 @@ class MeshEdgeTable {
 
 // The candidate proposal of (A) at a path vertex x (normal n) on face `face`: with probability
 // kNearFraction one of the edges around the face (MeshEdgeTable::near_begin/end) uniformly, else
-// the EdgeTree's draw ∝ length/distance². Edges next to the vertex subtend the largest angles at
-// it and the tree's clusters around x are coarse, so the ring bounds their weights Θ/p. The
-// interface of DiscreteDistribution for DrawSegmentCandidates: SampleBatch writes each draw's
+// the EdgeTree's draw ∝ length·cosine/distance². Edges next to the vertex subtend the largest
+// angles at it and the tree's clusters around x are coarse, so the ring bounds their weights Θ/p.
+// The interface of DiscreteDistribution for DrawSegmentCandidates: SampleBatch writes each draw's
 // inverse probability under the mixture (index −1: nothing to draw, every edge below x's plane).
 class NearEdgeMixture {
  public:

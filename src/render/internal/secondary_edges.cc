@@ -25,7 +25,8 @@ constexpr int kSecondaryKeptPoints = 4;
 // (C): (texel segment, point) candidates drawn before one is kept (its proposal knows no
 // distance, so it needs more than (A)).
 constexpr int kTexelCandidates = 16;
-constexpr uint64_t kKeptPointKey = 64;  // side paths of kept point k: Fork(kKeptPointKey + k).
+// Side paths of the kept point at candidate entry e: Fork(kKeptPointKey + e).
+constexpr uint64_t kKeptPointKey = 64;
 // Probability that a secondary sample also samples a texel boundary (C) (weighted by its
 // inverse): (C) traces two paths where it is seen, and the indirect light's texel jumps are
 // usually a small part of the derivative (docs/design-notes.md).
