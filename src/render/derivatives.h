@@ -129,10 +129,11 @@ struct DerivativeRequest {
   // Secondary edges (Li et al. 2018 §5: visibility seen from path vertices): edge samples per
   // path vertex whose hemisphere integral has jumps — occlusion of the environment light (with
   // shadows), silhouettes and creases of what an indirect bounce sees, and point-light shadow
-  // boundaries seen through a bounce. Each sample picks one mesh edge point (resampled among 16
-  // candidates by BSDF·cosine × subtended angle) and, with point lights, one shadow-casting edge
-  // point; most are rejected by cheap tests. Expected samples per vertex (a fraction r − ⌊r⌋ is
-  // one more sample with that probability), range [0, 16]; 0 turns them off.
+  // boundaries seen through a bounce. Each sample draws a few (edge, point) candidates from an
+  // edge hierarchy, keeps a few points by resampling on BSDF·cosine × subtended angle and, with
+  // point lights, one shadow-casting edge point; most are rejected by cheap tests. Expected samples
+  // per vertex (a fraction r − ⌊r⌋ is one more sample with that probability), range [0, 16]; 0
+  // turns them off.
   double secondary_edge_samples = 1.0;
   // Texel-boundary samples = ratio × spp × pixels, each tracing two camera rays and, when both
   // see the boundary's face, two paths. Only boundaries whose two texels differ visibly are
