@@ -27,11 +27,14 @@ Scene MakeScene(const Eigen::Matrix3d& rotation, const Eigen::Vector3d& shift) {
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   std::normal_distribution<double> noise(0.0, 0.002);
   while (scene.floor.size() < 1500) {
-    const Eigen::Vector3d p(2.5 * u(rng), 2.5 * u(rng), noise(rng));
+    // One draw per statement (a constructor's arguments have no defined evaluation order).
+    const double x = 2.5 * u(rng);
+    const double y = 2.5 * u(rng);
+    const Eigen::Vector3d p(x, y, noise(rng));
     if (p.head<2>().norm() > 0.35) scene.floor.push_back(rotation * p + shift);
   }
   while (scene.ball.size() < 400) {
-    const Eigen::Vector3d d(u(rng), u(rng), u(rng));
+    const Eigen::Vector3d d = Eigen::Vector3d::NullaryExpr([&](Eigen::Index) { return u(rng); });
     if (d.norm() < 0.2 || d.norm() > 1) continue;
     scene.ball.push_back(rotation * (Eigen::Vector3d(0, 0, 0.3) + 0.3 * d.normalized()) + shift);
   }

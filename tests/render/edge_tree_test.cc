@@ -28,8 +28,10 @@ Segments RandomSegments(int count, float scale, uint32_t seed) {
   std::uniform_real_distribution<float> unit(0.0f, 1.0f);
   Segments s;
   for (int i = 0; i < count; ++i) {
-    const Eigen::Vector3f p(unit(rng), unit(rng), unit(rng));
-    const Eigen::Vector3f d(unit(rng) - 0.5f, unit(rng) - 0.5f, unit(rng) - 0.5f);
+    // Coefficients drawn in order (a constructor's arguments have no defined evaluation order).
+    const Eigen::Vector3f p = Eigen::Vector3f::NullaryExpr([&](Eigen::Index) { return unit(rng); });
+    const Eigen::Vector3f d =
+        Eigen::Vector3f::NullaryExpr([&](Eigen::Index) { return unit(rng) - 0.5f; });
     s.Add(scale * p, scale * (p + 0.4f * d));
   }
   return s;

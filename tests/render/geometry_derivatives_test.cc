@@ -30,7 +30,10 @@ Eigen::Vector3d UnitNormal(const Eigen::Vector3d& p0, const Eigen::Vector3d& p1,
 TEST(NormalChainTest, MatchesFiniteDifferences) {
   std::mt19937 rng(3);
   std::normal_distribution<double> normal;
-  auto random_vector = [&] { return Eigen::Vector3d(normal(rng), normal(rng), normal(rng)); };
+  // Coefficients drawn in order (a constructor's arguments have no defined evaluation order).
+  auto random_vector = [&] {
+    return Eigen::Vector3d::NullaryExpr([&](Eigen::Index) { return normal(rng); }).eval();
+  };
   for (int trial = 0; trial < 20; ++trial) {
     std::array<Eigen::Vector3d, 3> p = {random_vector(), random_vector(), random_vector()};
     if (trial == 0) p[2] = p[0] + 1e-3 * (p[1] - p[0]) + 1e-4 * random_vector();  // a sliver.
@@ -72,7 +75,9 @@ Eigen::Vector3d HitPoint(const Eigen::Vector3d& o, const Eigen::Vector3d& d,
 TEST(HitPointDerivativesTest, MatchesFiniteDifferences) {
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> uniform(-1.0, 1.0);
-  auto random_vector = [&] { return Eigen::Vector3d(uniform(rng), uniform(rng), uniform(rng)); };
+  auto random_vector = [&] {
+    return Eigen::Vector3d::NullaryExpr([&](Eigen::Index) { return uniform(rng); }).eval();
+  };
   for (int trial = 0; trial < 20; ++trial) {
     const std::array<Eigen::Vector3d, 3> p = {Eigen::Vector3d(0, 0, 0) + 0.2 * random_vector(),
                                               Eigen::Vector3d(1, 0, 0) + 0.2 * random_vector(),
