@@ -88,6 +88,7 @@ void EdgeView::TraceSides(const Eigen::Vector2d& q, const Eigen::Vector2d& m,
 Eigen::Vector3d SideRadianceJump(const Context& ctx, const Eigen::Vector3d dirs[2],
                                  const RayHit hits[2], const Sampler& sampler, RenderStats* stats) {
   Eigen::Vector3d jump = Eigen::Vector3d::Zero();
+  if (TraceSharedSideJump(ctx, sampler, dirs, hits, stats, &jump)) return jump;
   for (int i = 0; i < 2; ++i) {
     Sampler copy = sampler;
     const Eigen::Vector3d radiance = TraceRadiance(ctx, &copy, dirs[i], hits[i], stats, nullptr);

@@ -120,9 +120,10 @@ struct EdgeView {
                   RayHit hits[2], RenderStats* stats) const;
 };
 
-// L(q − εm) − L(q + εm) from the full camera paths through the two side rays, traced with the
-// same random numbers on both sides so that only the jump remains (not finite when a side's
-// radiance is not).
+// L(q − εm) − L(q + εm) from the camera paths through the two side rays: one path shared by
+// both sides when their hits have the same normal (TraceSharedSideJump: a texel boundary), else
+// two full paths traced with the same random numbers so that only the jump remains (not finite
+// when a side's radiance is not).
 Eigen::Vector3d SideRadianceJump(const Context& ctx, const Eigen::Vector3d dirs[2],
                                  const RayHit hits[2], const Sampler& sampler, RenderStats* stats);
 

@@ -10,6 +10,10 @@ namespace sft {
 namespace render_internal {
 namespace {
 
+// Side hits whose normals are closer than this (cosine) share one path (TraceSharedSideJump):
+// the same face, or coplanar ones.
+constexpr double kSharedSideMinCosine = 1.0 - 1e-9;
+
 // The shading frame of a path vertex at ray hit `hit` of the ray along `dir`.
 struct ShadingPoint {
   Eigen::Vector3d p;
@@ -50,9 +54,10 @@ struct PathVertex {
   int face = -1;
   ShadingPoint sp;
   SurfaceMaterial surface;
-  BsdfParams sampling;  // the sampling material's parameters (detached sampling).
-  double offset = 0.0;  // ray offset at p.
-  bool lit = false;     // light reaching this vertex directly counts.
+  BsdfParams sampling;    // the parameters directions are sampled with (detached sampling).
+  bool detached = false;  // sampling differs from surface.params.
+  double offset = 0.0;    // ray offset at p.
+  bool lit = false;       // light reaching this vertex directly counts.
 };
 struct PathState {
   Eigen::Vector3d radiance = Eigen::Vector3d::Zero();
@@ -114,46 +119,65 @@ void AddEnvironmentLight(const Context& ctx, const PathVertex& v, Sampler* sampl
   Contribute(v, wi, f, term, ctx.view.environment_light_index, state);
 }
 
-// Samples the BSDF at v: adds the environment seen along the sample (MIS) and, when the path
-// continues, advances *dir and *hit and the throughput. False when the path ends.
-bool Scatter(const Context& ctx, const PathVertex& v, Sampler* sampler, PathState* state,
-             Eigen::Vector3d* dir, RayHit* hit) {
-  const bool detached = &ctx.sampling_material != &ctx.material;
+// A BSDF sample at a path vertex and the first hit of the ray it traces.
+struct ScatterSample {
+  BsdfSample bsdf;
+  RayHit next;
+};
+
+// Samples the BSDF of v's sampling material and traces the ray. False when nothing follows
+// from it (no further segment and no BSDF-sampled environment, or no valid sample).
+bool SampleScatter(const Context& ctx, const PathVertex& v, Sampler* sampler, RenderStats* stats,
+                   ScatterSample* out) {
   const bool continue_path = v.depth + 1 < ctx.max_segments;
   const bool bsdf_lights_environment =
       ctx.environment != nullptr && v.lit && ctx.options.effects.shadows;
   if (!continue_path && !bsdf_lights_environment) return false;
-  const Eigen::Vector3d& n = v.sp.n;
-  const Eigen::Vector3d& wo = v.sp.wo;
-  BsdfSample sample;
   Eigen::Vector3d u;
   u.x() = sampler->Next1D();  // lobe choice
   sampler->Next2D(&u.y(), &u.z());
-  if (!SampleBsdf(v.sampling, n, wo, u, &sample)) return false;
-  const Eigen::Vector3d wi = sample.wi;
-  const Eigen::Vector3d f = detached ? EvalBsdf(v.surface.params, n, wo, wi) : sample.f;
-  const double cos_over_pdf = n.dot(wi) / sample.pdf;
-  if (!std::isfinite(cos_over_pdf)) return false;
-  const Eigen::Vector3d p_off = v.sp.p + v.offset * n;
-  const RayHit next = ctx.scene.Intersect(p_off, wi, 0.0, kInfinity);
-  ++state->stats->bounce_rays;
-  if (!next.hit) {
-    if (bsdf_lights_environment) {
-      const double weight = PowerHeuristic(sample.pdf, ctx.environment->Pdf(wi));
+  if (!SampleBsdf(v.sampling, v.sp.n, v.sp.wo, u, &out->bsdf)) return false;
+  if (!std::isfinite(v.sp.n.dot(out->bsdf.wi) / out->bsdf.pdf)) return false;
+  out->next = ctx.scene.Intersect(v.sp.p + v.offset * v.sp.n, out->bsdf.wi, 0.0, kInfinity);
+  ++stats->bounce_rays;
+  return true;
+}
+
+// Applies sample s to the path at v, with v's own material: the environment seen along it on
+// a miss (MIS), else the throughput of the next segment. False when the path ends.
+bool ApplyScatter(const Context& ctx, const PathVertex& v, const ScatterSample& s,
+                  PathState* state) {
+  const Eigen::Vector3d& n = v.sp.n;
+  const Eigen::Vector3d& wi = s.bsdf.wi;
+  const Eigen::Vector3d f = v.detached ? EvalBsdf(v.surface.params, n, v.sp.wo, wi) : s.bsdf.f;
+  if (!s.next.hit) {
+    if (ctx.environment != nullptr && v.lit && ctx.options.effects.shadows) {
+      const double weight = PowerHeuristic(s.bsdf.pdf, ctx.environment->Pdf(wi));
       LightTerm term;
-      term.q = ctx.environment->Radiance(wi) * (ctx.view.environment_scale * weight / sample.pdf);
+      term.q = ctx.environment->Radiance(wi) * (ctx.view.environment_scale * weight / s.bsdf.pdf);
       term.c = n.dot(wi);
       term.dc_dn = wi;
       Contribute(v, wi, f, term, ctx.view.environment_light_index, state);
     }
     return false;
   }
-  if (!continue_path) return false;
-  const Eigen::Vector3d scatter = f * cos_over_pdf;
-  if (state->path) state->path->AddScatter(state->throughput, v.surface, n, wo, wi, f, sample.pdf);
-  state->throughput = state->throughput.cwiseProduct(scatter);
-  *dir = wi;
-  *hit = next;
+  if (v.depth + 1 >= ctx.max_segments) return false;
+  if (state->path)
+    state->path->AddScatter(state->throughput, v.surface, n, v.sp.wo, wi, f, s.bsdf.pdf);
+  state->throughput = state->throughput.cwiseProduct(f * (n.dot(wi) / s.bsdf.pdf));
+  return true;
+}
+
+// Samples the BSDF at v: adds the environment seen along the sample (MIS) and, when the path
+// continues, advances *dir and *hit and the throughput. False when the path ends.
+bool Scatter(const Context& ctx, const PathVertex& v, Sampler* sampler, PathState* state,
+             Eigen::Vector3d* dir, RayHit* hit) {
+  ScatterSample s;
+  if (!SampleScatter(ctx, v, sampler, state->stats, &s) || !ApplyScatter(ctx, v, s, state)) {
+    return false;
+  }
+  *dir = s.bsdf.wi;
+  *hit = s.next;
   return true;
 }
 
@@ -252,6 +276,7 @@ Eigen::Vector3d TraceRadiance(const Context& ctx, Sampler* sampler, Eigen::Vecto
     v.sampling = detached
                      ? LookUpMaterial(ctx, ctx.sampling_material, hit.face, hit.u, hit.v).params
                      : v.surface.params;
+    v.detached = detached;
     v.offset = RayOffset(ctx, hit.face, v.sp.p);
     v.lit = depth > 0 || ctx.options.effects.direct;
     if (v.lit) {
@@ -265,6 +290,54 @@ Eigen::Vector3d TraceRadiance(const Context& ctx, Sampler* sampler, Eigen::Vecto
     if (!Scatter(ctx, v, sampler, &state, &dir, &hit)) break;
   }
   return state.radiance;
+}
+
+bool TraceSharedSideJump(const Context& ctx, const Sampler& sampler, const Eigen::Vector3d dirs[2],
+                         const RayHit hits[2], RenderStats* stats, Eigen::Vector3d* jump) {
+  if (!hits[0].hit || !hits[1].hit) return false;
+  PathVertex v[2];
+  PathState state[2];
+  for (int k = 0; k < 2; ++k) {
+    if (!Shade(ctx, dirs[k], hits[k], &v[k].sp)) return false;
+    v[k].face = hits[k].face;
+    v[k].surface = LookUpMaterial(ctx, ctx.material, hits[k].face, hits[k].u, hits[k].v);
+    v[k].offset = RayOffset(ctx, hits[k].face, v[k].sp.p);
+    v[k].lit = ctx.options.effects.direct;
+    state[k].stats = stats;
+  }
+  if (!(v[0].sp.n.dot(v[1].sp.n) > kSharedSideMinCosine)) return false;
+  // Both sides sample directions with side 0's sampling material; it must cover the hemisphere.
+  const BsdfParams sampling =
+      &ctx.sampling_material != &ctx.material
+          ? LookUpMaterial(ctx, ctx.sampling_material, hits[0].face, hits[0].u, hits[0].v).params
+          : v[0].surface.params;
+  if (!(GlossySelectionProbability(sampling) < 1.0)) return false;
+  for (int k = 0; k < 2; ++k) {
+    v[k].sampling = sampling;
+    v[k].detached = k == 1 || &ctx.sampling_material != &ctx.material;
+  }
+  Sampler shared = sampler;
+  if (ctx.options.effects.direct) {
+    Sampler before = shared;
+    for (int k = 0; k < 2; ++k) {
+      AddPointLights(ctx, v[k], &state[k]);
+      if (ctx.environment == nullptr) continue;
+      shared = before;  // the same light sample on both sides.
+      AddEnvironmentLight(ctx, v[k], &shared, &state[k]);
+    }
+  }
+  ScatterSample s;
+  if (SampleScatter(ctx, v[0], &shared, stats, &s)) {
+    bool continues = false;
+    for (int k = 0; k < 2; ++k) continues |= ApplyScatter(ctx, v[k], s, &state[k]);
+    if (continues) {
+      const Eigen::Vector3d rest =
+          TraceRadiance(ctx, &shared, s.bsdf.wi, s.next, stats, nullptr, /*first_depth=*/1);
+      for (int k = 0; k < 2; ++k) state[k].radiance += state[k].throughput.cwiseProduct(rest);
+    }
+  }
+  *jump = state[0].radiance - state[1].radiance;
+  return true;
 }
 
 Eigen::Vector3d TraceAuxiliary(const Context& ctx, const Eigen::Vector3d& dir, const RayHit& hit) {

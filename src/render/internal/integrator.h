@@ -52,6 +52,16 @@ bool DirectAtReceiver(const Context& ctx, const PointLight& light, const Eigen::
 Eigen::Vector3d TraceRadiance(const Context& ctx, Sampler* sampler, Eigen::Vector3d dir, RayHit hit,
                               RenderStats* stats, PathDerivatives* path, int first_depth = 0);
 
+// L(dirs[0]) − L(dirs[1]) for two camera rays whose first hits lie a side offset apart on faces
+// with the same normal (a texel boundary seen directly), from one path for both sides: its first
+// vertex is shaded with each side's material, with the same light samples and the same BSDF
+// sample (drawn with side 0's sampling material, whose diffuse lobe covers the hemisphere), and
+// the rest of the path is traced once. The sides differ by the offset only, which the two-path
+// estimate neglects as well. False (nothing written) when the hits do not qualify (a miss,
+// different normals, a sampling material without a diffuse lobe): then trace both sides.
+bool TraceSharedSideJump(const Context& ctx, const Sampler& sampler, const Eigen::Vector3d dirs[2],
+                         const RayHit hits[2], RenderStats* stats, Eigen::Vector3d* jump);
+
 // First-hit auxiliary passes (albedo, roughness, normal, depth).
 Eigen::Vector3d TraceAuxiliary(const Context& ctx, const Eigen::Vector3d& dir, const RayHit& hit);
 
