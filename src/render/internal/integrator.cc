@@ -119,6 +119,14 @@ void AddEnvironmentLight(const Context& ctx, const PathVertex& v, Sampler* sampl
   Contribute(v, wi, f, term, ctx.view.environment_light_index, state);
 }
 
+// Light reaching v directly (when it counts there): the point lights and a light-sampled
+// environment direction.
+void AddDirectLight(const Context& ctx, const PathVertex& v, Sampler* sampler, PathState* state) {
+  if (!v.lit) return;
+  AddPointLights(ctx, v, state);
+  if (ctx.environment != nullptr) AddEnvironmentLight(ctx, v, sampler, state);
+}
+
 // A BSDF sample at a path vertex and the first hit of the ray it traces.
 struct ScatterSample {
   BsdfSample bsdf;
@@ -178,6 +186,23 @@ bool Scatter(const Context& ctx, const PathVertex& v, Sampler* sampler, PathStat
   }
   *dir = s.bsdf.wi;
   *hit = s.next;
+  return true;
+}
+
+// The path vertex at `hit` of the ray along `dir` at `depth`: shading frame, material, sampling
+// material, ray offset. False for a degenerate triangle (nothing is reflected).
+bool MakeVertex(const Context& ctx, const Eigen::Vector3d& dir, const RayHit& hit, int depth,
+                PathVertex* v) {
+  v->depth = depth;
+  v->face = hit.face;
+  if (!Shade(ctx, dir, hit, &v->sp)) return false;
+  v->surface = LookUpMaterial(ctx, ctx.material, hit.face, hit.u, hit.v);
+  v->detached = &ctx.sampling_material != &ctx.material;
+  v->sampling = v->detached
+                    ? LookUpMaterial(ctx, ctx.sampling_material, hit.face, hit.u, hit.v).params
+                    : v->surface.params;
+  v->offset = RayOffset(ctx, hit.face, v->sp.p);
+  v->lit = depth > 0 || ctx.options.effects.direct;
   return true;
 }
 
@@ -259,30 +284,17 @@ bool DirectAtReceiver(const Context& ctx, const PointLight& light, const Eigen::
 Eigen::Vector3d TraceRadiance(const Context& ctx, Sampler* sampler, Eigen::Vector3d dir, RayHit hit,
                               RenderStats* stats, PathDerivatives* path, int first_depth) {
   if (!hit.hit) return Background(ctx, dir, path);
-  const bool detached = &ctx.sampling_material != &ctx.material;
   PathState state;
   state.path = path;
   state.stats = stats;
   for (int depth = first_depth;; ++depth) {
     PathVertex v;
-    v.depth = depth;
-    v.face = hit.face;
-    if (!Shade(ctx, dir, hit, &v.sp)) break;  // degenerate triangle: nothing reflected.
+    if (!MakeVertex(ctx, dir, hit, depth, &v)) break;
     if (path) {
       path->SetVertex(hit.face, Eigen::Vector3d(1.0 - hit.u - hit.v, hit.u, hit.v), dir, v.sp.sign,
                       !ctx.view.point_lights.empty() || ctx.secondary != nullptr);
     }
-    v.surface = LookUpMaterial(ctx, ctx.material, hit.face, hit.u, hit.v);
-    v.sampling = detached
-                     ? LookUpMaterial(ctx, ctx.sampling_material, hit.face, hit.u, hit.v).params
-                     : v.surface.params;
-    v.detached = detached;
-    v.offset = RayOffset(ctx, hit.face, v.sp.p);
-    v.lit = depth > 0 || ctx.options.effects.direct;
-    if (v.lit) {
-      AddPointLights(ctx, v, &state);
-      if (ctx.environment != nullptr) AddEnvironmentLight(ctx, v, sampler, &state);
-    }
+    AddDirectLight(ctx, v, sampler, &state);
     if (path != nullptr && ctx.secondary != nullptr) {
       AddSecondaryEdgeSamples(ctx, *sampler, depth, hit.face, state.throughput, v.sp.p, v.sp.n,
                               v.sp.wo, v.surface.params, path, stats);
@@ -298,33 +310,18 @@ bool TraceSharedSideJump(const Context& ctx, const Sampler& sampler, const Eigen
   PathVertex v[2];
   PathState state[2];
   for (int k = 0; k < 2; ++k) {
-    if (!Shade(ctx, dirs[k], hits[k], &v[k].sp)) return false;
-    v[k].face = hits[k].face;
-    v[k].surface = LookUpMaterial(ctx, ctx.material, hits[k].face, hits[k].u, hits[k].v);
-    v[k].offset = RayOffset(ctx, hits[k].face, v[k].sp.p);
-    v[k].lit = ctx.options.effects.direct;
+    if (!MakeVertex(ctx, dirs[k], hits[k], /*depth=*/0, &v[k])) return false;
     state[k].stats = stats;
   }
   if (!(v[0].sp.n.dot(v[1].sp.n) > kSharedSideMinCosine)) return false;
   // Both sides sample directions with side 0's sampling material; it must cover the hemisphere.
-  const BsdfParams sampling =
-      &ctx.sampling_material != &ctx.material
-          ? LookUpMaterial(ctx, ctx.sampling_material, hits[0].face, hits[0].u, hits[0].v).params
-          : v[0].surface.params;
-  if (!(GlossySelectionProbability(sampling) < 1.0)) return false;
+  if (!(GlossySelectionProbability(v[0].sampling) < 1.0)) return false;
+  v[1].sampling = v[0].sampling;
+  v[1].detached = true;
+  Sampler shared;
   for (int k = 0; k < 2; ++k) {
-    v[k].sampling = sampling;
-    v[k].detached = k == 1 || &ctx.sampling_material != &ctx.material;
-  }
-  Sampler shared = sampler;
-  if (ctx.options.effects.direct) {
-    Sampler before = shared;
-    for (int k = 0; k < 2; ++k) {
-      AddPointLights(ctx, v[k], &state[k]);
-      if (ctx.environment == nullptr) continue;
-      shared = before;  // the same light sample on both sides.
-      AddEnvironmentLight(ctx, v[k], &shared, &state[k]);
-    }
+    shared = sampler;  // the same light samples on both sides.
+    AddDirectLight(ctx, v[k], &shared, &state[k]);
   }
   ScatterSample s;
   if (SampleScatter(ctx, v[0], &shared, stats, &s)) {
