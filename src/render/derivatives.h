@@ -136,8 +136,9 @@ struct DerivativeRequest {
   // turns them off.
   double secondary_edge_samples = 1.0;
   // Texel-boundary samples = ratio × spp × pixels, each tracing two camera rays and, when both
-  // see the boundary's face, two paths. Only boundaries whose two texels differ visibly are
-  // candidates (albedo; roughness when the glossy lobe is on), so constant materials cost
+  // see the boundary's faces, one path whose first vertex is shaded with both sides' materials
+  // (two paths where the faces' normals differ). Only boundaries whose two texels differ visibly
+  // are candidates (albedo; roughness when the glossy lobe is on), so constant materials cost
   // nothing. Default 1/8: with the jump size in the sampling weight and the samples stratified
   // along the lines the term converges fast (measurements: docs/design-notes.md, "Texel
   // boundaries").
