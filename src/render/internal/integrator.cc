@@ -127,6 +127,15 @@ void AddDirectLight(const Context& ctx, const PathVertex& v, Sampler* sampler, P
   if (ctx.environment != nullptr) AddEnvironmentLight(ctx, v, sampler, state);
 }
 
+// Whether a segment follows v, and whether the environment seen along a BSDF sample at v counts
+// there (MIS against AddEnvironmentLight's light samples).
+bool ContinuesPath(const Context& ctx, const PathVertex& v) {
+  return v.depth + 1 < ctx.max_segments;
+}
+bool BsdfLightsEnvironment(const Context& ctx, const PathVertex& v) {
+  return ctx.environment != nullptr && v.lit && ctx.options.effects.shadows;
+}
+
 // A BSDF sample at a path vertex and the first hit of the ray it traces.
 struct ScatterSample {
   BsdfSample bsdf;
@@ -137,10 +146,7 @@ struct ScatterSample {
 // from it (no further segment and no BSDF-sampled environment, or no valid sample).
 bool SampleScatter(const Context& ctx, const PathVertex& v, Sampler* sampler, RenderStats* stats,
                    ScatterSample* out) {
-  const bool continue_path = v.depth + 1 < ctx.max_segments;
-  const bool bsdf_lights_environment =
-      ctx.environment != nullptr && v.lit && ctx.options.effects.shadows;
-  if (!continue_path && !bsdf_lights_environment) return false;
+  if (!ContinuesPath(ctx, v) && !BsdfLightsEnvironment(ctx, v)) return false;
   Eigen::Vector3d u;
   u.x() = sampler->Next1D();  // lobe choice
   sampler->Next2D(&u.y(), &u.z());
@@ -159,7 +165,7 @@ bool ApplyScatter(const Context& ctx, const PathVertex& v, const ScatterSample& 
   const Eigen::Vector3d& wi = s.bsdf.wi;
   const Eigen::Vector3d f = v.detached ? EvalBsdf(v.surface.params, n, v.sp.wo, wi) : s.bsdf.f;
   if (!s.next.hit) {
-    if (ctx.environment != nullptr && v.lit && ctx.options.effects.shadows) {
+    if (BsdfLightsEnvironment(ctx, v)) {
       const double weight = PowerHeuristic(s.bsdf.pdf, ctx.environment->Pdf(wi));
       LightTerm term;
       term.q = ctx.environment->Radiance(wi) * (ctx.view.environment_scale * weight / s.bsdf.pdf);
@@ -169,9 +175,10 @@ bool ApplyScatter(const Context& ctx, const PathVertex& v, const ScatterSample& 
     }
     return false;
   }
-  if (v.depth + 1 >= ctx.max_segments) return false;
-  if (state->path)
+  if (!ContinuesPath(ctx, v)) return false;
+  if (state->path) {
     state->path->AddScatter(state->throughput, v.surface, n, v.sp.wo, wi, f, s.bsdf.pdf);
+  }
   state->throughput = state->throughput.cwiseProduct(f * (n.dot(wi) / s.bsdf.pdf));
   return true;
 }
