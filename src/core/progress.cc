@@ -43,6 +43,19 @@ void Progress::Warn(const std::string& message) {
   std::fflush(stderr);
 }
 
+void Progress::Note(const std::string& message) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const bool tty = isatty(fileno(stderr));
+  std::fprintf(stderr, "%ssft %s: %s\n", (enabled_ && tty) ? "\r\033[K" : "", label_.c_str(),
+               message.c_str());
+  std::fflush(stderr);
+}
+
+void Progress::SetDetail(const std::string& detail) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  detail_ = detail;
+}
+
 void Progress::Print(bool final_line) {
   const int64_t done = done_.load();
   last_printed_ = done;
@@ -51,8 +64,9 @@ void Progress::Print(bool final_line) {
   const double eta = fraction > 0 ? elapsed * (1.0 - fraction) / fraction : 0.0;
   // A carriage return keeps one line on a terminal; a log file gets one line per update.
   const bool tty = isatty(fileno(stderr));
-  std::fprintf(stderr, "%s%s: %lld/%lld (%.0f%%) elapsed %.1fs ETA %.1fs%s", tty ? "\r" : "",
-               label_.c_str(), static_cast<long long>(done), static_cast<long long>(total_),
+  const std::string label = detail_.empty() ? label_ : label_ + " [" + detail_ + "]";
+  std::fprintf(stderr, "%s%s: %lld/%lld (%.0f%%) elapsed %.1fs ETA %.1fs%s", tty ? "\r\033[K" : "",
+               label.c_str(), static_cast<long long>(done), static_cast<long long>(total_),
                100.0 * fraction, elapsed, final_line ? 0.0 : eta, (final_line || !tty) ? "\n" : "");
   std::fflush(stderr);
 }

@@ -22,11 +22,17 @@ class Progress {
   // Prints "sft LABEL: warning: MESSAGE" on its own line of stderr, also when the progress line
   // is disabled (a warning is never quiet); on a terminal the progress line is redrawn below it.
   void Warn(const std::string& message);
+  // Prints "sft LABEL: MESSAGE" on its own line of stderr (an event such as a stage change), also
+  // when the progress line is disabled.
+  void Note(const std::string& message);
+  // A detail shown after the label on the progress line ("reconstruct [half]: ..."); "" = none.
+  void SetDetail(const std::string& detail);
 
  private:
   void Print(bool final_line);
 
   std::string label_;
+  std::string detail_;  // guarded by mutex_.
   int64_t total_;
   bool enabled_;
   std::atomic<int64_t> done_{0};

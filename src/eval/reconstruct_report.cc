@@ -18,11 +18,53 @@ double MeanPsnr(const IterationRecord& r) {
   return r.view_psnr.empty() ? 0.0 : sum / r.view_psnr.size();
 }
 
+// F1 and Chamfer of the outer records against wall time (nothing without --reference).
+void AddReferenceCharts(const nlohmann::json& outer, HtmlReport* html) {
+  LineSeries f1{"F1", {}, {}}, chamfer{"Chamfer", {}, {}};
+  for (const auto& r : outer) {
+    if (!r.contains("f1") || !r.contains("chamfer") || !r.contains("seconds")) continue;
+    f1.x.push_back(r["seconds"].get<double>());
+    f1.y.push_back(r["f1"].get<double>());
+    chamfer.x.push_back(r["seconds"].get<double>());
+    chamfer.y.push_back(r["chamfer"].get<double>());
+  }
+  if (f1.x.empty()) return;
+  LineChart f1_chart;
+  f1_chart.title = "F1 against the reference mesh, against wall time";
+  f1_chart.x_label = "seconds";
+  f1_chart.y_label = "F1";
+  f1_chart.series = {f1};
+  LineChart chamfer_chart;
+  chamfer_chart.title = "Chamfer distance to the reference mesh, against wall time";
+  chamfer_chart.x_label = "seconds";
+  chamfer_chart.y_label = "Chamfer";
+  chamfer_chart.log_y = true;
+  chamfer_chart.series = {chamfer};
+  html->AddSvg(LineChartSvg(f1_chart));
+  html->AddSvg(LineChartSvg(chamfer_chart));
+}
+
+// The stages and the mesh's normals after each (images written by the schedule).
+Status AddStages(const nlohmann::json& stages, HtmlReport* html) {
+  if (stages.empty()) return Status::Ok();
+  html->AddHeading("The mesh after each stage (normals of the first fitted view)");
+  ImageRow row;
+  row.label = "stages";
+  for (const auto& s : stages) {
+    const std::string caption = s.value("stage", "?") + ": " +
+                                std::to_string(s.value("faces", 0)) + " faces, " +
+                                FormatNumber(s.value("end_seconds", 0.0)) + " s";
+    row.images.push_back({s.value("normals", ""), caption, nullptr});
+  }
+  return html->AddImageRow(row);
+}
+
 }  // namespace
 
 Status WriteReconstructReport(const std::string& out, const Dataset& dataset,
                               const std::vector<IterationRecord>& records,
-                              Reconstruction* reconstruction) {
+                              Reconstruction* reconstruction, const nlohmann::json& outer_records,
+                              const nlohmann::json& stage_records) {
   HtmlReport html(out, "sft reconstruct: " + dataset.root);
   const IterationRecord* last = records.empty() ? nullptr : &records.back();
   html.AddSummaryTable({{"dataset", dataset.root},
@@ -57,6 +99,8 @@ Status WriteReconstructReport(const std::string& out, const Dataset& dataset,
   }
   html.AddSvg(LineChartSvg(cost));
   html.AddSvg(LineChartSvg(psnr));
+  AddReferenceCharts(outer_records, &html);
+  SFT_RETURN_IF_ERROR(AddStages(stage_records, &html));
   html.AddHeading("Views at the final state");
   const std::vector<Image> renders = reconstruction->RenderViews(/*seed=*/0x5f7eed);
   const RenderCache& cache = reconstruction->cache();

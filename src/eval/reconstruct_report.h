@@ -1,8 +1,11 @@
 // OUT/report.html of `sft reconstruct`: the run's summary, the cost and mean-PSNR curves against
-// wall time, and target | render | |difference| for up to four views at the final state.
+// wall time, F1 and Chamfer against wall time (when the outer records carry them: --reference),
+// the stages with the mesh's normals after each, and target | render | |difference| for up to
+// four views at the final state.
 #ifndef SFT_EVAL_RECONSTRUCT_REPORT_H_
 #define SFT_EVAL_RECONSTRUCT_REPORT_H_
 
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -14,7 +17,9 @@ namespace sft {
 
 Status WriteReconstructReport(const std::string& out, const Dataset& dataset,
                               const std::vector<IterationRecord>& records,
-                              Reconstruction* reconstruction);
+                              Reconstruction* reconstruction,
+                              const nlohmann::json& outer_records = nlohmann::json::array(),
+                              const nlohmann::json& stage_records = nlohmann::json::array());
 
 }  // namespace sft
 

@@ -105,6 +105,18 @@ const std::map<std::string, Key>& Keys() {
                                  return std::string(
                                      o.regularizers.laplacian_of_shape ? "shape" : "displacement");
                                })},
+      {"image_scale",
+       {[](const json& v, O* o) -> std::string {
+          // 1, 1/2, 1/4, ... 1/64 exactly (powers of two are exact in binary).
+          for (int k = 0; k <= 6; ++k) {
+            if (v.is_number() && v.get<double>() == std::ldexp(1.0, -k)) {
+              o->cache.image_scale_log2 = k;
+              return "";
+            }
+          }
+          return "expected 1, 0.5, 0.25, 0.125, 0.0625, 0.03125 or 0.015625";
+        },
+        [](const O& o) { return json(std::ldexp(1.0, -o.cache.image_scale_log2)); }}},
       {"mask_dilation", Int([](O* o) -> int& { return o->cache.mask_dilation; }, 0, 64)},
       {"primary_edge_ratio",
        Real([](O* o) -> double& { return o->cache.edges.primary_edge_ratio; }, 0, 16)},

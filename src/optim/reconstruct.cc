@@ -220,4 +220,6 @@ std::vector<Image> Reconstruction::RenderViews(uint64_t seed) {
   return images;
 }
 
+Image Reconstruction::RenderNormals(int v) { return cache_->RenderPassImage(v, RenderPass::kNormal); }
+
 }  // namespace sft

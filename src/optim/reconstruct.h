@@ -1,5 +1,5 @@
-// The reconstruction schedule (DESIGN.md §1 steps 3–4, §2.2): outer iterations, each one phase or
-// two (texture, then geometry) of at most `solver.steps` solver iterations with a fixed seed; fresh
+// One fit of the reconstruction (a stage of the schedule, src/optim/schedule.h): outer iterations,
+// each one phase or two (texture, then geometry) of at most `solver.steps` solver iterations with a fixed seed; fresh
 // seeds per outer iteration. Each outer iteration of a trust-region solver builds a new problem
 // (supersets from renders at the current state), so that pixel supersets follow the moving mesh.
 #ifndef SFT_OPTIM_RECONSTRUCT_H_
@@ -41,7 +41,8 @@ struct ReconstructOptions {
 
 // One solver iteration, as metrics.csv writes it.
 struct IterationRecord {
-  int outer = 0;
+  int outer = 0;         // over the whole run (all stages).
+  std::string stage;     // the schedule's stage name ("" outside a schedule).
   std::string phase;     // "texture" | "geometry".
   int iteration = 0;     // within the phase's solve.
   double cost = 0.0;     // objective (image + regularizers) at the accepted point.
@@ -75,6 +76,9 @@ class Reconstruction {
   std::vector<double> LightScales() const { return params_.LightScales(); }
   // Renders every fitted view at the current state (seed `seed`) and returns level-0 images.
   std::vector<Image> RenderViews(uint64_t seed);
+  // The normal pass of fitted view `v` at the current state (RGB: world-space geometric normals
+  // facing the camera; alpha: coverage), at the fit's image scale.
+  Image RenderNormals(int v);
   const RenderCache& cache() const { return *cache_; }
   const std::vector<PhaseRecord>& phases() const { return phase_records_; }
   const std::vector<int>& view_indices() const { return cache_->view_indices(); }

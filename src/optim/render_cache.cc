@@ -57,6 +57,10 @@ bool RenderCacheOptions::Check(std::string* why) const {
     *why = "mask_dilation: must be in [0, 64]";
     return false;
   }
+  if (image_scale_log2 < 0 || image_scale_log2 > 6) {
+    *why = "image_scale: must be 1, 1/2, 1/4, ... or 1/64";
+    return false;
+  }
   return true;
 }
 
@@ -83,9 +87,15 @@ Status RenderCache::Create(const Dataset& dataset, const DatasetViews* views,
     std::vector<uint8_t> active;
     SFT_RETURN_IF_ERROR(ActivePixels(dataset, v, target.width, target.height, options.mask_dilation,
                                      &active, &targets.has_mask));
-    const std::vector<Image> pyramid = BuildPyramid(ToRgb(target), options.pyramid_levels);
+    Image scaled = ToRgb(target);
+    if (options.image_scale_log2 > 0) {
+      const int k = options.image_scale_log2;
+      scaled = BuildPyramid(scaled, k + 1).back();
+      active = MaskPyramid(active, target.width, target.height, k + 1).back();
+    }
+    const std::vector<Image> pyramid = BuildPyramid(scaled, options.pyramid_levels);
     targets.active =
-        MaskPyramid(active, target.width, target.height, static_cast<int>(pyramid.size()));
+        MaskPyramid(active, scaled.width, scaled.height, static_cast<int>(pyramid.size()));
     std::vector<std::unique_ptr<LevelCache>> levels;
     for (size_t l = 0; l < pyramid.size(); ++l) {
       auto level = std::make_unique<LevelCache>();
@@ -118,6 +128,7 @@ void RenderCache::UpdateScene() {
 
 ViewSetup RenderCache::ScaledView(int v) const {
   ViewSetup view = views_->views[view_indices_[v]];
+  view.camera = DownscaledCamera(view.camera, options_.image_scale_log2);
   for (PointLight& light : view.point_lights) {
     if (light.light_index >= 0) light.intensity *= params_->LightScale(light.light_index);
   }
@@ -125,6 +136,18 @@ ViewSetup RenderCache::ScaledView(int v) const {
     view.environment_scale *= params_->LightScale(view.environment_light_index);
   }
   return view;
+}
+
+Image RenderCache::RenderPassImage(int v, RenderPass pass) {
+  UpdateScene();
+  RenderOptions render = options_.render;
+  render.seed = seed_;
+  render.pass = pass;
+  render.spp = 4;  // antialiasing only: the pass has no noise.
+  Image image;
+  RenderStats stats;
+  RenderView(*scene_, material_, ScaledView(v), render, &image, &stats);
+  return image;
 }
 
 void RenderCache::Render(bool rows) {

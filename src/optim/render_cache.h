@@ -35,6 +35,10 @@ struct RenderCacheOptions {
   double level_weight = 1.0;  // level l's residuals are weighted by level_weight^l, (0, 64].
   double image_weight = 1.0;  // weight of the whole image term, [0, 1e6]; 0 = regularizers only.
   int mask_dilation = 2;      // level-0 pixels within this many pixels of the mask count, [0, 64].
+  // The fit's images are the dataset's at 2^-image_scale_log2 of their resolution: targets and
+  // masks are box-downsampled (BuildPyramid, MaskPyramid) and cameras scaled (DownscaledCamera);
+  // [0, 6]. Pyramid levels are counted from that scale.
+  int image_scale_log2 = 0;
 
   bool Check(std::string* why) const;
 };
@@ -58,6 +62,8 @@ class RenderCache : public ceres::EvaluationCallback {
 
   void PrepareForEvaluation(bool evaluate_jacobians, bool new_evaluation_point) override;
 
+  // Renders view v's `pass` (RenderOptions::pass) at the current parameters (not stored).
+  Image RenderPassImage(int v, RenderPass pass);
   // Renders every view at the current parameters: rows of the `active` kinds when `rows`.
   void Render(bool rows);
   // The seed of the renders from now on (a new outer iteration).

@@ -22,12 +22,16 @@ json TimeSplitJson(const SolverTimeSplit& t) {
 }  // namespace
 
 Status WriteRunState(const std::string& out, const RunState& state) {
-  json j = {{"format", "sft-reconstruct-state/1"},
-            {"dataset", state.dataset},
-            {"init", state.init},
-            {"config", state.config},
-            {"outer_done", state.outer_done},
-            {"seconds", state.seconds},
+  const ScheduleProgress& p = state.progress;
+  json j = {{"format", kRunStateFormat},
+            {"run", state.run_info},
+            {"stages", state.stages},
+            {"stage", p.stage},
+            {"stage_outer_done", p.stage_outer_done},
+            {"stage_prepared", p.stage_prepared},
+            {"outer_done", p.outer_done},
+            {"topology_changes", p.topology_changes},
+            {"seconds", p.seconds},
             {"finished", state.finished}};
   return WriteTextFile(JoinPath(out, "state.json"), j.dump(1) + "\n");
 }
@@ -37,37 +41,61 @@ Status ReadRunState(const std::string& out, RunState* state) {
   std::string text;
   SFT_RETURN_IF_ERROR(ReadTextFile(path, &text));
   const json j = json::parse(text, nullptr, /*allow_exceptions=*/false);
-  if (j.is_discarded() || !j.is_object() || j.value("format", "") != "sft-reconstruct-state/1") {
-    return Status::Error(path + ": not an sft reconstruction state (format " +
-                         "sft-reconstruct-state/1)");
+  if (j.is_discarded() || !j.is_object()) {
+    return Status::Error(path + ": not an sft reconstruction state (not a JSON object)");
   }
-  if (!j.contains("dataset") || !j["dataset"].is_string() || !j.contains("config") ||
-      !j["config"].is_object() || !j.contains("outer_done") ||
-      !j["outer_done"].is_number_integer()) {
-    return Status::Error(path + ": missing dataset, config or outer_done");
+  const std::string format = j.value("format", "");
+  if (format != kRunStateFormat) {
+    return Status::Error(path + ": format \"" + format + "\" is not " + kRunStateFormat +
+                         " (a run of an older sft cannot be resumed: start a new run from its " +
+                         "mesh.ply with --init)");
   }
-  state->dataset = j["dataset"].get<std::string>();
-  state->init = j.value("init", "");
-  state->config = j["config"];
-  state->outer_done = j["outer_done"].get<int>();
-  state->seconds = j.value("seconds", 0.0);
+  const auto integer = [&](const char* key) {
+    return j.contains(key) && j[key].is_number_integer() && j[key].get<int64_t>() >= 0;
+  };
+  if (!j.contains("run") || !j["run"].is_object() || !j["run"].contains("dataset") ||
+      !j["run"]["dataset"].is_string() || !j.contains("stages") || !j["stages"].is_array() ||
+      !integer("stage") || !integer("stage_outer_done") || !integer("outer_done")) {
+    return Status::Error(path + ": missing or invalid run, stages, stage, stage_outer_done or " +
+                         "outer_done");
+  }
+  state->run_info = j["run"];
+  state->stages = j["stages"];
+  ScheduleProgress& p = state->progress;
+  p.stage = j["stage"].get<int>();
+  p.stage_outer_done = j["stage_outer_done"].get<int>();
+  p.stage_prepared = j.value("stage_prepared", false);
+  p.outer_done = j["outer_done"].get<int>();
+  p.topology_changes = j.value("topology_changes", 0);
+  p.seconds = j.value("seconds", 0.0);
   state->finished = j.value("finished", false);
+  if (p.stage > static_cast<int>(state->stages.size())) {
+    return Status::Error(path + ": stage " + std::to_string(p.stage) + " of " +
+                         std::to_string(state->stages.size()));
+  }
   return Status::Ok();
 }
 
-Status WriteReconstructionState(const std::string& out, const Dataset& dataset,
-                                const Reconstruction& reconstruction) {
-  const TriMesh mesh = reconstruction.Mesh();
+Status WriteRunSnapshot(const std::string& out, const Dataset& dataset, const TriMesh& mesh,
+                        const Material& material, const std::vector<double>& light_scales) {
   SFT_RETURN_IF_ERROR(WriteMesh(JoinPath(out, "mesh.ply"), mesh));
   SFT_RETURN_IF_ERROR(WriteMesh(JoinPath(out, "mesh.obj"), mesh));
-  SFT_RETURN_IF_ERROR(
-      SaveMaterial(JoinPath(out, "material.json"), reconstruction.CurrentMaterial()));
-  return WriteLightScales(JoinPath(out, "lights.json"), dataset, reconstruction.LightScales());
+  SFT_RETURN_IF_ERROR(SaveMaterial(JoinPath(out, "material.json"), material));
+  std::vector<double> scales = light_scales;
+  if (scales.empty()) scales.assign(dataset.lights.size(), 1.0);
+  return WriteLightScales(JoinPath(out, "lights.json"), dataset, scales);
+}
+
+Status ReadRunSnapshot(const std::string& out, const Dataset& dataset, TriMesh* mesh,
+                       Material* material, std::vector<double>* light_scales) {
+  SFT_RETURN_IF_ERROR(ReadMesh(JoinPath(out, "mesh.ply"), mesh));
+  SFT_RETURN_IF_ERROR(LoadMaterial(JoinPath(out, "material.json"), *mesh, material));
+  return ReadLightScales(JoinPath(out, "lights.json"), dataset, light_scales);
 }
 
 Status WriteMetrics(const std::string& out, const std::vector<IterationRecord>& records,
                     const std::vector<PhaseRecord>& phases, const json& extra) {
-  std::string csv = "outer,phase,iteration,cost,seconds,accepted,mean_psnr";
+  std::string csv = "outer,stage,phase,iteration,cost,seconds,accepted,mean_psnr";
   const size_t num_views = records.empty() ? 0 : records.front().view_psnr.size();
   for (size_t v = 0; v < num_views; ++v) csv += ",psnr_view" + std::to_string(v);
   csv += "\n";
@@ -76,7 +104,8 @@ Status WriteMetrics(const std::string& out, const std::vector<IterationRecord>& 
     double mean = 0.0;
     for (double p : r.view_psnr) mean += p / std::max<size_t>(1, r.view_psnr.size());
     char line[256];
-    std::snprintf(line, sizeof(line), "%d,%s,%d,%.9g,%.3f,%d,%.4f", r.outer, r.phase.c_str(),
+    std::snprintf(line, sizeof(line), "%d,%s,%s,%d,%.9g,%.3f,%d,%.4f", r.outer, r.stage.c_str(),
+                  r.phase.c_str(),
                   r.iteration, r.cost, r.seconds, r.accepted ? 1 : 0, mean);
     csv += line;
     for (double p : r.view_psnr) {
@@ -85,6 +114,7 @@ Status WriteMetrics(const std::string& out, const std::vector<IterationRecord>& 
     }
     csv += "\n";
     iterations.push_back({{"outer", r.outer},
+                          {"stage", r.stage},
                           {"phase", r.phase},
                           {"iteration", r.iteration},
                           {"cost", r.cost},
@@ -116,14 +146,13 @@ Status WriteMetrics(const std::string& out, const std::vector<IterationRecord>& 
   return WriteTextFile(JoinPath(out, "metrics.json"), metrics.dump(1) + "\n");
 }
 
-Status ReadOuterRecords(const std::string& out, json* records) {
+Status ReadMetricsJson(const std::string& out, json* metrics) {
   const std::string path = JoinPath(out, "metrics.json");
   std::string text;
   SFT_RETURN_IF_ERROR(ReadTextFile(path, &text));
-  const json j = json::parse(text, nullptr, /*allow_exceptions=*/false);
-  *records = json::array();
-  if (!j.is_discarded() && j.is_object() && j.contains("outer") && j["outer"].is_array()) {
-    *records = j["outer"];
+  *metrics = json::parse(text, nullptr, /*allow_exceptions=*/false);
+  if (metrics->is_discarded() || !metrics->is_object()) {
+    return Status::Error(path + ": not a JSON object");
   }
   return Status::Ok();
 }
@@ -141,6 +170,7 @@ Status ReadIterationRecords(const std::string& out, std::vector<IterationRecord>
   for (const json& e : j["iterations"]) {
     IterationRecord r;
     r.outer = e.value("outer", 0);
+    r.stage = e.value("stage", "");
     r.phase = e.value("phase", "");
     r.iteration = e.value("iteration", 0);
     r.cost = e.value("cost", 0.0);

@@ -1,13 +1,16 @@
 // What `sft reconstruct` writes into its output folder, each file atomically:
-//   mesh.ply, mesh.obj          the current mesh (faces and their order as the initial mesh);
+//   mesh.ply, mesh.obj          the current mesh;
 //   material.json, albedo.mc, roughness.mc   the material (mesh colors; `sft render` reads it);
 //   lights.json                 the fitted light scales (src/io/light_scales.h);
-//   metrics.csv, metrics.json   per iteration: outer, phase, iteration, cost, seconds, accepted,
-//                               per-view PSNR; metrics.json adds per-phase solver statistics;
-//   state.json                  what --resume needs: dataset, effective config, outer iterations
-//                               done, elapsed seconds, the --init path as given;
-//   initial_mesh.ply            the starting mesh, the baseline of the folded-face count (kept so
-//                               a resumed run compares with the run's start, not its checkpoint).
+//   metrics.csv, metrics.json   per iteration: outer, stage, phase, iteration, cost, seconds,
+//                               accepted, per-view PSNR; metrics.json adds per-phase solver
+//                               statistics, per-outer records, topology changes and stages;
+//   state.json                  what --resume needs (format sft-reconstruct-state/2): the run's
+//                               info (dataset, start, config), the stages, where the run stands;
+//   initial_mesh.ply            the run's starting mesh;
+//   baseline_mesh.ply           the mesh after the last topology change: folded faces are
+//                               counted against it;
+//   stages/NN_NAME_normals.png  the normals of the first fitted view after each stage.
 // A checkpoint is written after every outer iteration and when the run is interrupted.
 #ifndef SFT_OPTIM_RUN_OUTPUTS_H_
 #define SFT_OPTIM_RUN_OUTPUTS_H_
@@ -18,32 +21,37 @@
 
 #include "src/core/status.h"
 #include "src/optim/reconstruct.h"
+#include "src/optim/schedule.h"
 
 namespace sft {
 
 // The resumable state of a run (state.json).
+constexpr char kRunStateFormat[] = "sft-reconstruct-state/2";
 struct RunState {
-  std::string dataset;    // the dataset folder, as given.
-  std::string init;       // the --init mesh, as given (for the record; initial_mesh.ply is used).
-  nlohmann::json config;  // ReconstructConfigJson of the effective options.
-  int outer_done = 0;     // outer iterations completed.
-  double seconds = 0.0;   // wall time of the run so far (all sessions).
-  bool finished = false;  // every outer iteration done.
+  nlohmann::json run_info;  // dataset (as given), start, config (flat keys as given).
+  nlohmann::json stages = nlohmann::json::array();  // StageJson of every stage.
+  ScheduleProgress progress;
+  bool finished = false;  // every stage done.
+
+  std::string dataset() const { return run_info.value("dataset", ""); }
 };
 
 Status WriteRunState(const std::string& out, const RunState& state);
+// Refuses other formats (older versions) with one line naming the file and the formats.
 Status ReadRunState(const std::string& out, RunState* state);
 
 // mesh.ply, mesh.obj, material.json (+ .mc files), lights.json.
-Status WriteReconstructionState(const std::string& out, const Dataset& dataset,
-                                const Reconstruction& reconstruction);
+Status WriteRunSnapshot(const std::string& out, const Dataset& dataset, const TriMesh& mesh,
+                        const Material& material, const std::vector<double>& light_scales);
+Status ReadRunSnapshot(const std::string& out, const Dataset& dataset, TriMesh* mesh,
+                       Material* material, std::vector<double>* light_scales);
 
 // metrics.csv and metrics.json. `records` are all iterations so far (resumed runs included),
 // `extra` is merged into metrics.json's top level.
 Status WriteMetrics(const std::string& out, const std::vector<IterationRecord>& records,
                     const std::vector<PhaseRecord>& phases, const nlohmann::json& extra);
-// Reads the per-outer-iteration entries ("outer", an array; empty when absent) of metrics.json.
-Status ReadOuterRecords(const std::string& out, nlohmann::json* records);
+// metrics.json as a whole (an object).
+Status ReadMetricsJson(const std::string& out, nlohmann::json* metrics);
 // Reads the iteration records of an earlier session back from metrics.json (for --resume).
 Status ReadIterationRecords(const std::string& out, std::vector<IterationRecord>* records);
 

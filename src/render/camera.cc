@@ -268,4 +268,22 @@ Eigen::Vector3d Camera::CamFromImage(const Eigen::Vector2d& pixel) const {
   return ray;
 }
 
+Camera DownscaledCamera(const Camera& camera, int log2_factor) {
+  Camera scaled = camera;
+  if (log2_factor <= 0) return scaled;
+  const int factor = 1 << log2_factor;
+  scaled.width = (camera.width + factor - 1) / factor;
+  scaled.height = (camera.height + factor - 1) / factor;
+  // Focal lengths and principal point lead the parameter list: f, cx, cy for the simple models,
+  // fx, fy, cx, cy for the others (CameraModelNumParams' order).
+  const bool simple = camera.model == CameraModel::kSimplePinhole ||
+                      camera.model == CameraModel::kSimpleRadial ||
+                      camera.model == CameraModel::kRadial;
+  const int pixel_params = simple ? 3 : 4;
+  for (int i = 0; i < pixel_params && i < static_cast<int>(scaled.params.size()); ++i) {
+    scaled.params[i] /= factor;
+  }
+  return scaled;
+}
+
 }  // namespace sft

@@ -72,6 +72,13 @@ struct Camera {
   Eigen::Vector2d Principal() const;
 };
 
+// The camera of the same view at 2^-log2_factor of its resolution: ⌈w/2^k⌉ × ⌈h/2^k⌉ pixels,
+// focal lengths and principal point divided by 2^k (pixel (x, y) covers [x, x+1] × [y, y+1], so
+// the continuous image coordinates scale exactly; a coarse pixel is the box mean of its 2^k × 2^k
+// children, as the pyramid's levels are). Distortion coefficients act on normalized coordinates
+// and stay as they are. log2_factor ≥ 0.
+Camera DownscaledCamera(const Camera& camera, int log2_factor);
+
 }  // namespace sft
 
 #endif  // SFT_RENDER_CAMERA_H_

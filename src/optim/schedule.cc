@@ -1,0 +1,327 @@
+#include "src/optim/schedule.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+
+#include "src/core/file_util.h"
+#include "src/init/self_intersection.h"
+#include "src/io/image_io.h"
+#include "src/io/scene_setup.h"
+#include "src/optim/run_outputs.h"
+#include "src/optim/schedule_config.h"
+
+namespace sft {
+namespace {
+
+using json = nlohmann::json;
+
+double NowSeconds() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+constexpr char kBaselineMesh[] = "baseline_mesh.ply";
+
+// Normals in [0, 1] colours ((n + 1) / 2), background black.
+Image NormalColours(const Image& normals) {
+  Image out(normals.width, normals.height, 3);
+  for (int y = 0; y < normals.height; ++y) {
+    for (int x = 0; x < normals.width; ++x) {
+      const bool hit = normals.channels < 4 || normals.at(x, y, 3) > 0.0f;
+      for (int c = 0; c < 3; ++c) {
+        out.at(x, y, c) = hit ? 0.5f * (normals.at(x, y, c) + 1.0f) : 0.0f;
+      }
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+bool StageOptions::Check(std::string* why) const {
+  if (name.empty()) {
+    *why = "name: must not be empty";
+    return false;
+  }
+  if (texel_resolution < 0 || texel_resolution > 64) {
+    *why = "texel_resolution: must be in [0, 64]";
+    return false;
+  }
+  if (effect_plan != "fixed") {
+    *why = "effect_plan: only \"fixed\" is available";
+    return false;
+  }
+  if (material_model != "mesh_colors") {
+    *why = "material_model: only \"mesh_colors\" is available";
+    return false;
+  }
+  return fit.Check(why) && topology.Check(why);
+}
+
+int64_t Schedule::StepWork(const StageOptions& stage) {
+  // Relative cost of one solver step: pixels (4^-k of the dataset's) × spp, 1000 units for a
+  // full-scale step at 16 spp; every phase of an outer iteration counts `steps` steps.
+  const double pixels = std::ldexp(1.0, -2 * stage.fit.cache.image_scale_log2);
+  return std::max<int64_t>(1, std::llround(1000.0 * pixels * stage.fit.cache.render.spp / 16.0));
+}
+
+int64_t Schedule::RemainingWork() const {
+  int64_t work = 0;
+  for (size_t s = progress_.stage; s < stages_.size(); ++s) {
+    const StageOptions& stage = stages_[s];
+    const int phases = stage.fit.phases == PhaseSchedule::kAlternate ? 2 : 1;
+    const int outers = stage.fit.outer_iterations -
+                       (static_cast<int>(s) == progress_.stage ? progress_.stage_outer_done : 0);
+    work += static_cast<int64_t>(outers) * phases * stage.fit.solver.steps * StepWork(stage);
+  }
+  return work;
+}
+
+Status Schedule::Start(const Dataset& dataset, const std::string& out,
+                       const std::vector<StageOptions>& stages, const ScheduleStart& start,
+                       const json& run_info, std::unique_ptr<Schedule>* schedule) {
+  if (stages.empty()) return Status::Error("the schedule has no stages");
+  std::unique_ptr<Schedule> s(new Schedule());
+  s->dataset_ = &dataset;
+  s->out_ = out;
+  s->stages_ = stages;
+  s->run_info_ = run_info;
+  s->current_ = start;
+  s->baseline_ = start.mesh;
+  SFT_RETURN_IF_ERROR(MakeDirectories(out));
+  SFT_RETURN_IF_ERROR(WriteMesh(JoinPath(out, "initial_mesh.ply"), start.mesh));
+  SFT_RETURN_IF_ERROR(WriteMesh(JoinPath(out, kBaselineMesh), start.mesh));
+  *schedule = std::move(s);
+  return Status::Ok();
+}
+
+Status Schedule::Resume(const Dataset& dataset, const std::string& out,
+                        const std::vector<StageOptions>& stages, const json& run_info,
+                        const ScheduleProgress& progress, std::unique_ptr<Schedule>* schedule) {
+  std::unique_ptr<Schedule> s(new Schedule());
+  s->dataset_ = &dataset;
+  s->out_ = out;
+  s->stages_ = stages;
+  s->run_info_ = run_info;
+  s->progress_ = progress;
+  SFT_RETURN_IF_ERROR(ReadRunSnapshot(out, dataset, &s->current_.mesh, &s->current_.material,
+                                      &s->current_.light_scales));
+  const std::string baseline = JoinPath(out, kBaselineMesh);
+  SFT_RETURN_IF_ERROR(ReadMesh(FileExists(baseline) ? baseline : JoinPath(out, "mesh.ply"),
+                               &s->baseline_));
+  if (s->baseline_.n_faces() != s->current_.mesh.n_faces()) {
+    return Status::Error(baseline + ": " + std::to_string(s->baseline_.n_faces()) +
+                         " faces, the checkpoint's mesh.ply has " +
+                         std::to_string(s->current_.mesh.n_faces()));
+  }
+  SFT_RETURN_IF_ERROR(ReadIterationRecords(out, &s->records_));
+  json metrics;
+  SFT_RETURN_IF_ERROR(ReadMetricsJson(out, &metrics));
+  if (metrics.contains("outer") && metrics["outer"].is_array()) s->outer_records_ = metrics["outer"];
+  if (metrics.contains("topology_changes") && metrics["topology_changes"].is_array()) {
+    s->topology_records_ = metrics["topology_changes"];
+  }
+  if (metrics.contains("stages") && metrics["stages"].is_array()) {
+    s->stage_records_ = metrics["stages"];
+  }
+  *schedule = std::move(s);
+  return Status::Ok();
+}
+
+double Schedule::Elapsed() const { return seconds_at_start_ + NowSeconds() - session_start_; }
+
+Status Schedule::CreateReconstruction() {
+  const StageOptions& stage = stages_[progress_.stage];
+  SFT_RETURN_IF_ERROR(Reconstruction::Create(*dataset_, current_.mesh, current_.material,
+                                             current_.light_scales, stage.fit, &reconstruction_));
+  reconstruction_->elapsed_offset = Elapsed();
+  phases_seen_ = 0;
+  return Status::Ok();
+}
+
+void Schedule::SyncCurrent() {
+  if (!reconstruction_) return;
+  current_.mesh = reconstruction_->Mesh();
+  current_.material = reconstruction_->CurrentMaterial();
+  current_.light_scales = reconstruction_->LightScales();
+}
+
+Status Schedule::ChangeTopology(TopologyChange change, const ScheduleCallbacks& callbacks) {
+  const StageOptions& stage = stages_[progress_.stage];
+  std::vector<int> views;
+  SFT_RETURN_IF_ERROR(
+      SelectViews(stage.fit.views, static_cast<int>(dataset_->views.size()), &views));
+  const int faces_before = static_cast<int>(current_.mesh.n_faces());
+  const double start = NowSeconds();
+  json record;
+  SFT_RETURN_IF_ERROR(ApplyTopologyChange(change, stage.topology, *dataset_, views,
+                                          stage.fit.cache.image_scale_log2,
+                                          stage.texel_resolution, &current_.mesh,
+                                          &current_.material, &record));
+  record["stage"] = stage.name;
+  record["outer"] = progress_.outer_done;
+  record["seconds"] = NowSeconds() - start;
+  record["at_seconds"] = Elapsed();
+  topology_records_.push_back(record);
+  ++progress_.topology_changes;
+  baseline_ = current_.mesh;
+  SFT_RETURN_IF_ERROR(WriteMesh(JoinPath(out_, kBaselineMesh), baseline_));
+  if (callbacks.on_event) {
+    char line[256];
+    std::snprintf(line, sizeof(line), "%s: %s, %d -> %zu faces in %.1f s", stage.name.c_str(),
+                  change == TopologyChange::kRemesh ? ("remesh " + stage.topology.remesh).c_str()
+                                                    : "resample",
+                  faces_before, current_.mesh.n_faces(), record["seconds"].get<double>());
+    callbacks.on_event(line);
+  }
+  return Status::Ok();
+}
+
+Status Schedule::PrepareStage(const ScheduleCallbacks& callbacks) {
+  SyncCurrent();
+  const StageOptions& stage = stages_[progress_.stage];
+  if (callbacks.on_event) {
+    char line[256];
+    std::snprintf(line, sizeof(line), "stage %d/%zu %s: %s at 1/%d scale, %d spp, %d outer x %d steps",
+                  progress_.stage + 1, stages_.size(), stage.name.c_str(),
+                  PhaseScheduleName(stage.fit.phases), 1 << stage.fit.cache.image_scale_log2,
+                  stage.fit.cache.render.spp, stage.fit.outer_iterations, stage.fit.solver.steps);
+    callbacks.on_event(line);
+  }
+  if (stage.topology.remesh != "none") {
+    SFT_RETURN_IF_ERROR(ChangeTopology(TopologyChange::kRemesh, callbacks));
+  }
+  if (stage.topology.resample) {
+    SFT_RETURN_IF_ERROR(ChangeTopology(TopologyChange::kResample, callbacks));
+  }
+  if (stage.texel_resolution > 0 &&
+      stage.texel_resolution != current_.material.albedo.resolution()) {
+    current_.material = ResampleMaterial(current_.material, stage.texel_resolution);
+  }
+  progress_.stage_prepared = true;
+  return CreateReconstruction();
+}
+
+// metrics.json's per-outer entry: cost, time, faces, mesh quality against the baseline and the
+// callbacks' scores.
+Status Schedule::OuterRecord(const ScheduleCallbacks& callbacks, json* out) {
+  const StageOptions& stage = stages_[progress_.stage];
+  const MeshQuality quality = CompareMeshQuality(baseline_, current_.mesh);
+  const int self_intersecting = CountSelfIntersectingFaces(current_.mesh);
+  const IterationRecord* last = records_.empty() ? nullptr : &records_.back();
+  *out = {{"outer", progress_.outer_done - 1},
+          {"stage", stage.name},
+          {"seconds", last ? last->seconds : Elapsed()},
+          {"cost", last ? last->cost : 0.0},
+          {"faces", current_.mesh.n_faces()},
+          {"flipped_faces", quality.flipped_faces},
+          {"degenerate_faces", quality.degenerate_faces},
+          {"self_intersecting_faces", self_intersecting}};
+  json dropped = json::array();
+  const std::vector<PhaseRecord>& phases = reconstruction_->phases();
+  for (size_t p = phases_seen_; p < phases.size(); ++p) {
+    dropped.push_back(phases[p].stats.dropped_jacobian_fraction);
+    phase_records_.push_back(phases[p]);
+  }
+  phases_seen_ = phases.size();
+  (*out)["dropped_jacobian_fraction"] = dropped;
+  if (callbacks.score) {
+    json extra;
+    SFT_RETURN_IF_ERROR(callbacks.score(current_.mesh, &extra));
+    if (extra.is_object()) out->update(extra);
+  }
+  return Status::Ok();
+}
+
+Status Schedule::FinishStage() {
+  const StageOptions& stage = stages_[progress_.stage];
+  char name[256];
+  std::snprintf(name, sizeof(name), "stages/%02d_%s_normals.png", progress_.stage,
+                stage.name.c_str());
+  SFT_RETURN_IF_ERROR(MakeDirectories(JoinPath(out_, "stages")));
+  const Image normals = reconstruction_->RenderNormals(0);
+  SFT_RETURN_IF_ERROR(WritePng(JoinPath(out_, name), NormalColours(normals), /*srgb=*/false));
+  stage_records_.push_back({{"stage", stage.name},
+                            {"index", progress_.stage},
+                            {"end_seconds", Elapsed()},
+                            {"faces", current_.mesh.n_faces()},
+                            {"normals", name}});
+  ++progress_.stage;
+  progress_.stage_outer_done = 0;
+  progress_.stage_prepared = false;
+  return Status::Ok();
+}
+
+Status Schedule::RunStageOuter(const ScheduleCallbacks& callbacks, bool* stop) {
+  const StageOptions& stage = stages_[progress_.stage];
+  SFT_RETURN_IF_ERROR(
+      reconstruction_->RunOuter(progress_.outer_done, [&](const IterationRecord& record) {
+        IterationRecord r = record;
+        r.stage = stage.name;
+        records_.push_back(r);
+        const bool go_on = !callbacks.on_iteration || callbacks.on_iteration(r);
+        *stop = *stop || !go_on;
+        return go_on;
+      }));
+  SyncCurrent();
+  if (!*stop) {
+    ++progress_.outer_done;
+    ++progress_.stage_outer_done;
+  }
+  json record;
+  SFT_RETURN_IF_ERROR(OuterRecord(callbacks, &record));
+  outer_records_.push_back(record);
+  const bool stage_done = progress_.stage_outer_done >= stage.fit.outer_iterations;
+  const int folds = record["flipped_faces"].get<int>() + record["self_intersecting_faces"].get<int>();
+  if (!*stop && !stage_done && stage.topology.resample_fold_fraction > 0.0 &&
+      folds > stage.topology.resample_fold_fraction * current_.mesh.n_faces()) {
+    SFT_RETURN_IF_ERROR(ChangeTopology(TopologyChange::kResample, callbacks));
+    SFT_RETURN_IF_ERROR(CreateReconstruction());
+  }
+  if (!*stop && stage_done) SFT_RETURN_IF_ERROR(FinishStage());
+  return Checkpoint();
+}
+
+Status Schedule::Checkpoint() {
+  progress_.seconds = Elapsed();
+  SFT_RETURN_IF_ERROR(WriteRunSnapshot(out_, *dataset_, current_.mesh, current_.material,
+                                       current_.light_scales));
+  json info = run_info_;
+  info["outer"] = outer_records_;
+  info["topology_changes"] = topology_records_;
+  info["stages"] = stage_records_;
+  SFT_RETURN_IF_ERROR(WriteMetrics(out_, records_, phase_records_, info));
+  RunState state;
+  state.run_info = run_info_;
+  for (const StageOptions& s : stages_) state.stages.push_back(StageJson(s));
+  state.progress = progress_;
+  state.finished = finished();
+  return WriteRunState(out_, state);
+}
+
+Status Schedule::Run(const ScheduleCallbacks& callbacks) {
+  session_start_ = NowSeconds();
+  seconds_at_start_ = progress_.seconds;
+  stopped_ = false;
+  while (!finished()) {
+    if (!progress_.stage_prepared) {
+      SFT_RETURN_IF_ERROR(PrepareStage(callbacks));
+    } else if (!reconstruction_) {
+      SFT_RETURN_IF_ERROR(CreateReconstruction());
+    }
+    bool stop = false;
+    SFT_RETURN_IF_ERROR(RunStageOuter(callbacks, &stop));
+    if (stop) {
+      stopped_ = true;
+      return Status::Ok();
+    }
+  }
+  if (!reconstruction_) {  // resumed a finished run: the report still needs the final state.
+    progress_.stage = static_cast<int>(stages_.size()) - 1;
+    SFT_RETURN_IF_ERROR(CreateReconstruction());
+    progress_.stage = static_cast<int>(stages_.size());
+  }
+  return Status::Ok();
+}
+
+}  // namespace sft

@@ -1,0 +1,142 @@
+// The reconstruction schedule: an ordered list of stages, each a run of outer iterations of one
+// fit (phases, image scale, spp, pyramid, solver, effects: ReconstructOptions) on one topology.
+// Before a stage starts, its topology change (remeshing, resampling) and its texel resolution
+// are applied; the mesh-colour texels carry across by re-projection onto the new surface. Within
+// a stage, an outer iteration that leaves too many folded or self-intersecting faces triggers a
+// resampling. After every outer iteration the run folder receives a checkpoint (state.json,
+// mesh, material, metrics) that `Resume` continues from, also across topology changes.
+//
+// Modelled on a pipeline controller: the CLI configures the stages (schedule_config.h), calls
+// Run with callbacks for progress, console lines and extra per-outer scores, and reports. The
+// stage list, its keys and the built-in schedules are documented in docs/reconstruct.md.
+#ifndef SFT_OPTIM_SCHEDULE_H_
+#define SFT_OPTIM_SCHEDULE_H_
+
+#include <algorithm>
+#include <functional>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "src/core/status.h"
+#include "src/geometry/material.h"
+#include "src/geometry/mesh.h"
+#include "src/io/dataset.h"
+#include "src/optim/reconstruct.h"
+#include "src/optim/topology.h"
+
+namespace sft {
+
+// One stage of the schedule.
+struct StageOptions {
+  std::string name = "refine";  // shown on the progress line, in metrics.json and the report.
+  ReconstructOptions fit;       // phases, outer iterations, steps, spp, image scale, solver...
+  // Mesh-colours resolution of albedo and roughness during the stage, [1, 64]; 0 = keep the
+  // current one. Texels are resampled (same mesh) or re-projected (after a topology change).
+  int texel_resolution = 0;
+  TopologyOptions topology;  // remeshing / resampling before the stage, and on folds.
+  // Slots for the next stages of the project; each accepts its one current value:
+  std::string effect_plan = "fixed";           // "fixed": the effects as configured.
+  std::string material_model = "mesh_colors";  // "mesh_colors": per-face texel grids.
+
+  bool Check(std::string* why) const;
+};
+
+// Where a run stands; state.json records it (format sft-reconstruct-state/2).
+struct ScheduleProgress {
+  int stage = 0;                 // index of the current stage (== stages.size() when finished).
+  int stage_outer_done = 0;      // outer iterations completed within the current stage.
+  bool stage_prepared = false;   // the current stage's topology/texel change has been applied.
+  int outer_done = 0;            // outer iterations completed over all stages (seeds, records).
+  int topology_changes = 0;      // remeshings and resamplings so far.
+  double seconds = 0.0;          // wall time of the run so far, all sessions.
+};
+
+// The state a schedule starts from (or a checkpoint holds).
+struct ScheduleStart {
+  TriMesh mesh;
+  Material material;
+  std::vector<double> light_scales;  // empty = all 1.
+};
+
+struct ScheduleCallbacks {
+  // After every solver iteration; false stops the run after writing a checkpoint.
+  std::function<bool(const IterationRecord&)> on_iteration;
+  // One console line per stage start, topology change and stop.
+  std::function<void(const std::string&)> on_event;
+  // Extra per-outer metrics for the current mesh (e.g. F1 and Chamfer against a reference);
+  // merged into metrics.json's "outer" entries.
+  std::function<Status(const TriMesh&, nlohmann::json*)> score;
+};
+
+class Schedule {
+ public:
+  // A fresh run in `out` (an existing, empty or new folder checked by the caller). `run_info` is
+  // stored in state.json and merged into metrics.json (dataset path, start, flat config keys).
+  static Status Start(const Dataset& dataset, const std::string& out,
+                      const std::vector<StageOptions>& stages, const ScheduleStart& start,
+                      const nlohmann::json& run_info, std::unique_ptr<Schedule>* schedule);
+  // Continues the run in `out` from its checkpoint. `stages` are the run's stages (as state.json
+  // records them, with any overrides applied; their count must match).
+  static Status Resume(const Dataset& dataset, const std::string& out,
+                       const std::vector<StageOptions>& stages, const nlohmann::json& run_info,
+                       const ScheduleProgress& progress, std::unique_ptr<Schedule>* schedule);
+
+  // Runs the remaining stages; writes a checkpoint after every outer iteration and when stopped.
+  Status Run(const ScheduleCallbacks& callbacks);
+
+  bool finished() const { return progress_.stage >= static_cast<int>(stages_.size()); }
+  bool stopped() const { return stopped_; }
+  const ScheduleProgress& progress() const { return progress_; }
+  // The stage running (the last one once finished).
+  const StageOptions& CurrentStage() const {
+    return stages_[std::min<size_t>(progress_.stage, stages_.size() - 1)];
+  }
+  const std::vector<StageOptions>& stages() const { return stages_; }
+  const std::vector<IterationRecord>& records() const { return records_; }
+  const nlohmann::json& outer_records() const { return outer_records_; }
+  const nlohmann::json& stage_records() const { return stage_records_; }
+  // The reconstruction of the stage run last (the final state once finished); null before Run.
+  Reconstruction* reconstruction() { return reconstruction_.get(); }
+  TriMesh Mesh() const { return current_.mesh; }
+
+  // Total solver steps of the remaining work, each weighted by its relative cost (image pixels ×
+  // spp), for a progress line whose ETA holds across stages of different scales.
+  int64_t RemainingWork() const;
+  static int64_t StepWork(const StageOptions& stage);
+
+ private:
+  Schedule() = default;
+  Status PrepareStage(const ScheduleCallbacks& callbacks);
+  Status CreateReconstruction();
+  Status RunStageOuter(const ScheduleCallbacks& callbacks, bool* stop);
+  Status ChangeTopology(TopologyChange change, const ScheduleCallbacks& callbacks);
+  Status OuterRecord(const ScheduleCallbacks& callbacks, nlohmann::json* out);
+  Status FinishStage();
+  Status Checkpoint();
+  void SyncCurrent();
+  double Elapsed() const;  // seconds of the run so far, all sessions.
+
+  const Dataset* dataset_ = nullptr;
+  std::string out_;
+  std::vector<StageOptions> stages_;
+  nlohmann::json run_info_;
+  ScheduleProgress progress_;
+  ScheduleStart current_;  // the state at the last sync (mesh, material, light scales).
+  TriMesh baseline_;       // folded faces are counted against it (reset at topology changes).
+  std::unique_ptr<Reconstruction> reconstruction_;
+  std::vector<IterationRecord> records_;
+  std::vector<PhaseRecord> phase_records_;
+  nlohmann::json outer_records_ = nlohmann::json::array();
+  nlohmann::json topology_records_ = nlohmann::json::array();
+  nlohmann::json stage_records_ = nlohmann::json::array();
+  size_t phases_seen_ = 0;  // phase records of reconstruction_ already collected.
+  double session_start_ = 0.0;  // steady-clock seconds when this session's Run began.
+  double seconds_at_start_ = 0.0;
+  bool stopped_ = false;
+};
+
+}  // namespace sft
+
+#endif  // SFT_OPTIM_SCHEDULE_H_

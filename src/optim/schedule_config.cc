@@ -1,0 +1,247 @@
+#include "src/optim/schedule_config.h"
+
+#include <cmath>
+#include <cstdio>
+#include <functional>
+#include <map>
+
+#include "src/core/file_util.h"
+#include "src/optim/config.h"
+
+namespace sft {
+namespace {
+
+using json = nlohmann::json;
+
+// The built-in stage lists (docs/reconstruct.md, "Built-in schedules").
+// refine: from a given mesh, one stage of the fit's defaults.
+// hull: from a carved hull, the report's shape: alternating texture and geometry at a growing
+// image scale, remeshing between scales, resampling before the full scale, and a final texture
+// stage at full scale with a higher texel resolution.
+const char kRefineSchedule[] = R"([{"name": "refine"}])";
+const char kHullSchedule[] = R"([
+  {"name": "quarter", "image_scale": 0.25, "pyramid_levels": 2, "outer_iterations": 3,
+   "fit_specular": true},
+  {"name": "half", "image_scale": 0.5, "pyramid_levels": 3, "outer_iterations": 3,
+   "remesh": "adaptive", "fit_specular": true},
+  {"name": "full", "image_scale": 1, "outer_iterations": 2, "remesh": "adaptive",
+   "resample": true, "fit_specular": true},
+  {"name": "texture", "phases": "texture", "image_scale": 1, "outer_iterations": 2,
+   "texel_resolution": 3, "fit_specular": true}
+])";
+
+// Stage-only keys: how to apply a value ("" or what is wrong) and read it back.
+struct StageKey {
+  std::function<std::string(const json&, StageOptions*)> set;
+  std::function<json(const StageOptions&)> get;
+};
+
+StageKey OneOf(std::function<std::string&(StageOptions*)> field,
+               std::vector<std::string> allowed, std::string later) {
+  return {[field, allowed, later](const json& v, StageOptions* s) -> std::string {
+            std::string list;
+            for (const std::string& a : allowed) {
+              if (v.is_string() && v.get<std::string>() == a) {
+                field(s) = a;
+                return "";
+              }
+              list += (list.empty() ? "" : ", ") + a;
+            }
+            return "expected " + list + later;
+          },
+          [field](const StageOptions& s) { return json(field(const_cast<StageOptions*>(&s))); }};
+}
+
+StageKey RealIn(std::function<double&(StageOptions*)> field, double lo, double hi, bool open_lo) {
+  return {[=](const json& v, StageOptions* s) -> std::string {
+            const bool ok = v.is_number() && std::isfinite(v.get<double>()) &&
+                            (open_lo ? v.get<double>() > lo : v.get<double>() >= lo) &&
+                            v.get<double>() <= hi;
+            if (!ok) {
+              return std::string("expected a number in ") + (open_lo ? "(" : "[") +
+                     json(lo).dump() + ", " + json(hi).dump() + "]";
+            }
+            field(s) = v.get<double>();
+            return "";
+          },
+          [field](const StageOptions& s) { return json(field(const_cast<StageOptions*>(&s))); }};
+}
+
+const std::map<std::string, StageKey>& StageKeys() {
+  using S = StageOptions;
+  static const std::map<std::string, StageKey> keys = {
+      {"texel_resolution",
+       {[](const json& v, S* s) -> std::string {
+          if (!v.is_number_integer() || v.get<int64_t>() < 0 || v.get<int64_t>() > 64) {
+            return "expected an integer in [0, 64] (0 = keep)";
+          }
+          s->texel_resolution = v.get<int>();
+          return "";
+        },
+        [](const S& s) { return json(s.texel_resolution); }}},
+      {"remesh", OneOf([](S* s) -> std::string& { return s->topology.remesh; },
+                       {"none", "adaptive", "isotropic"}, "")},
+      {"remesh_edge_pixels",
+       RealIn([](S* s) -> double& { return s->topology.remesh_edge_pixels; }, 0, 64, true)},
+      {"resample",
+       {[](const json& v, S* s) -> std::string {
+          if (!v.is_boolean()) return "expected true or false";
+          s->topology.resample = v.get<bool>();
+          return "";
+        },
+        [](const S& s) { return json(s.topology.resample); }}},
+      {"resample_fold_fraction",
+       RealIn([](S* s) -> double& { return s->topology.resample_fold_fraction; }, 0, 1, false)},
+      {"max_faces",
+       {[](const json& v, S* s) -> std::string {
+          if (!v.is_number_integer() || v.get<int64_t>() < 100 || v.get<int64_t>() > 5000000) {
+            return "expected an integer in [100, 5000000]";
+          }
+          s->topology.max_faces = v.get<int>();
+          return "";
+        },
+        [](const S& s) { return json(s.topology.max_faces); }}},
+      {"effect_plan", OneOf([](S* s) -> std::string& { return s->effect_plan; }, {"fixed"},
+                            " (the effect planner is not available yet)")},
+      {"material_model", OneOf([](S* s) -> std::string& { return s->material_model; },
+                               {"mesh_colors"}, " (UV textures are not available yet)")},
+  };
+  return keys;
+}
+
+Status ParseJsonFile(const std::string& path, json* out) {
+  std::string text;
+  SFT_RETURN_IF_ERROR(ReadTextFile(path, &text));
+  *out = json::parse(text, nullptr, /*allow_exceptions=*/false);
+  if (out->is_discarded()) return Status::Error(path + ": not valid JSON");
+  return Status::Ok();
+}
+
+}  // namespace
+
+Status ApplyStageConfig(const json& keys, const std::string& source, StageOptions* stage) {
+  if (!keys.is_object()) return Status::Error(source + ": expected a JSON object");
+  for (const auto& [name, value] : keys.items()) {
+    if (name == "name") {
+      if (!value.is_string() || value.get<std::string>().empty()) {
+        return Status::Error(source + ": name: expected a non-empty string");
+      }
+      stage->name = value.get<std::string>();
+      continue;
+    }
+    const auto it = StageKeys().find(name);
+    if (it != StageKeys().end()) {
+      const std::string why = it->second.set(value, stage);
+      if (!why.empty()) return Status::Error(source + ": " + name + ": " + why);
+      continue;
+    }
+    SFT_RETURN_IF_ERROR(ApplyReconstructConfig({{name, value}}, source, &stage->fit));
+  }
+  return Status::Ok();
+}
+
+Status MergeScheduleConfig(const json& config, const std::string& source, ScheduleConfig* out) {
+  if (!config.is_object()) return Status::Error(source + ": expected a JSON object");
+  for (const auto& [name, value] : config.items()) {
+    if (name == "schedule") {
+      if (!value.is_string() || (value != "auto" && value != "refine" && value != "hull")) {
+        return Status::Error(source + ": schedule: expected auto, refine or hull");
+      }
+      out->schedule = value.get<std::string>();
+    } else if (name == "stages") {
+      if (!value.is_array() || value.empty()) {
+        return Status::Error(source + ": stages: expected a non-empty array of stage objects");
+      }
+      for (size_t k = 0; k < value.size(); ++k) {
+        StageOptions probe;  // checks keys and values now, so errors name the file.
+        const std::string where = source + ": stages[" + std::to_string(k) + "]";
+        SFT_RETURN_IF_ERROR(ApplyStageConfig(value[k], where, &probe));
+      }
+      out->stages = value;
+    } else if (name == "name") {
+      return Status::Error(source + ": name: a stage key (put it inside \"stages\")");
+    } else {
+      StageOptions probe;
+      SFT_RETURN_IF_ERROR(ApplyStageConfig({{name, value}}, source, &probe));
+      out->flat[name] = value;
+    }
+  }
+  return Status::Ok();
+}
+
+Status ReadScheduleConfig(const std::string& path, ScheduleConfig* out) {
+  json config;
+  SFT_RETURN_IF_ERROR(ParseJsonFile(path, &config));
+  return MergeScheduleConfig(config, path, out);
+}
+
+Status ResolveStages(const ScheduleConfig& config, bool carved_start,
+                     std::vector<StageOptions>* stages) {
+  json list = config.stages;
+  std::string source = "stages";
+  if (list.is_null()) {
+    const bool hull = config.schedule == "hull" || (config.schedule == "auto" && carved_start);
+    list = json::parse(hull ? kHullSchedule : kRefineSchedule);
+    source = std::string("built-in schedule ") + (hull ? "hull" : "refine");
+  }
+  stages->clear();
+  for (size_t k = 0; k < list.size(); ++k) {
+    StageOptions stage;
+    stage.name = "stage" + std::to_string(k);
+    const std::string where = source + "[" + std::to_string(k) + "]";
+    SFT_RETURN_IF_ERROR(ApplyStageConfig(list[k], where, &stage));
+    SFT_RETURN_IF_ERROR(ApplyStageConfig(config.flat, "flat keys", &stage));
+    std::string why;
+    if (!stage.Check(&why)) return Status::Error(where + " (" + stage.name + "): " + why);
+    stages->push_back(std::move(stage));
+  }
+  return Status::Ok();
+}
+
+json StageJson(const StageOptions& stage) {
+  json j = ReconstructConfigJson(stage.fit);
+  for (const auto& [name, key] : StageKeys()) j[name] = key.get(stage);
+  j["name"] = stage.name;
+  return j;
+}
+
+Status StagesFromJson(const json& list, const std::string& source,
+                      std::vector<StageOptions>* stages) {
+  if (!list.is_array() || list.empty()) {
+    return Status::Error(source + ": stages: expected a non-empty array");
+  }
+  stages->clear();
+  for (size_t k = 0; k < list.size(); ++k) {
+    StageOptions stage;
+    const std::string where = source + ": stages[" + std::to_string(k) + "]";
+    SFT_RETURN_IF_ERROR(ApplyStageConfig(list[k], where, &stage));
+    std::string why;
+    if (!stage.Check(&why)) return Status::Error(where + ": " + why);
+    stages->push_back(std::move(stage));
+  }
+  return Status::Ok();
+}
+
+std::string FormatSchedule(const std::vector<StageOptions>& stages) {
+  std::string text =
+      "stage  name        phases     scale   spp  levels  outer  steps  texels  solver  "
+      "before\n";
+  for (size_t k = 0; k < stages.size(); ++k) {
+    const StageOptions& s = stages[k];
+    const ReconstructOptions& f = s.fit;
+    std::string before;
+    if (s.topology.remesh != "none") before += "remesh " + s.topology.remesh;
+    if (s.topology.resample) before += std::string(before.empty() ? "" : ", ") + "resample";
+    if (before.empty()) before = "-";
+    char line[256];
+    std::snprintf(line, sizeof(line), "%5zu  %-10s  %-9s  1/%-4d %4d  %6d  %5d  %5d  %6s  %-6s  %s\n",
+                  k, s.name.c_str(), PhaseScheduleName(f.phases), 1 << f.cache.image_scale_log2,
+                  f.cache.render.spp, f.cache.pyramid_levels, f.outer_iterations, f.solver.steps,
+                  s.texel_resolution > 0 ? std::to_string(s.texel_resolution).c_str() : "keep",
+                  SolverKindName(f.solver.kind), before.c_str());
+    text += line;
+  }
+  return text;
+}
+
+}  // namespace sft

@@ -1,0 +1,56 @@
+// The schedule's configuration (docs/reconstruct.md): one JSON object of
+//   - flat keys (every key of config.h's list and every stage key below except "name"): they
+//     override the same key in every stage, as the command-line flags do;
+//   - "schedule": a built-in stage list, "auto" (default: "hull" when the run starts from a
+//     carved hull, "refine" otherwise), "refine" or "hull";
+//   - "stages": an explicit stage list (an array of objects) instead of a built-in one.
+// A stage object holds any flat key plus "name", and the stage-only keys "texel_resolution",
+// "remesh", "remesh_edge_pixels", "resample", "resample_fold_fraction", "effect_plan" and
+// "material_model". A stage's options are: defaults < the stage's keys < the flat keys.
+// Errors name the file, the stage and the key ("cfg.json: stages[1].remesh: expected none,
+// adaptive or isotropic").
+#ifndef SFT_OPTIM_SCHEDULE_CONFIG_H_
+#define SFT_OPTIM_SCHEDULE_CONFIG_H_
+
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "src/core/status.h"
+#include "src/optim/schedule.h"
+
+namespace sft {
+
+struct ScheduleConfig {
+  std::string schedule = "auto";                   // auto | refine | hull.
+  nlohmann::json stages;                           // explicit list; null = the built-in one.
+  nlohmann::json flat = nlohmann::json::object();  // keys that override every stage.
+};
+
+// Adds `config`'s keys to *out (later calls override earlier ones key by key; "stages" and
+// "schedule" replace). Checks every key and value; `source` names the file in errors.
+Status MergeScheduleConfig(const nlohmann::json& config, const std::string& source,
+                           ScheduleConfig* out);
+Status ReadScheduleConfig(const std::string& path, ScheduleConfig* out);
+
+// The stage list: the explicit or built-in stages (`carved_start` picks "auto"'s), each with the
+// flat keys applied, checked.
+Status ResolveStages(const ScheduleConfig& config, bool carved_start,
+                     std::vector<StageOptions>* stages);
+
+// Applies stage keys (a stage object or flat keys) to one stage.
+Status ApplyStageConfig(const nlohmann::json& keys, const std::string& source,
+                        StageOptions* stage);
+
+// Every key of a stage with its value (ApplyStageConfig of it reproduces the stage).
+nlohmann::json StageJson(const StageOptions& stage);
+// Stages from StageJson objects (state.json's "stages").
+Status StagesFromJson(const nlohmann::json& list, const std::string& source,
+                      std::vector<StageOptions>* stages);
+
+// The effective stage list as a table (`sft reconstruct --print-schedule`).
+std::string FormatSchedule(const std::vector<StageOptions>& stages);
+
+}  // namespace sft
+
+#endif  // SFT_OPTIM_SCHEDULE_CONFIG_H_
