@@ -73,7 +73,9 @@ TEST(ReconstructCliTest, ReconstructEvalResume) {
   const nlohmann::json state = nlohmann::json::parse(ReadAll(tmp.Join("r/state.json")));
   EXPECT_EQ(state["outer_done"], 2);
   EXPECT_TRUE(state["finished"].get<bool>());
-  EXPECT_EQ(state["init"], tmp.Join("init.ply"));
+  EXPECT_EQ(state["run"]["init"], tmp.Join("init.ply"));
+  EXPECT_EQ(state["run"]["start"], "init");
+  EXPECT_EQ(state["format"], "sft-reconstruct-state/2");
 
   // eval, both modes.
   ASSERT_EQ(RunSft("eval --dataset " + tmp.Join("ds") + " --reconstruction " + tmp.Join("r") +
@@ -103,23 +105,28 @@ TEST(ReconstructCliTest, ReconstructEvalResume) {
 }
 
 // Ctrl-C: the run stops after the current iteration, writes its checkpoint and exits 130;
-// --resume continues from it.
+// --resume continues from it. The signal is sent once the first checkpoint exists (not after a
+// fixed delay, which races with slow builds).
 TEST(ReconstructCliTest, InterruptWritesACheckpointAndResumes) {
   testing::TempDir tmp;
   ASSERT_EQ(testing::SynthIcosphere(tmp.Join("ds"), "--cameras 2 --zooms 1 --res 16 --spp 8"), "");
   std::string out;
-  // SIGINT after 3 s into a run that would take minutes (`timeout` passes on the exit status).
-  const int code =
-      testing::RunCommand("timeout --preserve-status -s INT 3 " + testing::SftBinary() +
-                              " reconstruct --quiet --dataset " + tmp.Join("ds") + " --init " +
-                              tmp.Join("ds/gt/mesh.ply") + " --out " + tmp.Join("r") +
-                              " --outer 10000 --steps 2 --spp 4 --bounces 1 --phases texture",
-                          &out);
-  EXPECT_EQ(code, 130) << out;
+  const std::string run = testing::SftBinary() + " reconstruct --quiet --dataset " +
+                          tmp.Join("ds") + " --init " + tmp.Join("ds/gt/mesh.ply") + " --out " +
+                          tmp.Join("r") +
+                          " --outer 10000 --steps 2 --spp 4 --bounces 1 --phases texture";
+  // Waits (at most 120 s) for state.json, then interrupts; prints the run's exit status last.
+  const std::string script = run + " & pid=$!; for i in $(seq 1200); do [ -f " +
+                             tmp.Join("r/state.json") +
+                             " ] && break; sleep 0.1; done; kill -INT $pid; wait $pid; "
+                             "echo \"exit=$?\"";
+  ASSERT_EQ(testing::RunCommand("bash -c '" + script + "'", &out), 0) << out;
+  EXPECT_THAT(out, HasSubstr("exit=130"));
   EXPECT_THAT(out, HasSubstr("--resume"));
   const nlohmann::json state = nlohmann::json::parse(ReadAll(tmp.Join("r/state.json")));
   EXPECT_FALSE(state["finished"].get<bool>());
   const int done = state["outer_done"].get<int>();
+  EXPECT_GE(done, 1);
   EXPECT_TRUE(fs::exists(tmp.Join("r/mesh.ply")));
   ASSERT_EQ(RunSft("reconstruct --quiet --resume " + tmp.Join("r") + " --outer " +
                        std::to_string(done + 1) + " --no-report",
@@ -129,6 +136,25 @@ TEST(ReconstructCliTest, InterruptWritesACheckpointAndResumes) {
   const nlohmann::json resumed = nlohmann::json::parse(ReadAll(tmp.Join("r/state.json")));
   EXPECT_EQ(resumed["outer_done"].get<int>(), done + 1);
   EXPECT_TRUE(resumed["finished"].get<bool>());
+}
+
+// --print-schedule prints the effective stages and writes nothing: the built-in "refine" list
+// with --init, the "hull" list when the start would be carved (no --init, no initial_mesh, masks),
+// and flags applied to every stage.
+TEST(ReconstructCliTest, PrintScheduleFollowsTheStart) {
+  testing::TempDir tmp;
+  ASSERT_EQ(testing::SynthIcosphere(tmp.Join("ds"), "--cameras 2 --zooms 1 --res 8 --spp 2"), "");
+  std::string out;
+  const std::string base = "reconstruct --dataset " + tmp.Join("ds") + " --print-schedule";
+  ASSERT_EQ(RunSft(base + " --init " + tmp.Join("ds/gt/mesh.ply") + " --spp 7", &out), 0) << out;
+  EXPECT_THAT(out, HasSubstr("refine"));
+  EXPECT_THAT(out, HasSubstr("   7 "));
+  EXPECT_EQ(CountLines(out), 2) << out;
+  ASSERT_EQ(RunSft(base + " --out " + tmp.Join("o"), &out), 0) << out;
+  EXPECT_THAT(out, HasSubstr("remesh"));
+  EXPECT_THAT(out, HasSubstr("1/4"));
+  EXPECT_GE(CountLines(out), 4) << out;
+  EXPECT_FALSE(fs::exists(tmp.Join("o")));
 }
 
 TEST(ReconstructCliTest, BadInputIsOneLine) {
@@ -152,6 +178,14 @@ TEST(ReconstructCliTest, BadInputIsOneLine) {
   EXPECT_EQ(RunSft("reconstruct --quiet --resume " + tmp.Join("nothing"), &out), 1);
   EXPECT_THAT(out, HasSubstr("state.json"));
   EXPECT_FALSE(fs::exists(tmp.Join("o/state.json")));
+  // A checkpoint of an older version is refused with one line.
+  fs::create_directories(tmp.Join("old"));
+  testing::WriteTestFile(tmp.Join("old/state.json"),
+                         "{\"format\": \"sft-reconstruct-state/1\", \"dataset\": \"" +
+                             tmp.Join("ds") + "\", \"config\": {}, \"outer_done\": 1}");
+  EXPECT_EQ(RunSft("reconstruct --quiet --resume " + tmp.Join("old"), &out), 1);
+  EXPECT_THAT(out, HasSubstr("sft-reconstruct-state/1"));
+  EXPECT_EQ(CountLines(out), 1) << out;
 }
 
 }  // namespace

@@ -1,0 +1,291 @@
+// The schedule: stage lists from the config (keys, precedence, errors, built-in lists), the image
+// scale of a stage (targets and cameras downscaled consistently), and runs of several stages with
+// texel-resolution changes, checkpoints and resume.
+#include "src/optim/schedule.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "src/geometry/material.h"
+#include "src/io/dataset.h"
+#include "src/optim/run_outputs.h"
+#include "src/optim/schedule_config.h"
+#include "tests/testing/synth_dataset.h"
+#include "tests/testing/temp_dir.h"
+
+namespace sft {
+namespace {
+
+using json = nlohmann::json;
+using ::testing::HasSubstr;
+
+TEST(ScheduleConfigTest, FlatKeysOverrideEveryStage) {
+  ScheduleConfig config;
+  ASSERT_TRUE(MergeScheduleConfig(json::parse(R"({
+      "spp": 24,
+      "stages": [{"name": "a", "image_scale": 0.5, "spp": 8, "texel_resolution": 2},
+                 {"name": "b", "phases": "texture", "outer_iterations": 3}]})"),
+                                  "cfg", &config)
+                  .ok());
+  std::vector<StageOptions> stages;
+  ASSERT_TRUE(ResolveStages(config, /*carved_start=*/false, &stages).ok());
+  ASSERT_EQ(stages.size(), 2u);
+  EXPECT_EQ(stages[0].name, "a");
+  EXPECT_EQ(stages[0].fit.cache.image_scale_log2, 1);
+  EXPECT_EQ(stages[0].fit.cache.render.spp, 24);  // the flat key wins over the stage's 8.
+  EXPECT_EQ(stages[0].texel_resolution, 2);
+  EXPECT_EQ(stages[1].fit.phases, PhaseSchedule::kTexture);
+  EXPECT_EQ(stages[1].fit.outer_iterations, 3);
+  EXPECT_EQ(stages[1].fit.cache.render.spp, 24);
+  EXPECT_EQ(stages[1].fit.cache.image_scale_log2, 0);  // the default, not stage a's.
+  // StageJson round-trips.
+  std::vector<StageOptions> again;
+  ASSERT_TRUE(StagesFromJson(json::array({StageJson(stages[0]), StageJson(stages[1])}), "state",
+                             &again)
+                  .ok());
+  EXPECT_EQ(StageJson(again[0]), StageJson(stages[0]));
+  EXPECT_EQ(StageJson(again[1]), StageJson(stages[1]));
+  const std::string table = FormatSchedule(stages);
+  EXPECT_THAT(table, HasSubstr("1/2"));
+  EXPECT_EQ(std::count(table.begin(), table.end(), '\n'), 3);
+}
+
+TEST(ScheduleConfigTest, BuiltInListsFollowTheStart) {
+  ScheduleConfig config;
+  std::vector<StageOptions> stages;
+  ASSERT_TRUE(ResolveStages(config, /*carved_start=*/false, &stages).ok());
+  ASSERT_EQ(stages.size(), 1u);
+  EXPECT_EQ(stages[0].name, "refine");
+  ASSERT_TRUE(ResolveStages(config, /*carved_start=*/true, &stages).ok());
+  ASSERT_GE(stages.size(), 3u);
+  EXPECT_EQ(stages.front().fit.cache.image_scale_log2, 2);  // coarse to fine.
+  EXPECT_EQ(stages.back().fit.cache.image_scale_log2, 0);
+  EXPECT_EQ(stages.back().fit.phases, PhaseSchedule::kTexture);
+  EXPECT_GT(stages.back().texel_resolution, 1);
+  // "schedule": "hull" picks the hull list from any start.
+  ASSERT_TRUE(MergeScheduleConfig({{"schedule", "hull"}}, "cfg", &config).ok());
+  ASSERT_TRUE(ResolveStages(config, /*carved_start=*/false, &stages).ok());
+  EXPECT_GE(stages.size(), 3u);
+}
+
+TEST(ScheduleConfigTest, ErrorsNameTheStageAndKey) {
+  const auto error = [](const std::string& text) {
+    ScheduleConfig config;
+    const Status status = MergeScheduleConfig(json::parse(text), "cfg.json", &config);
+    return status.ok() ? std::string("ok") : status.message();
+  };
+  EXPECT_EQ(error(R"({"stages": [{"spp": 4}, {"remesh": "magic"}]})"),
+            "cfg.json: stages[1]: remesh: expected none, adaptive or isotropic");
+  EXPECT_EQ(error(R"({"stages": [{"image_scale": 0.3}]})"),
+            "cfg.json: stages[0]: image_scale: expected 1, 0.5, 0.25, 0.125, 0.0625, 0.03125 or "
+            "0.015625");
+  EXPECT_THAT(error(R"({"stages": [{"stepz": 1}]})"), HasSubstr("stages[0]: stepz: unknown key"));
+  EXPECT_THAT(error(R"({"stages": []})"), HasSubstr("stages: expected a non-empty array"));
+  EXPECT_THAT(error(R"({"schedule": "fast"})"), HasSubstr("schedule: expected auto"));
+  EXPECT_THAT(error(R"({"name": "x"})"), HasSubstr("name: a stage key"));
+  EXPECT_THAT(error(R"({"effect_plan": "auto"})"), HasSubstr("effect_plan: expected fixed"));
+  EXPECT_THAT(error(R"({"texel_resolution": 65})"), HasSubstr("texel_resolution"));
+}
+
+std::string ReadAll(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+// A textured icosphere at 32², 4 views, flash-lit, one segment.
+class ScheduleRunTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = new testing::TempDir();
+    ASSERT_EQ(testing::SynthIcosphere(
+                  dir_->Join("ds"),
+                  "--cameras 4 --zooms 1 --res 32 --spp 64 --bounces 1 --material "
+                  "'{\"procedural\": \"noise\", \"colors\": [[0.8, 0.3, 0.2], [0.2, 0.5, 0.7]], "
+                  "\"roughness\": 0.5, \"specular\": 0, \"resolution\": 2}'"),
+              "");
+  }
+  static void TearDownTestSuite() {
+    delete dir_;
+    dir_ = nullptr;
+  }
+  void SetUp() override {
+    ASSERT_TRUE(ReadDataset(dir_->Join("ds"), &dataset_).ok());
+    ASSERT_TRUE(ReadMesh(dir_->Join("ds/gt/mesh.ply"), &start_.mesh).ok());
+    ASSERT_TRUE(
+        LoadMaterial(R"({"albedo": [0.5, 0.5, 0.5], "roughness": 0.5})", start_.mesh,
+                     &start_.material)
+            .ok());
+  }
+  std::vector<StageOptions> Stages(const std::string& text) {
+    ScheduleConfig config;
+    EXPECT_TRUE(MergeScheduleConfig(json::parse(text), "test", &config).ok());
+    std::vector<StageOptions> stages;
+    EXPECT_TRUE(ResolveStages(config, false, &stages).ok());
+    return stages;
+  }
+
+  static testing::TempDir* dir_;
+  Dataset dataset_;
+  ScheduleStart start_;
+};
+
+testing::TempDir* ScheduleRunTest::dir_ = nullptr;
+
+// At the true mesh and material, a render at half scale matches the half-scale target as well
+// as a full-scale render matches the full-scale target: the camera and the target are scaled
+// consistently (a half-pixel shift of the principal point would cost several dB at the edges).
+TEST_F(ScheduleRunTest, HalfScaleTargetsMatchHalfScaleRenders) {
+  Material truth;
+  ASSERT_TRUE(LoadMaterial(dir_->Join("ds/gt/material.json"), start_.mesh, &truth).ok());
+  double psnr[2];
+  for (int k = 0; k < 2; ++k) {
+    ReconstructOptions options;
+    options.cache.render.spp = 64;
+    options.cache.render.bounces = 1;
+    options.cache.image_scale_log2 = k;
+    std::unique_ptr<Reconstruction> r;
+    ASSERT_TRUE(Reconstruction::Create(dataset_, start_.mesh, truth, {}, options, &r).ok());
+    const std::vector<Image> renders = r->RenderViews(7);
+    EXPECT_EQ(renders[0].width, 32 >> k);
+    EXPECT_EQ(r->cache().Target(0).width, 32 >> k);
+    double mse = 0.0;
+    for (double m : r->cache().ViewMse()) mse += m / r->cache().num_views();
+    psnr[k] = PsnrFromMse(mse);
+  }
+  EXPECT_GT(psnr[0], 28.0);
+  // Half scale averages 4 pixels: less noise, so at least as good.
+  EXPECT_GT(psnr[1], psnr[0] - 0.5) << psnr[0] << " " << psnr[1];
+}
+
+// Two stages: texture at half scale, then texture at full scale with twice the texel
+// resolution. The run records both, changes the texel resolution, lowers the cost, writes the
+// stage images; a resumed finished run does nothing; the state is format 2.
+TEST_F(ScheduleRunTest, StagesRunInOrderWithCheckpoints) {
+  testing::TempDir out;
+  const auto stages = Stages(R"({"spp": 8, "bounces": 1, "steps": 3, "phases": "texture",
+      "stages": [{"name": "coarse", "image_scale": 0.5, "outer_iterations": 2},
+                 {"name": "fine", "texel_resolution": 2, "outer_iterations": 1}]})");
+  std::unique_ptr<Schedule> schedule;
+  ASSERT_TRUE(Schedule::Start(dataset_, out.Join("r"), stages, start_, {{"dataset", "ds"}},
+                              &schedule)
+                  .ok());
+  std::vector<std::string> events;
+  ScheduleCallbacks callbacks;
+  callbacks.on_event = [&](const std::string& line) { events.push_back(line); };
+  const int64_t work = schedule->RemainingWork();
+  int64_t done = 0;
+  callbacks.on_iteration = [&](const IterationRecord& r) {
+    done += Schedule::StepWork(schedule->CurrentStage());
+    return true;
+  };
+  ASSERT_TRUE(schedule->Run(callbacks).ok());
+  EXPECT_TRUE(schedule->finished());
+  EXPECT_EQ(done, work);  // every iteration ran and the weights add up to the ETA's total.
+  ASSERT_EQ(events.size(), 2u);
+  EXPECT_THAT(events[0], HasSubstr("stage 1/2 coarse"));
+  EXPECT_THAT(events[1], HasSubstr("stage 2/2 fine"));
+  const auto& records = schedule->records();
+  ASSERT_FALSE(records.empty());
+  EXPECT_EQ(records.front().stage, "coarse");
+  EXPECT_EQ(records.back().stage, "fine");
+  EXPECT_EQ(records.back().outer, 2);
+  EXPECT_LT(records.back().cost, records.front().cost * 2.0);  // costs differ by scale; finite.
+  EXPECT_EQ(schedule->reconstruction()->CurrentMaterial().albedo.resolution(), 2);
+
+  RunState state;
+  ASSERT_TRUE(ReadRunState(out.Join("r"), &state).ok());
+  EXPECT_EQ(state.progress.stage, 2);
+  EXPECT_EQ(state.progress.outer_done, 3);
+  EXPECT_TRUE(state.finished);
+  EXPECT_TRUE(std::filesystem::exists(out.Join("r/stages/00_coarse_normals.png")));
+  EXPECT_TRUE(std::filesystem::exists(out.Join("r/stages/01_fine_normals.png")));
+  const json metrics = json::parse(ReadAll(out.Join("r/metrics.json")));
+  EXPECT_EQ(metrics["outer"].size(), 3u);
+  EXPECT_EQ(metrics["outer"][0]["stage"], "coarse");
+  EXPECT_EQ(metrics["outer"][0]["self_intersecting_faces"], 0);
+  EXPECT_EQ(metrics["stages"].size(), 2u);
+
+  // Texel resolution in the checkpoint: the material file carries resolution 2.
+  TriMesh mesh;
+  Material material;
+  std::vector<double> scales;
+  ASSERT_TRUE(ReadRunSnapshot(out.Join("r"), dataset_, &mesh, &material, &scales).ok());
+  EXPECT_EQ(material.albedo.resolution(), 2);
+
+  // Resuming a finished run runs nothing and keeps the records.
+  std::unique_ptr<Schedule> resumed;
+  ASSERT_TRUE(Schedule::Resume(dataset_, out.Join("r"), stages, state.run_info, state.progress,
+                               &resumed)
+                  .ok());
+  int iterations = 0;
+  callbacks.on_iteration = [&](const IterationRecord&) { return ++iterations > 0; };
+  ASSERT_TRUE(resumed->Run(callbacks).ok());
+  EXPECT_EQ(iterations, 0);
+  EXPECT_EQ(resumed->records().size(), records.size());
+}
+
+// A stop in the middle of stage 1 writes a checkpoint; resuming finishes exactly the remaining
+// outer iterations, with the same total as an uninterrupted run.
+TEST_F(ScheduleRunTest, StopAndResumeMidStage) {
+  testing::TempDir out;
+  const auto stages = Stages(R"({"spp": 4, "bounces": 1, "steps": 2, "phases": "texture",
+      "stages": [{"name": "a", "image_scale": 0.5, "outer_iterations": 1},
+                 {"name": "b", "outer_iterations": 3}]})");
+  std::unique_ptr<Schedule> schedule;
+  ASSERT_TRUE(Schedule::Start(dataset_, out.Join("r"), stages, start_, {{"dataset", "ds"}},
+                              &schedule)
+                  .ok());
+  ScheduleCallbacks callbacks;
+  int calls = 0;
+  // Stop at stage b's first iteration after its first outer iteration finished.
+  callbacks.on_iteration = [&](const IterationRecord& r) {
+    ++calls;
+    return !(r.stage == "b" && r.outer == 2);
+  };
+  ASSERT_TRUE(schedule->Run(callbacks).ok());
+  EXPECT_TRUE(schedule->stopped());
+  RunState state;
+  ASSERT_TRUE(ReadRunState(out.Join("r"), &state).ok());
+  EXPECT_EQ(state.progress.stage, 1);
+  EXPECT_EQ(state.progress.stage_outer_done, 1);
+  EXPECT_TRUE(state.progress.stage_prepared);
+  EXPECT_FALSE(state.finished);
+
+  std::unique_ptr<Schedule> resumed;
+  ASSERT_TRUE(Schedule::Resume(dataset_, out.Join("r"), stages, state.run_info, state.progress,
+                               &resumed)
+                  .ok());
+  std::vector<int> outers;
+  callbacks.on_iteration = [&](const IterationRecord& r) {
+    outers.push_back(r.outer);
+    return true;
+  };
+  ASSERT_TRUE(resumed->Run(callbacks).ok());
+  EXPECT_TRUE(resumed->finished());
+  ASSERT_FALSE(outers.empty());
+  EXPECT_EQ(outers.front(), 2);  // the interrupted outer iteration runs again.
+  EXPECT_EQ(outers.back(), 3);
+  EXPECT_EQ(resumed->progress().outer_done, 4);
+}
+
+TEST(RunStateTest, OlderFormatIsRefusedWithOneLine) {
+  testing::TempDir dir;
+  testing::WriteTestFile(dir.Join("state.json"),
+                         R"({"format": "sft-reconstruct-state/1", "dataset": "d", "config": {},
+                             "outer_done": 1})");
+  RunState state;
+  const Status status = ReadRunState(dir.path(), &state);
+  ASSERT_FALSE(status.ok());
+  EXPECT_THAT(status.message(), HasSubstr("sft-reconstruct-state/1"));
+  EXPECT_THAT(status.message(), HasSubstr("older sft"));
+  EXPECT_EQ(status.message().find('\n'), std::string::npos);
+}
+
+}  // namespace
+}  // namespace sft
