@@ -1,6 +1,5 @@
 // The spatially varying material: diffuse albedo (RGB) and GGX roughness stored as mesh colors,
-// plus a global specular weight (DESIGN.md §2.3). BSDF f = albedo/π +
-// specular·D·G1·G1/(4|n·wi||n·wo|).
+// plus a global specular weight. BSDF f = albedo/π + specular·D·G1·G1/(4|n·wi||n·wo|).
 #ifndef SFT_GEOMETRY_MATERIAL_H_
 #define SFT_GEOMETRY_MATERIAL_H_
 
@@ -25,8 +24,8 @@ struct Material {
 Material ConstantMaterial(int num_faces, const Eigen::Vector3d& albedo, double roughness,
                           double specular, int resolution = 1);
 
-// Builds a material from `spec`: the path of a JSON file, or inline JSON (first non-space
-// character '{'). Forms (DESIGN.md issue 2):
+// Builds a material from `spec`: the path of a JSON file, or inline JSON (first non-space character
+// '{'). Forms (docs/cli.md, "Materials"):
 //   {"albedo": [r,g,b], "roughness": x, "specular": s}                       constants
 //   {"albedo_texture": "tex.png", "colorspace": "linear"|"srgb", "roughness": x, "specular": s,
 //    "resolution": r}   sampled from the mesh's per-corner UVs (the mesh must have them)
