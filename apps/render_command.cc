@@ -339,7 +339,7 @@ CommandRunner SetupRenderCommand(CLI::App* app) {
   app->add_option("--dataset", opts->dataset, "Dataset directory (sft-dataset/1)")->required();
   app->add_option("--mesh", opts->mesh, "Mesh to render (OBJ, PLY, OFF)")->required();
   app->add_option("--material", opts->material,
-                  "Material: JSON file or inline JSON (see README); default albedo 0.7");
+                  "Material: JSON file or inline JSON (see docs/cli.md); default albedo 0.7");
   app->add_option("--out", opts->out, "Output directory; images go to OUT/images/")->required();
   app->add_option("--lights", opts->lights,
                   "Light scales to apply (lights.json written by sft reconstruct)");

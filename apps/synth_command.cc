@@ -1,11 +1,11 @@
-// sft synth: renders a synthetic dataset of a mesh in the report's setup (DESIGN.md §1): cameras
-// on a Fibonacci sphere (or an orbit, --path orbit) looking at the object, one or more zoom
-// levels, a camera-attached point light (or an environment probe), black background, masks from
-// pixel coverage, and the ground truth (normalized mesh and material) under gt/. --ground adds a
-// textured ground plane seen in the images only (src/io/synth_scene.h).
+// sft synth: renders a synthetic dataset of a mesh in the report's setup: cameras on a Fibonacci
+// sphere (or an orbit, --path orbit) looking at the object, one or more zoom levels, a
+// camera-attached point light (or an environment probe), black background, masks from pixel
+// coverage, and the ground truth (normalized mesh and material) under gt/. --ground adds a textured
+// ground plane seen in the images only (src/io/synth_scene.h).
 //
-// Decisions (README "sft synth"): the mesh is centred on its bounding-box centre and scaled to a
-// bounding-box diagonal of 1 (--no-normalize keeps it as is); --up-axis y rotates y-up meshes to
+// Decisions (docs/cli.md "sft synth"): the mesh is centred on its bounding-box centre and scaled to
+// a bounding-box diagonal of 1 (--no-normalize keeps it as is); --up-axis y rotates y-up meshes to
 // the z-up world (x, y, z) -> (x, −z, y) as the Cycles dataset tool does; the camera distance puts
 // the bounding sphere at --fill of the half-image at zoom 1; zoom z multiplies the focal length.
 // The default light intensity gives a white Lambertian patch facing the camera at the object's

@@ -1,5 +1,5 @@
-// Google Benchmark: how the coarse levels of the residual pyramid get their Jacobian rows (issue
-// 11 item 1, DESIGN.md §2.2). The bunny (5k faces) at 128², 1 path segment, vertex derivatives
+// Google Benchmark: how the coarse levels of the residual pyramid get their Jacobian rows (issue 11
+// item 1, docs/reconstruct.md). The bunny (5k faces) at 128², 1 path segment, vertex derivatives
 // with edge sampling (reconstruction's geometry phase), 4 levels:
 //   BM_PyramidChildRows        one level-0 render with rows; coarse rows are means of child rows.
 //   BM_PyramidPerLevelRenders  each coarse level l rendered on its own with a camera of 2^-l the

@@ -1,4 +1,4 @@
-// The image residual of one pyramid pixel (DESIGN.md §2.2): for view v, level l, pixel p,
+// The image residual of one pyramid pixel (docs/reconstruct.md): for view v, level l, pixel p,
 //
 //   r_c = √w_l · (P_l(I(θ))_pc − P_l(T)_pc),   c ∈ {R, G, B},
 //

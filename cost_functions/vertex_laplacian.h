@@ -1,5 +1,5 @@
-// Laplacian regulariser on vertex positions (DESIGN.md §2.2: the Gauss–Newton analogue of "Large
-// Steps" preconditioning).
+// Laplacian regulariser on vertex positions (the Gauss–Newton analogue of "Large Steps"
+// preconditioning).
 //
 // Residual (3 residuals, one per coordinate), for vertex i with one-ring neighbours j = 1..n:
 //

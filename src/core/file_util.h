@@ -42,7 +42,7 @@ Status MakeDirectories(const std::string& path);
 
 bool FileExists(const std::string& path);
 
-// Whether `path` may name a file inside a dataset (DESIGN.md §2.5): non-empty, relative, and
+// Whether `path` may name a file inside a dataset (docs/dataset.md): non-empty, relative, and
 // without a ".." component, so that joining it to the dataset folder (or mirroring it under an
 // output folder) can never leave that folder. Otherwise false with the reason in *why.
 bool IsContainedRelativePath(const std::string& path, std::string* why);

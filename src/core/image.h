@@ -1,6 +1,6 @@
 // Image: a float image, row-major with interleaved channels (1 = grey/mask, 3 = RGB, 4 = RGBA).
 // Values are linear radiance for renders and decoded photographs; row 0 is the top row and pixel
-// (x, y) covers [x, x+1] x [y, y+1] in image coordinates (DESIGN.md §2.5).
+// (x, y) covers [x, x+1] x [y, y+1] in image coordinates (docs/dataset.md).
 #ifndef SFT_CORE_IMAGE_H_
 #define SFT_CORE_IMAGE_H_
 

@@ -1,6 +1,6 @@
 // Counter-based random numbers. Every sample is a pure function of (seed, view, pixel, sample,
 // dimension), so an image is bit-for-bit identical for any thread count or scheduling, and a
-// derivative pass can replay exactly the paths of the forward pass (DESIGN.md §2.3).
+// derivative pass can replay exactly the paths of the forward pass.
 #ifndef SFT_CORE_RNG_H_
 #define SFT_CORE_RNG_H_
 

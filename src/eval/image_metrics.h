@@ -1,5 +1,5 @@
-// Image quality of re-renders against reference images over a mask (DESIGN.md §1 step 6: PSNR and
-// SSIM of full, albedo and roughness re-renders).
+// Image quality of re-renders against reference images over a mask (`sft eval`: PSNR and SSIM of
+// full, albedo and roughness re-renders, docs/cli.md).
 //
 // Both measures compare the first min(channels, 3) channels (RGB, or grey); alpha is ignored. The
 // mask (optional: an empty Image means every pixel) has one channel, and a pixel counts when its

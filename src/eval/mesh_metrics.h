@@ -1,5 +1,5 @@
-// Geometric accuracy of a reconstructed mesh against a reference mesh (DESIGN.md §1 step 6): F1 at
-// a distance tolerance, and the Chamfer distance.
+// Geometric accuracy of a reconstructed mesh against a reference mesh (`sft eval --reference`): F1
+// at a distance tolerance, and the Chamfer distance.
 //
 // Units. Both meshes are first mapped by the same similarity, p ↦ (p − c)/D, where c is the centre
 // and D the diagonal of the *reference*'s bounding box, so every distance and the tolerance are

@@ -1,4 +1,4 @@
-// The mesh type (OpenMesh TriMesh with double-precision points, DESIGN.md §2.4) and mesh files.
+// The mesh type (OpenMesh TriMesh with double-precision points) and mesh files.
 #ifndef SFT_GEOMETRY_MESH_H_
 #define SFT_GEOMETRY_MESH_H_
 

@@ -1,5 +1,5 @@
-// Visual-hull carving from masks (DESIGN.md §2.4, docs/init.md): the signed field whose negative
-// part is the set of points that project inside the mask of every view that sees them.
+// Visual-hull carving from masks (docs/init.md): the signed field whose negative part is the set of
+// points that project inside the mask of every view that sees them.
 //
 // The field. Each view's mask becomes a signed distance map in pixels (negative inside, zero
 // half-way between an object pixel's centre and a background pixel's centre; OpenCV's exact

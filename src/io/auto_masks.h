@@ -39,7 +39,7 @@ struct AutoMaskOptions {
   bool Check(std::string* why) const;
 };
 
-// Segments view `index` of `dataset` (world frame normalised, DESIGN.md §2.5) using the world
+// Segments view `index` of `dataset` (world frame normalised, docs/import.md) using the world
 // points `sparse`; `mask` becomes a 1-channel image of 0/1 of the camera's size.
 Status AutoMask(const Dataset& dataset, int index, const std::vector<Eigen::Vector3d>& sparse,
                 const AutoMaskOptions& options, Image* mask);

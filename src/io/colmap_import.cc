@@ -148,7 +148,7 @@ Status ImportMask(const std::string& masks, const std::string& name, const Camer
                          std::to_string(camera.width) + "x" + std::to_string(camera.height));
   }
   cv::Mat binary;
-  cv::threshold(mat, binary, 127, 255, cv::THRESH_BINARY);  // > 127 = object (DESIGN.md §2.5).
+  cv::threshold(mat, binary, 127, 255, cv::THRESH_BINARY);  // > 127 = object (docs/dataset.md).
   bits->width = binary.cols;
   bits->height = binary.rows;
   bits->inside.assign(binary.datastart, binary.dataend);

@@ -1,5 +1,5 @@
 // `sft import colmap`: a COLMAP sparse model (text or binary) and its images become an
-// sft-dataset/1 (DESIGN.md §2.5) with the optional import keys of docs/import.md
+// sft-dataset/1 (docs/dataset.md) with the optional import keys of docs/import.md
 // (source_from_world, sparse_points, initial_mesh, dense_points, image_encoding, lighting).
 //
 // Decisions (docs/import.md): only registered images become views, in COLMAP image-id order; each

@@ -136,7 +136,7 @@ class SceneParser {
     return Status::Ok();
   }
 
-  // A file path inside the dataset: relative, no ".." (DESIGN.md §2.5). Readers reject anything
+  // A file path inside the dataset: relative, no ".." (docs/dataset.md). Readers reject anything
   // else, so that no command can be led outside the dataset (or, mirroring the path under its
   // output folder, outside that) by scene.json.
   Status ContainedPath(const std::string& path, const std::string& value) const {
@@ -484,7 +484,7 @@ class SceneParser {
     return Status::Ok();
   }
 
-  // The optional keys of importers (DESIGN.md §2.5, docs/import.md): file paths follow the
+  // The optional keys of importers (docs/dataset.md, docs/import.md): file paths follow the
   // dataset's path rules, texts are free, source_from_world is a similarity with scale > 0.
   Status ParseImportKeys(const json& root, Dataset* dataset) const {
     for (const auto& [key, out] :

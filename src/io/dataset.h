@@ -1,4 +1,4 @@
-// The `sft-dataset/1` format of DESIGN.md §2.5: a directory with scene.json, images/, masks/,
+// The `sft-dataset/1` format (docs/dataset.md): a directory with scene.json, images/, masks/,
 // probes/, gt/. This is a contract with other tools: unknown keys are preserved on round trips and
 // the meaning of the documented keys never changes.
 //
@@ -73,7 +73,7 @@ struct ViewSpec {
   nlohmann::json cam_from_world_extra;
 };
 
-// A similarity transform y = scale * (rotation * x) + translation (DESIGN.md §2.5
+// A similarity transform y = scale * (rotation * x) + translation (docs/dataset.md
 // "source_from_world": p_source = s·R·p + t).
 struct Similarity3d {
   double scale = 1.0;  // > 0.
@@ -101,7 +101,7 @@ struct Dataset {
   Background background = Background::kBlack;
   std::string gt_mesh;          // `ground_truth.mesh` (relative), empty when absent.
   nlohmann::json ground_truth;  // the whole `ground_truth` object as read (null when absent).
-  // Optional keys written by importers (DESIGN.md §2.5, docs/import.md); empty when absent.
+  // Optional keys written by importers (docs/dataset.md, docs/import.md); empty when absent.
   std::string sparse_points;           // "sparse_points": PLY point cloud (xyz, rgb), world frame.
   std::string initial_mesh;            // "initial_mesh": starting mesh, world frame.
   std::string dense_points;            // "dense_points": dense point cloud (e.g. COLMAP fused.ply).
@@ -122,9 +122,9 @@ Status ReadDataset(const std::string& dir, Dataset* dataset);
 // the messages); ReadDataset reads DIR/scene.json and calls this. Touches no file.
 Status ParseSceneJson(std::string text, const std::string& dir, Dataset* dataset);
 
-// Renderers need every view's lighting: an error naming the first view whose `lights` list is
-// empty (unknown lighting, as importers write it; DESIGN.md §2.5), else OK. Reading such a
-// dataset is fine; commands that render it call this first.
+// Renderers need every view's lighting: an error naming the first view whose `lights` list is empty
+// (unknown lighting, as importers write it; docs/dataset.md), else OK. Reading such a dataset is
+// fine; commands that render it call this first.
 Status CheckViewsHaveLights(const Dataset& dataset);
 
 // Opens every view image, mask and light probe once and checks sizes against the cameras

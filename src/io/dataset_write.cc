@@ -135,7 +135,7 @@ Status ViewsJson(const Dataset& dataset, const std::string& file, ojson* views) 
   return Status::Ok();
 }
 
-// ground_truth and the optional keys importers write (DESIGN.md §2.5, docs/import.md).
+// ground_truth and the optional keys importers write (docs/dataset.md, docs/import.md).
 void AppendOptionalKeys(const Dataset& dataset, ojson* root) {
   ojson ground_truth;
   if (dataset.ground_truth.is_object()) ground_truth = dataset.ground_truth;

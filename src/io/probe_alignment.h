@@ -1,5 +1,5 @@
 // Aligning a 360° light probe to a dataset (docs/import.md "Probe alignment"): the rotation
-// world_from_env that takes the probe's env frame (DESIGN.md §2.5, src/render/environment.h) into
+// world_from_env that takes the probe's env frame (docs/dataset.md, src/render/environment.h) into
 // the dataset's world frame, which for an imported capture is COLMAP's arbitrary frame.
 //
 // Method: the probe is cut into perspective crops (virtual pinhole views on a Fibonacci sphere of

@@ -5,7 +5,7 @@
 // The renderer takes one mesh and one material, so the plane is appended to a copy of the object
 // mesh and its texels to a copy of the object's mesh colors (same resolution). The object keeps
 // faces [0, object_faces); the plane's faces follow. Masks stay object-only: `sft synth` renders a
-// coverage pass of the object alone (docs: README "sft synth"); with every camera above the plane
+// coverage pass of the object alone (docs/cli.md "sft synth"); with every camera above the plane
 // the plane never occludes the object, so that coverage is the object's visible silhouette.
 #ifndef SFT_IO_SYNTH_SCENE_H_
 #define SFT_IO_SYNTH_SCENE_H_

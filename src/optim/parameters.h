@@ -1,9 +1,9 @@
 // The reconstruction's state as one flat vector in the renderer's parameter layout
 // (ParameterLayout, src/render/derivatives.h): x[i] is parameter i — vertex coordinates, albedo
-// texels (RGB), roughness texels, the specular weight, one intensity scale per dataset light.
-// Ceres parameter blocks point into this vector (DESIGN.md §2.1): one block per vertex (3), per
-// albedo texel (3), per roughness texel (1), the specular weight (1) and each light scale (1), so
-// the mapping between Ceres blocks and layout indices is the block's offset in the vector.
+// texels (RGB), roughness texels, the specular weight, one intensity scale per dataset light. Ceres
+// parameter blocks point into this vector: one block per vertex (3), per albedo texel (3), per
+// roughness texel (1), the specular weight (1) and each light scale (1), so the mapping between
+// Ceres blocks and layout indices is the block's offset in the vector.
 #ifndef SFT_OPTIM_PARAMETERS_H_
 #define SFT_OPTIM_PARAMETERS_H_
 

@@ -1,12 +1,11 @@
-// The Ceres problem of one outer iteration (DESIGN.md §2.2): parameter blocks into the flat state
-// (src/optim/parameters.h) with the bounds of the feasible set, and one 3-residual block per
-// active pyramid pixel of every view (cost_functions/pyramid_pixel.h) whose parameter blocks are
-// a fixed superset: the union of the blocks the pixel's samples touched in `superset_renders`
-// renders with different seeds (coarse pixels: the union of their children). Parameter kinds that
-// the phase does not vary are not in the problem at all (constant). Texels that no surface point
-// samples (the i + j = r texels of each face in the report's layout) never appear in a row, so
-// they are not in the problem either; FillUnsampledTexels gives them their in-face neighbour's
-// value for output.
+// The Ceres problem of one outer iteration (docs/reconstruct.md): parameter blocks into the flat
+// state (src/optim/parameters.h) with the bounds of the feasible set, and one 3-residual block per
+// active pyramid pixel of every view (cost_functions/pyramid_pixel.h) whose parameter blocks are a
+// fixed superset: the union of the blocks the pixel's samples touched in `superset_renders` renders
+// with different seeds (coarse pixels: the union of their children). Parameter kinds that the phase
+// does not vary are not in the problem at all (constant). Texels that no surface point samples (the
+// i + j = r texels of each face in the report's layout) never appear in a row, so they are not in
+// the problem either; FillUnsampledTexels gives them their in-face neighbour's value for output.
 #ifndef SFT_OPTIM_PROBLEM_H_
 #define SFT_OPTIM_PROBLEM_H_
 

@@ -1,9 +1,9 @@
-// Image pyramids for the multi-scale residual (DESIGN.md §2.2). Level 0 is the image; level l+1
-// has ⌈w/2⌉ × ⌈h/2⌉ pixels, each the mean of its (up to 2 × 2) children at level l — a box filter,
-// the same for renderings and targets. Because the map is linear, the pyramid of the expected
-// rendering equals the expected pyramid of the renderings, and the Jacobian row of a coarse pixel
-// is the same mean of its children's rows ("coarse rows as sums of child rows": exact, shares the
-// level-0 samples; see docs/design-notes.md for the choice against per-level renders).
+// Image pyramids for the multi-scale residual (docs/reconstruct.md). Level 0 is the image; level
+// l+1 has ⌈w/2⌉ × ⌈h/2⌉ pixels, each the mean of its (up to 2 × 2) children at level l — a box
+// filter, the same for renderings and targets. Because the map is linear, the pyramid of the
+// expected rendering equals the expected pyramid of the renderings, and the Jacobian row of a
+// coarse pixel is the same mean of its children's rows ("coarse rows as sums of child rows": exact,
+// shares the level-0 samples; see docs/design-notes.md for the choice against per-level renders).
 #ifndef SFT_OPTIM_PYRAMID_H_
 #define SFT_OPTIM_PYRAMID_H_
 

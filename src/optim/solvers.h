@@ -1,5 +1,6 @@
-// The solvers over one objective (DESIGN.md §2.2): ½ Σ r² of the pyramid pixel residuals of every
-// view (plus regularizers), minimised over the active parameter kinds within the feasible set.
+// The solvers over one objective (docs/reconstruct.md): ½ Σ r² of the pyramid pixel residuals of
+// every view (plus regularizers), minimised over the active parameter kinds within the feasible
+// set.
 //   lm, dogleg  Ceres trust region over the ReconstructionProblem (Jacobian rows from the render
 //               cache; bounds as Ceres parameter bounds). Linear solver CGNR + Jacobi with capped
 //               iterations by default; sparse normal Cholesky or dense QR for small problems.

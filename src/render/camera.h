@@ -1,7 +1,7 @@
-// Cameras in COLMAP's conventions (DESIGN.md §2.5): models and parameter order as COLMAP's
-// cameras.txt; the camera looks along +z with +x right and +y down; pixel (x, y) covers
-// [x, x+1] x [y, y+1] so the upper-left pixel's centre is (0.5, 0.5); `cam_from_world` maps
-// world points into the camera frame.
+// Cameras in COLMAP's conventions (docs/dataset.md): models and parameter order as COLMAP's
+// cameras.txt; the camera looks along +z with +x right and +y down; pixel (x, y) covers [x, x+1] x
+// [y, y+1] so the upper-left pixel's centre is (0.5, 0.5); `cam_from_world` maps world points into
+// the camera frame.
 #ifndef SFT_RENDER_CAMERA_H_
 #define SFT_RENDER_CAMERA_H_
 

@@ -1,6 +1,6 @@
-// Camera placement shared by `sft synth` and the benchmarks (DESIGN.md §1): cameras on a
-// Fibonacci sphere around a target, looking at it, at the distance where the target's bounding
-// sphere fills a given fraction of the half image.
+// Camera placement shared by `sft synth` and the benchmarks: cameras on a Fibonacci sphere around a
+// target, looking at it, at the distance where the target's bounding sphere fills a given fraction
+// of the half image.
 #ifndef SFT_RENDER_CAMERA_RIG_H_
 #define SFT_RENDER_CAMERA_RIG_H_
 

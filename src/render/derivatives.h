@@ -1,7 +1,7 @@
-// Derivative outputs of the renderer (DESIGN.md §2.2–2.3): for one view, from the same sample
-// paths as the image, (a) sparse Jacobian rows — per pixel, the list of (parameter, ∂R, ∂G, ∂B) of
-// the pixel's expected value, duplicates merged — and/or (b) the adjoint gradient Jᵀw for a
-// per-pixel RGB weight image w, without storing the Jacobian.
+// Derivative outputs of the renderer: for one view, from the same sample paths as the image, (a)
+// sparse Jacobian rows — per pixel, the list of (parameter, ∂R, ∂G, ∂B) of the pixel's expected
+// value, duplicates merged — and/or (b) the adjoint gradient Jᵀw for a per-pixel RGB weight image
+// w, without storing the Jacobian.
 //
 // Parameters live in one flat index space (ParameterLayout): vertex coordinates, albedo texels
 // (RGB), roughness texels, the specular weight, and one intensity scale per dataset light (the

@@ -1,7 +1,7 @@
-// An equirectangular environment light (DESIGN.md §2.5): the env frame is z-up; a direction
-// d = (x, y, z) in it maps to u = 0.5 − atan2(y, x)/(2π), v = acos(z)/π (u to the right, v down
-// from the top row), so the image centre looks along +x — Blender's convention. World directions
-// are taken to the env frame by world_from_envᵀ.
+// An equirectangular environment light (docs/dataset.md, "Conventions"): the env frame is z-up; a
+// direction d = (x, y, z) in it maps to u = 0.5 − atan2(y, x)/(2π), v = acos(z)/π (u to the right,
+// v down from the top row), so the image centre looks along +x — Blender's convention. World
+// directions are taken to the env frame by world_from_envᵀ.
 //
 // Radiance = scale · the bilinear interpolation of the texels (negative texels clamped to 0), as
 // Cycles' default Linear interpolation: texel (x, y) holds the value at its centre

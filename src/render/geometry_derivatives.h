@@ -1,6 +1,6 @@
-// Building blocks of vertex derivatives (DESIGN.md §2.3): how a face's unit normal and a ray's
-// hit point move when the face's vertices (and the ray's origin) move, with the ray's direction
-// held fixed ("detached" sampling, see derivatives.h).
+// Building blocks of vertex derivatives: how a face's unit normal and a ray's hit point move when
+// the face's vertices (and the ray's origin) move, with the ray's direction held fixed ("detached"
+// sampling, see derivatives.h).
 //
 // Conventions: a face has corners p0, p1, p2 (counter-clockwise = front), edges e1 = p1 − p0,
 // e2 = p2 − p0, N = e1 × e2 and unit normal n̂ = N/|N|; the renderer shades with n = σ·n̂,

@@ -1,8 +1,8 @@
-// The forward path tracer (DESIGN.md §2.3): camera rays through a box pixel filter, next-event
-// estimation to point and environment lights, BSDF sampling with multiple importance sampling
-// (power heuristic) against the environment, a fixed number of path segments. Deterministic:
-// sample s of pixel p of view v uses Sampler(seed, v, p, s) only, so the image is identical for
-// any thread count.
+// The forward path tracer (docs/architecture.md, "Render core"): camera rays through a box pixel
+// filter, next-event estimation to point and environment lights, BSDF sampling with multiple
+// importance sampling (power heuristic) against the environment, a fixed number of path segments.
+// Deterministic: sample s of pixel p of view v uses Sampler(seed, v, p, s) only, so the image is
+// identical for any thread count.
 #ifndef SFT_RENDER_RENDER_H_
 #define SFT_RENDER_RENDER_H_
 

@@ -204,7 +204,7 @@ TEST(DatasetErrors, ViewWithoutImage) {
   EXPECT_THAT(ReadError(scene), HasSubstr("views[1].image: expected a string"));
 }
 
-// Paths in scene.json are relative to the dataset and never leave it (DESIGN.md §2.5): absolute
+// Paths in scene.json are relative to the dataset and never leave it (docs/dataset.md): absolute
 // paths and ".." components are refused with one error naming the field, before any file is read.
 TEST(DatasetErrors, PathsMustStayInsideTheDataset) {
   const std::vector<std::pair<std::string, std::string>> cases = {

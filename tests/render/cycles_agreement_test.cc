@@ -1,8 +1,8 @@
-// Forward renders agree with Blender Cycles 3.4 (1024 spp) on the reference datasets copied from
-// shared/data/cycles (issue 2, DESIGN.md §3): same mesh, material, lights and bounces.
-// Thresholds: mean over object pixels of |ours − cycles| ≤ 2% of mean(cycles) with direct light,
-// ≤ 3% with GI or an environment map; every 8×8 block average (blocks at least half covered by
-// the mask and not darker than 10% of the mean) within 5%.
+// Forward renders agree with Blender Cycles 3.4 (1024 spp) on the reference datasets in data/cycles
+// (issue 2, data/cycles/README.md): same mesh, material, lights and bounces. Thresholds: mean over
+// object pixels of |ours − cycles| ≤ 2% of mean(cycles) with direct light, ≤ 3% with GI or an
+// environment map; every 8×8 block average (blocks at least half covered by the mask and not darker
+// than 10% of the mean) within 5%.
 #include <gtest/gtest.h>
 
 #include <cstdio>

@@ -27,14 +27,14 @@ Eigen::Vector3d Direction(double theta_deg, double phi_deg) {
   return {std::sin(t) * std::cos(p), std::sin(t) * std::sin(p), std::cos(t)};
 }
 
-// The env-frame direction of the point (u, v) of the map (DESIGN.md §2.5 inverted by hand:
-// φ = (0.5 − u)·360°, θ = v·180°).
+// The env-frame direction of the point (u, v) of the map (docs/dataset.md inverted by hand: φ =
+// (0.5 − u)·360°, θ = v·180°).
 Eigen::Vector3d DirectionOfUv(double u, double v) {
   return Direction(v * 180.0, (0.5 - u) * 360.0);
 }
 
-// DESIGN.md §2.5: u = 0.5 − atan2(y, x)/(2π), v = acos(z)/π; the image centre looks along +x.
-// At a texel's centre the interpolated lookup is the texel itself.
+// docs/dataset.md: u = 0.5 − atan2(y, x)/(2π), v = acos(z)/π; the image centre looks along +x. At a
+// texel's centre the interpolated lookup is the texel itself.
 TEST(EnvironmentTest, DirectionMappingMatchesBlender) {
   Image image(8, 4, 3, 0.f);
   image.at(4, 1, 0) = 1.f;  // centre (u, v) = (0.5625, 0.375): θ = 67.5°, φ = −22.5° (y < 0).

@@ -1,5 +1,5 @@
-// Hard cases checked against known answers, not only for finiteness (DESIGN.md §3): huge and tiny
-// scene scales, and roughness near zero.
+// Hard cases checked against known answers, not only for finiteness: huge and tiny scene scales,
+// and roughness near zero.
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -17,11 +17,11 @@ using testing::QuadFaces;
 using testing::QuadPositions;
 using testing::TopDownView;
 
-// Lambert plane under a point light: radiance ρ·I·cos θ/(π·d²) at every point (DESIGN.md §2.5).
+// Lambert plane under a point light: radiance ρ·I·cos θ/(π·d²) at every point (docs/dataset.md).
 // The pixel value is the box-filter average of that smooth function, computed here by a 16×16
-// midpoint rule over the pixel (quadrature error < 1e-5 relative). The render's only noise is
-// the pixel jitter: the function varies ≲ 2% across a pixel, so 64 samples leave ≲ 0.1%
-// (2%/√(12·64)). Tolerance 0.2%.
+// midpoint rule over the pixel (quadrature error < 1e-5 relative). The render's only noise is the
+// pixel jitter: the function varies ≲ 2% across a pixel, so 64 samples leave ≲ 0.1% (2%/√(12·64)).
+// Tolerance 0.2%.
 TEST(RenderTest, LambertPlaneUnderPointLight) {
   const RenderScene scene(QuadPositions(1.0), QuadFaces());
   const Eigen::Vector3d albedo(0.8, 0.5, 0.2);

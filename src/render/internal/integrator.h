@@ -1,6 +1,6 @@
-// Internal to src/render: the path tracer of one camera sample (DESIGN.md §2.3) — next-event
-// estimation to point and environment lights, BSDF sampling with multiple importance sampling
-// (power heuristic) against the environment — and the auxiliary first-hit passes.
+// Internal to src/render: the path tracer of one camera sample — next-event estimation to point and
+// environment lights, BSDF sampling with multiple importance sampling (power heuristic) against the
+// environment — and the auxiliary first-hit passes.
 #ifndef SFT_RENDER_INTERNAL_INTEGRATOR_H_
 #define SFT_RENDER_INTERNAL_INTEGRATOR_H_
 

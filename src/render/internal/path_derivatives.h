@@ -1,5 +1,5 @@
-// Internal to src/render: the per-path bookkeeping of parameter derivatives (DESIGN.md §2.3,
-// the "interior" terms of derivatives.h) and the per-pixel accumulator that sums them.
+// Internal to src/render: the per-path bookkeeping of parameter derivatives (the "interior" terms
+// of derivatives.h) and the per-pixel accumulator that sums them.
 #ifndef SFT_RENDER_INTERNAL_PATH_DERIVATIVES_H_
 #define SFT_RENDER_INTERNAL_PATH_DERIVATIVES_H_
 
