@@ -204,12 +204,12 @@ Status Schedule::PrepareStage(const ScheduleCallbacks& callbacks) {
 
 // metrics.json's per-outer entry: cost, time, faces, mesh quality against the baseline and the
 // callbacks' scores.
-Status Schedule::OuterRecord(const ScheduleCallbacks& callbacks, json* out) {
+Status Schedule::OuterRecord(const ScheduleCallbacks& callbacks, int outer, json* out) {
   const StageOptions& stage = stages_[progress_.stage];
   const MeshQuality quality = CompareMeshQuality(baseline_, current_.mesh);
   const int self_intersecting = CountSelfIntersectingFaces(current_.mesh);
   const IterationRecord* last = records_.empty() ? nullptr : &records_.back();
-  *out = {{"outer", progress_.outer_done - 1},
+  *out = {{"outer", outer},
           {"stage", stage.name},
           {"seconds", last ? last->seconds : Elapsed()},
           {"cost", last ? last->cost : 0.0},
@@ -254,8 +254,8 @@ Status Schedule::FinishStage() {
 
 Status Schedule::RunStageOuter(const ScheduleCallbacks& callbacks, bool* stop) {
   const StageOptions& stage = stages_[progress_.stage];
-  SFT_RETURN_IF_ERROR(
-      reconstruction_->RunOuter(progress_.outer_done, [&](const IterationRecord& record) {
+  const int outer = progress_.outer_done;
+  SFT_RETURN_IF_ERROR(reconstruction_->RunOuter(outer, [&](const IterationRecord& record) {
         IterationRecord r = record;
         r.stage = stage.name;
         records_.push_back(r);
@@ -269,7 +269,7 @@ Status Schedule::RunStageOuter(const ScheduleCallbacks& callbacks, bool* stop) {
     ++progress_.stage_outer_done;
   }
   json record;
-  SFT_RETURN_IF_ERROR(OuterRecord(callbacks, &record));
+  SFT_RETURN_IF_ERROR(OuterRecord(callbacks, outer, &record));
   outer_records_.push_back(record);
   const bool stage_done = progress_.stage_outer_done >= stage.fit.outer_iterations;
   const int folds = record["flipped_faces"].get<int>() + record["self_intersecting_faces"].get<int>();

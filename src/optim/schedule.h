@@ -112,7 +112,7 @@ class Schedule {
   Status CreateReconstruction();
   Status RunStageOuter(const ScheduleCallbacks& callbacks, bool* stop);
   Status ChangeTopology(TopologyChange change, const ScheduleCallbacks& callbacks);
-  Status OuterRecord(const ScheduleCallbacks& callbacks, nlohmann::json* out);
+  Status OuterRecord(const ScheduleCallbacks& callbacks, int outer, nlohmann::json* out);
   Status FinishStage();
   Status Checkpoint();
   void SyncCurrent();
