@@ -105,6 +105,13 @@ const std::map<std::string, Key>& Keys() {
                                  return std::string(
                                      o.regularizers.laplacian_of_shape ? "shape" : "displacement");
                                })},
+      {"pyramid_filter",
+       Choice(
+           [](const std::string& s, O* o) -> std::string {
+             return PyramidFilterFromName(s, &o->cache.pyramid_filter) ? ""
+                                                                       : "expected box or binomial";
+           },
+           [](const O& o) { return std::string(PyramidFilterName(o.cache.pyramid_filter)); })},
       {"mask_dilation", Int([](O* o) -> int& { return o->cache.mask_dilation; }, 0, 64)},
       {"primary_edge_ratio",
        Real([](O* o) -> double& { return o->cache.edges.primary_edge_ratio; }, 0, 16)},

@@ -57,6 +57,10 @@ bool RenderCacheOptions::Check(std::string* why) const {
     *why = "mask_dilation: must be in [0, 64]";
     return false;
   }
+  if (pyramid_filter != PyramidFilter::kBox && pyramid_filter != PyramidFilter::kBinomial) {
+    *why = "pyramid_filter: must be box or binomial";
+    return false;
+  }
   return true;
 }
 
@@ -83,9 +87,10 @@ Status RenderCache::Create(const Dataset& dataset, const DatasetViews* views,
     std::vector<uint8_t> active;
     SFT_RETURN_IF_ERROR(ActivePixels(dataset, v, target.width, target.height, options.mask_dilation,
                                      &active, &targets.has_mask));
-    const std::vector<Image> pyramid = BuildPyramid(ToRgb(target), options.pyramid_levels);
-    targets.active =
-        MaskPyramid(active, target.width, target.height, static_cast<int>(pyramid.size()));
+    const std::vector<Image> pyramid =
+        BuildPyramid(ToRgb(target), options.pyramid_levels, options.pyramid_filter);
+    targets.active = MaskPyramid(active, target.width, target.height,
+                                 static_cast<int>(pyramid.size()), options.pyramid_filter);
     std::vector<std::unique_ptr<LevelCache>> levels;
     for (size_t l = 0; l < pyramid.size(); ++l) {
       auto level = std::make_unique<LevelCache>();
@@ -164,7 +169,7 @@ void RenderCache::Render(bool rows) {
 
 void RenderCache::StoreRender(int v, const Image& image, const JacobianRows* rows) {
   const auto start = std::chrono::steady_clock::now();
-  std::vector<Image> pyramid = BuildPyramid(ToRgb(image), num_levels(v));
+  std::vector<Image> pyramid = BuildPyramid(ToRgb(image), num_levels(v), options_.pyramid_filter);
   LevelRows level_rows;
   if (rows != nullptr) {
     level_rows = RowsFromRenderer(*rows);
@@ -186,7 +191,7 @@ void RenderCache::StoreRender(int v, const Image& image, const JacobianRows* row
       level.rows = LevelRows();
       continue;
     }
-    if (l > 0) level_rows = DownsampleRows(levels_[v][l - 1]->rows);
+    if (l > 0) level_rows = DownsampleRows(levels_[v][l - 1]->rows, options_.pyramid_filter);
     level.rows = std::move(level_rows);
   }
   if (non_finite_ > 0) finite_ = false;
@@ -251,7 +256,10 @@ Image RenderCache::AdjointWeights(int v) const {
   Image acc;
   for (int l = num_levels(v) - 1; l >= 0; --l) {
     const LevelCache& level = *levels_[v][l];
-    if (!acc.empty()) acc = DownsampleMeanAdjoint(acc, level.render.width, level.render.height);
+    if (!acc.empty()) {
+      acc = DownsampleMeanAdjoint(acc, level.render.width, level.render.height,
+                                  options_.pyramid_filter);
+    }
     if (acc.empty()) acc = Image(level.render.width, level.render.height, 3);
     const std::vector<uint8_t>& active = targets_[v].active[l];
     const double w = level.sqrt_weight * level.sqrt_weight;

@@ -35,6 +35,9 @@ struct RenderCacheOptions {
   double level_weight = 1.0;  // level l's residuals are weighted by level_weight^l, (0, 64].
   double image_weight = 1.0;  // weight of the whole image term, [0, 1e6]; 0 = regularizers only.
   int mask_dilation = 2;      // level-0 pixels within this many pixels of the mask count, [0, 64].
+  // The filter between pyramid levels (src/optim/pyramid.h), of renders, targets, Jacobian rows,
+  // masks and the adjoint alike: kBox (2 × 2 means) or kBinomial ([1 2 1]/4 separable).
+  PyramidFilter pyramid_filter = PyramidFilter::kBox;
 
   bool Check(std::string* why) const;
 };
