@@ -117,6 +117,13 @@ const std::map<std::string, Key>& Keys() {
           return "expected 1, 0.5, 0.25, 0.125, 0.0625, 0.03125 or 0.015625";
         },
         [](const O& o) { return json(std::ldexp(1.0, -o.cache.image_scale_log2)); }}},
+      {"pyramid_filter",
+       Choice(
+           [](const std::string& s, O* o) -> std::string {
+             return PyramidFilterFromName(s, &o->cache.pyramid_filter) ? ""
+                                                                       : "expected box or binomial";
+           },
+           [](const O& o) { return std::string(PyramidFilterName(o.cache.pyramid_filter)); })},
       {"mask_dilation", Int([](O* o) -> int& { return o->cache.mask_dilation; }, 0, 64)},
       {"primary_edge_ratio",
        Real([](O* o) -> double& { return o->cache.edges.primary_edge_ratio; }, 0, 16)},
@@ -184,6 +191,10 @@ const std::map<std::string, Key>& Keys() {
        Real([](O* o) -> double& { return o->regularizers.orientation_weight; }, 0, 1e12)},
       {"orientation_min_fraction",
        Real([](O* o) -> double& { return o->regularizers.orientation_min_fraction; }, 1e-6, 0.999)},
+      {"proximal_weight",
+       Real([](O* o) -> double& { return o->regularizers.proximal_weight; }, 0, 1e12)},
+      {"proximal_lambda",
+       Real([](O* o) -> double& { return o->regularizers.proximal_lambda; }, 0, 1e6)},
       {"albedo_smoothness",
        Real([](O* o) -> double& { return o->regularizers.albedo_smoothness; }, 0, 1e12)},
       {"roughness_smoothness",

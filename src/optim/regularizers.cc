@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "cost_functions/face_orientation.h"
+#include "cost_functions/proximal_smoothing.h"
 #include "cost_functions/texel_smoothness.h"
 #include "cost_functions/vertex_laplacian.h"
 
@@ -45,6 +46,11 @@ bool RegularizerOptions::Check(std::string* why) const {
     *why = "orientation_weight must be finite and >= 0, orientation_min_fraction in (0, 1)";
     return false;
   }
+  if (!(proximal_weight >= 0.0 && std::isfinite(proximal_weight) && proximal_lambda >= 0.0 &&
+        proximal_lambda <= 1e6)) {
+    *why = "proximal_weight must be finite and >= 0, proximal_lambda in [0, 1e6]";
+    return false;
+  }
   return true;
 }
 
@@ -68,6 +74,14 @@ void AddRegularizers(const TriMesh& rest, const ActiveParameters& active,
     orientation.weight = std::sqrt(options.orientation_weight);
     orientation.min_fraction = options.orientation_min_fraction;
     AddFaceOrientation(rest, orientation, blocks, problem);
+  }
+  if (active.vertices && options.proximal_weight > 0.0) {
+    std::vector<double*> blocks(layout.num_vertices);
+    for (int v = 0; v < layout.num_vertices; ++v) blocks[v] = params->data() + 3 * v;
+    ProximalSmoothingOptions proximal;
+    proximal.weight = std::sqrt(options.proximal_weight);
+    proximal.lambda = options.proximal_lambda;
+    AddProximalSmoothing(rest, proximal, blocks, problem);
   }
   if (active.albedo && options.albedo_smoothness > 0.0) {
     AddSmoothness(rest, material.albedo.resolution(), 3, layout.AlbedoOffset(),

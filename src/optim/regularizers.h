@@ -1,4 +1,5 @@
 // Regularizer residual blocks of the reconstruction (cost_functions/vertex_laplacian.h,
+// cost_functions/face_orientation.h, cost_functions/proximal_smoothing.h,
 // cost_functions/texel_smoothness.h), added for the parameter kinds a phase varies.
 #ifndef SFT_OPTIM_REGULARIZERS_H_
 #define SFT_OPTIM_REGULARIZERS_H_
@@ -29,6 +30,17 @@ struct RegularizerOptions {
   // back, ≥ 0; 0 = off.
   double orientation_weight = 10.0;
   double orientation_min_fraction = 0.25;  // in (0, 1).
+  // μ of the smoothing proximal term μ/2·‖(I + λL)(x − x_a)‖² (cost_functions/proximal_smoothing.h:
+  // the Levenberg–Marquardt form of Nicolet et al. 2021's "large steps" preconditioner), ≥ 0,
+  // finite; 0 = off. Unit: 1/length² (the residual is a length), given for scenes normalised to a
+  // bounding-box diagonal of 1 like laplacian_weight (for diagonal d the same effect needs μ/d²).
+  // x_a is the mesh at the start of the phase's Solve: re-anchored per outer iteration. A large μ
+  // turns the LM step into −μ⁻¹(I + λL)⁻²∇ (the large-steps update); small μ leaves LM as is.
+  double proximal_weight = 0.0;
+  // λ of the proximal term: smoothing strength of I + λL, L the combinatorial Laplacian D − A
+  // (dimensionless); finite, in [0, 1e6]; 0 = plain Tikhonov damping. The paper uses 19 to 49,
+  // Mitsuba 3's shape-optimisation tutorial 25.
+  double proximal_lambda = 25.0;
   double albedo_smoothness = 0.0;     // weight of albedo differences of neighbouring texels, ≥ 0.
   double roughness_smoothness = 0.0;  // the same for roughness, ≥ 0.
 
@@ -37,7 +49,8 @@ struct RegularizerOptions {
 
 // Adds the regularizers of the active kinds to `problem`. Their parameter blocks point into
 // `params`; blocks new to the problem get the bounds of `bounds`. `rest` is the mesh whose
-// positions the Laplacian measures displacements from (and whose connectivity it uses).
+// positions the Laplacian measures displacements from and the proximal term is anchored at (and
+// whose connectivity they use).
 void AddRegularizers(const TriMesh& rest, const ActiveParameters& active,
                      const RegularizerOptions& options, const ParameterBounds& bounds,
                      const Material& material, SceneParameters* params, ceres::Problem* problem);

@@ -61,6 +61,10 @@ bool RenderCacheOptions::Check(std::string* why) const {
     *why = "image_scale: must be 1, 1/2, 1/4, ... or 1/64";
     return false;
   }
+  if (pyramid_filter != PyramidFilter::kBox && pyramid_filter != PyramidFilter::kBinomial) {
+    *why = "pyramid_filter: must be box or binomial";
+    return false;
+  }
   return true;
 }
 
@@ -89,13 +93,15 @@ Status RenderCache::Create(const Dataset& dataset, const DatasetViews* views,
                                      &active, &targets.has_mask));
     Image scaled = ToRgb(target);
     if (options.image_scale_log2 > 0) {
+      // A lower-resolution camera integrates over its larger pixels: always the box filter here.
       const int k = options.image_scale_log2;
       scaled = BuildPyramid(scaled, k + 1).back();
       active = MaskPyramid(active, target.width, target.height, k + 1).back();
     }
-    const std::vector<Image> pyramid = BuildPyramid(scaled, options.pyramid_levels);
-    targets.active =
-        MaskPyramid(active, scaled.width, scaled.height, static_cast<int>(pyramid.size()));
+    const std::vector<Image> pyramid =
+        BuildPyramid(scaled, options.pyramid_levels, options.pyramid_filter);
+    targets.active = MaskPyramid(active, scaled.width, scaled.height,
+                                 static_cast<int>(pyramid.size()), options.pyramid_filter);
     std::vector<std::unique_ptr<LevelCache>> levels;
     for (size_t l = 0; l < pyramid.size(); ++l) {
       auto level = std::make_unique<LevelCache>();
@@ -187,7 +193,7 @@ void RenderCache::Render(bool rows) {
 
 void RenderCache::StoreRender(int v, const Image& image, const JacobianRows* rows) {
   const auto start = std::chrono::steady_clock::now();
-  std::vector<Image> pyramid = BuildPyramid(ToRgb(image), num_levels(v));
+  std::vector<Image> pyramid = BuildPyramid(ToRgb(image), num_levels(v), options_.pyramid_filter);
   LevelRows level_rows;
   if (rows != nullptr) {
     level_rows = RowsFromRenderer(*rows);
@@ -209,7 +215,7 @@ void RenderCache::StoreRender(int v, const Image& image, const JacobianRows* row
       level.rows = LevelRows();
       continue;
     }
-    if (l > 0) level_rows = DownsampleRows(levels_[v][l - 1]->rows);
+    if (l > 0) level_rows = DownsampleRows(levels_[v][l - 1]->rows, options_.pyramid_filter);
     level.rows = std::move(level_rows);
   }
   if (non_finite_ > 0) finite_ = false;
@@ -274,7 +280,10 @@ Image RenderCache::AdjointWeights(int v) const {
   Image acc;
   for (int l = num_levels(v) - 1; l >= 0; --l) {
     const LevelCache& level = *levels_[v][l];
-    if (!acc.empty()) acc = DownsampleMeanAdjoint(acc, level.render.width, level.render.height);
+    if (!acc.empty()) {
+      acc = DownsampleMeanAdjoint(acc, level.render.width, level.render.height,
+                                  options_.pyramid_filter);
+    }
     if (acc.empty()) acc = Image(level.render.width, level.render.height, 3);
     const std::vector<uint8_t>& active = targets_[v].active[l];
     const double w = level.sqrt_weight * level.sqrt_weight;

@@ -39,6 +39,9 @@ struct RenderCacheOptions {
   // masks are box-downsampled (BuildPyramid, MaskPyramid) and cameras scaled (DownscaledCamera);
   // [0, 6]. Pyramid levels are counted from that scale.
   int image_scale_log2 = 0;
+  // The filter between pyramid levels (src/optim/pyramid.h), of renders, targets, Jacobian rows,
+  // masks and the adjoint alike: kBox (2 × 2 means) or kBinomial ([1 2 1]/4 separable).
+  PyramidFilter pyramid_filter = PyramidFilter::kBox;
 
   bool Check(std::string* why) const;
 };
