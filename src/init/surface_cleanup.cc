@@ -1,9 +1,13 @@
 #include "src/init/surface_cleanup.h"
 
+#include <glog/logging.h>
+
 #include <OpenMesh/Tools/Decimater/DecimaterT.hh>
+#include <OpenMesh/Tools/Decimater/ModAspectRatioT.hh>
 #include <OpenMesh/Tools/Decimater/ModNormalFlippingT.hh>
 #include <OpenMesh/Tools/Decimater/ModQuadricT.hh>
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <numeric>
 #include <unordered_map>
@@ -175,11 +179,28 @@ Status BuildClosedSurface(const std::vector<Eigen::Vector3d>& points,
   return Status::Ok();
 }
 
-void DecimateMesh(int target_faces, TriMesh* mesh) {
+bool DecimationGuards::Check(std::string* why) const {
+  if (!(max_normal_deviation_degrees > 0.0 && max_normal_deviation_degrees <= 180.0)) {
+    *why = "max_normal_deviation_degrees must be in (0, 180], got " +
+           std::to_string(max_normal_deviation_degrees);
+    return false;
+  }
+  if (!(max_aspect_ratio == 0.0 || (max_aspect_ratio >= 1.2 && std::isfinite(max_aspect_ratio)))) {
+    *why = "max_aspect_ratio must be 0 (off) or finite and at least 1.2, got " +
+           std::to_string(max_aspect_ratio);
+    return false;
+  }
+  return true;
+}
+
+void DecimateMesh(int target_faces, TriMesh* mesh, const DecimationGuards& guards) {
+  std::string why;
+  CHECK(guards.Check(&why)) << why;
   if (static_cast<int>(mesh->n_faces()) <= target_faces) return;
   using Decimater = OpenMesh::Decimater::DecimaterT<TriMesh>;
   using Quadric = OpenMesh::Decimater::ModQuadricT<TriMesh>::Handle;
   using NormalFlipping = OpenMesh::Decimater::ModNormalFlippingT<TriMesh>::Handle;
+  using AspectRatio = OpenMesh::Decimater::ModAspectRatioT<TriMesh>::Handle;
   mesh->request_vertex_status();
   mesh->request_edge_status();
   mesh->request_face_status();
@@ -189,10 +210,15 @@ void DecimateMesh(int target_faces, TriMesh* mesh) {
     Decimater decimater(*mesh);
     Quadric quadric;
     NormalFlipping flipping;
+    AspectRatio aspect;
     decimater.add(quadric);
     decimater.add(flipping);
     decimater.module(quadric).unset_max_err();
-    decimater.module(flipping).set_max_normal_deviation(60.0);
+    decimater.module(flipping).set_max_normal_deviation(guards.max_normal_deviation_degrees);
+    if (guards.max_aspect_ratio > 0.0) {
+      decimater.add(aspect);
+      decimater.module(aspect).set_aspect_ratio(static_cast<float>(guards.max_aspect_ratio));
+    }
     decimater.initialize();
     decimater.decimate_to_faces(0, static_cast<size_t>(target_faces));
   }

@@ -30,10 +30,25 @@ Status BuildClosedSurface(const std::vector<Eigen::Vector3d>& points,
                           const std::vector<Eigen::Vector3i>& triangles, TriMesh* mesh,
                           SurfaceCleanupReport* report);
 
-// Quadric-error decimation (OpenMesh Decimater, ModQuadricT, with ModNormalFlippingT refusing
-// collapses that turn a face normal by more than 60°) down to at most `target_faces` faces where
-// legal collapses allow. Collapses keep a closed manifold closed and manifold.
-void DecimateMesh(int target_faces, TriMesh* mesh);
+// What DecimateMesh refuses besides collapses that break the topology.
+struct DecimationGuards {
+  // A collapse that turns a face normal by more than this is refused (OpenMesh
+  // ModNormalFlippingT); degrees, in (0, 180].
+  double max_normal_deviation_degrees = 60.0;
+  // A collapse that leaves a face whose longest edge over its height exceeds this is refused unless
+  // it improves on the worst face it replaces (OpenMesh ModAspectRatioT, binary mode); 0 turns the
+  // guard off, otherwise at least 1.2 (an equilateral triangle has 2/√3 ≈ 1.155).
+  double max_aspect_ratio = 0.0;
+
+  bool Check(std::string* why) const;
+};
+
+// Quadric-error decimation (Garland & Heckbert 1997; OpenMesh Decimater with ModQuadricT as the
+// priority and the guards above as binary modules) down to at most `target_faces` faces where
+// legal collapses allow. Halfedge collapses: every remaining vertex keeps its position. Collapses
+// keep a closed manifold closed and manifold. `guards` must pass Check.
+void DecimateMesh(int target_faces, TriMesh* mesh,
+                  const DecimationGuards& guards = DecimationGuards());
 
 // True when every edge has exactly two faces and every vertex's faces form one fan (a closed
 // 2-manifold without pinched vertices); otherwise false with what is wrong in *why.
