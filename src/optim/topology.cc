@@ -3,7 +3,7 @@
 #include <chrono>
 #include <cmath>
 
-#include "src/geometry/mesh_colors.h"
+#include "src/geometry/mesh_colors_resample.h"
 #include "src/init/initial_mesh.h"
 #include "src/init/remesh.h"
 #include "src/init/resample.h"
