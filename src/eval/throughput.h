@@ -2,7 +2,7 @@
 // the renderer's own ray set on the renderer's own BVH (RenderScene::embree_scene()):
 //   - camera rays: the same camera, the same sub-pixel positions (RenderView's first Next2D of
 //     each sample's Sampler, replicated here) and the same spp as RenderView, through rtcIntersect1
-//     and through rtcIntersect8 packets (rtcIntersect16 is emulated on AVX2 CPUs, PLATFORM.md);
+//     and through rtcIntersect8 packets (rtcIntersect16 is emulated on AVX2 CPUs: design notes);
 //   - shadow rays: from the first hits to every point light, spawned exactly as RenderView does at
 //     the first vertex (same offset, same cosine and distance tests), through rtcOccluded1;
 // all multithreaded with TBB on the same number of threads as the renderer, with flush-to-zero /

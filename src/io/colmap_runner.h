@@ -1,7 +1,7 @@
-// Runs COLMAP's command-line programs (COLMAP 3.8, CPU: PLATFORM.md) for `sft import video`.
-// Each stage runs as `colmap STAGE ARGS...` through popen with QT_QPA_PLATFORM=offscreen and
-// OMP_WAIT_POLICY=passive; its whole output (stdout and stderr) is appended to a log file and
-// never printed. Progress counts are read from the lines COLMAP prints:
+// Runs COLMAP's command-line programs (COLMAP 3.8, CPU only: docs/design-notes.md "Platform facts")
+// for `sft import video`. Each stage runs as `colmap STAGE ARGS...` through popen with
+// QT_QPA_PLATFORM=offscreen and OMP_WAIT_POLICY=passive; its whole output (stdout and stderr) is
+// appended to a log file and never printed. Progress counts are read from the lines COLMAP prints:
 //   feature_extractor   "Processed file [i/n]"
 //   exhaustive_matcher  "Matching block [i/n, j/n]"   (block i·n + j of n²)
 //   sequential_matcher  "Matching image [i/n]"

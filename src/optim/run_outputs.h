@@ -1,6 +1,6 @@
 // What `sft reconstruct` writes into its output folder, each file atomically:
 //   mesh.ply, mesh.obj          the current mesh;
-//   material.json, albedo.mc, roughness.mc   the material (mesh colors; `sft render` reads it);
+//   material.json, material_albedo.meshcolors, material_roughness.meshcolors   the material (mesh colors; `sft render` reads it);
 //   lights.json                 the fitted light scales (src/io/light_scales.h);
 //   metrics.csv, metrics.json   per iteration: outer, stage, phase, iteration, cost, seconds,
 //                               accepted, per-view PSNR; metrics.json adds per-phase solver

@@ -5,7 +5,7 @@
 //   f(wo, wi) = albedo/π + F · D(h)·G1(wi)·G1(wo) / (4·|n·wi|·|n·wo|),   h = normalize(wi + wo).
 //
 // This is exactly Blender's Diffuse BSDF + Glossy BSDF (GGX) joined by an Add Shader, so Cycles
-// renders are references (PLATFORM.md).
+// renders are references (docs/design-notes.md, "Platform facts").
 //
 // Direction convention, used everywhere in sft: `wo` points from the surface towards the viewer
 // (the previous path vertex or the camera), `wi` from the surface towards the light (the next path
