@@ -58,9 +58,18 @@ Status CompareRuns(const std::vector<std::string>& runs, const std::vector<std::
           f.x.push_back(last_seconds);
           f.y.push_back(last_f1);
         }
-        std::snprintf(line, sizeof(line), "%s,outer,%d,%.3f,%.9g,%.6g,%.6g\n", labels[r].c_str(),
-                      o.value("outer", 0), last_seconds, last_cost, last_chamfer, last_f1);
+        std::snprintf(line, sizeof(line), "%s,outer,%d,%.3f,%.9g,", labels[r].c_str(),
+                      o.value("outer", 0), last_seconds, last_cost);
         csv += line;
+        // Without --reference the run has no Chamfer or F1: empty fields, not a sentinel value
+        // that a plot or spreadsheet would take for a measurement.
+        if (last_chamfer >= 0) {
+          std::snprintf(line, sizeof(line), "%.6g,%.6g", last_chamfer, last_f1);
+          csv += line;
+        } else {
+          csv += ",";
+        }
+        csv += "\n";
       }
     }
     cost.series.push_back(c);

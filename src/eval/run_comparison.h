@@ -13,7 +13,7 @@ namespace sft {
 
 // `runs` are sft reconstruct output folders, `labels` their names (same length). Writes
 // OUT/comparison.csv (run, seconds, cost per iteration; seconds, cost, chamfer, f1 per outer
-// iteration when the run had --reference) and OUT/report.html.
+// iteration, chamfer and f1 empty when the run had no --reference) and OUT/report.html.
 Status CompareRuns(const std::vector<std::string>& runs, const std::vector<std::string>& labels,
                    const std::string& out);
 

@@ -1,18 +1,24 @@
 // The hostile-input suite: runs the `sft` CLI on generated bad or unusual inputs (meshes,
-// materials, datasets, options) and checks, for every case, that
-//   - the exit code is in 1..125 (a clean error, not a signal), or 0 with the expected outputs;
-//   - the output is at most a few lines;
-//   - no file outside the output folder was created, changed or removed, and in particular the
-//     dataset's files are byte-identical afterwards.
+// materials, datasets, options) and checks, for every case,
+//   - a case meant to fail: an exit code in 1..125 (a clean error, not a signal or a crash) and
+//     exactly one output line, which names the offending file, field or flag;
+//   - a case meant to succeed: exit 0, every expected output written, and the outputs plausible
+//     (render.json parses and lists the expected images; each image is a finite EXR of the
+//     camera's size, not black unless the case expects black);
+//   - either way: no file outside the output folder was created, changed or removed, and in
+//     particular the dataset's files are byte-identical afterwards.
 // Each case runs in its own folder holding a copy of a small synthesized dataset ("ds"), a mesh,
 // a material file and an empty place for the output ("out").
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <functional>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -59,16 +65,22 @@ std::map<std::string, std::string> Snapshot(const fs::path& root,
   return files;
 }
 
+// The render command most cases run.
+constexpr char kRender[] = "render --quiet --dataset {ds} --mesh {mesh} --spp 2 --out {out}";
+
 // A case: `prepare` edits the case folder; `args` is the command line after `sft`, in which
-// {ds}, {out}, {mesh}, {material} and {dir} are replaced by paths in the case folder; `ok`
-// means exit 0 is acceptable (then `outputs`, relative to the case folder, must exist).
+// {ds}, {out}, {mesh}, {material} and {dir} are replaced by paths in the case folder.
+// `succeeds`: the command must exit 0 and write `outputs` (relative to the case folder), which
+// `check` (when set) inspects further; otherwise it must fail with one line containing
+// `error_mentions` (required: the file, field or flag at fault).
 struct HostileCase {
   std::string name;
   std::function<void(const fs::path& dir)> prepare;
   std::string args;
-  bool ok = false;
+  bool succeeds = false;
   std::vector<std::string> outputs;
-  std::string error_mentions;  // when failing, the error line contains this ("" = anything).
+  std::string error_mentions;
+  std::function<void(const fs::path& dir)> check = nullptr;
 };
 
 class HostileInputTest : public ::testing::Test {
@@ -86,10 +98,36 @@ class HostileInputTest : public ::testing::Test {
     fs::copy_file(mesh, base_->Join("mesh.obj"));
     testing::WriteTestFile(base_->Join("material.json"),
                            "{\"albedo\": [0.5, 0.5, 0.5], \"roughness\": 0.4}");
+    // The plain mesh's render, for the cases that must render exactly as without their oddity.
+    baseline_ = new testing::TempDir();
+    ASSERT_EQ(
+        testing::RunCommand(
+            testing::SftBinary() + " " + Expand(kRender, base_->path()) + " --no-report", &out),
+        0)
+        << out;
+    fs::rename(base_->Join("out"), baseline_->Join("out"));
   }
   static void TearDownTestSuite() {
     delete base_;
     base_ = nullptr;
+    delete baseline_;
+    baseline_ = nullptr;
+  }
+
+  // Checks that out/images/000.exr and 001.exr equal the plain mesh's render (same seed).
+  static void SameAsBaseline(const fs::path& dir) {
+    for (const char* name : {"images/000.exr", "images/001.exr"}) {
+      Image ours, baseline;
+      ASSERT_TRUE(ReadImage((dir / "out" / name).string(), &ours).ok()) << name;
+      ASSERT_TRUE(ReadImage(baseline_->Join(std::string("out/") + name), &baseline).ok()) << name;
+      ASSERT_EQ(ours.data.size(), baseline.data.size()) << name;
+      double max_difference = 0.0;
+      for (size_t i = 0; i < ours.data.size(); ++i) {
+        max_difference =
+            std::max(max_difference, std::abs(double{ours.data[i]} - baseline.data[i]));
+      }
+      EXPECT_LE(max_difference, 1e-5) << name;
+    }
   }
 
   static std::string Expand(std::string args, const fs::path& dir) {
@@ -108,7 +146,7 @@ class HostileInputTest : public ::testing::Test {
     return args;
   }
 
-  // Runs every case; returns the number that failed (each failure is reported by name).
+  // Runs every case (each failure is reported under the case's name).
   void RunCases(const std::vector<HostileCase>& cases) {
     for (const HostileCase& c : cases) {
       SCOPED_TRACE(c.name);
@@ -120,15 +158,20 @@ class HostileInputTest : public ::testing::Test {
       std::string output;
       const std::string command = testing::SftBinary() + " " + Expand(c.args, dir);
       const int code = testing::RunCommand(command, &output);
-      EXPECT_TRUE((code >= 1 && code <= 125) || (code == 0 && c.ok))
-          << "exit " << code << " for: " << command << "\n"
-          << output;
-      EXPECT_LE(CountLines(output), 4) << output;
-      if (code != 0 && !c.error_mentions.empty()) {
+      if (c.succeeds) {
+        EXPECT_EQ(code, 0) << command << "\n" << output;
+        // --quiet: at most a warning or two (e.g. a comparison skipped), never a flood.
+        EXPECT_LE(CountLines(output), 4) << output;
+        if (code == 0) {
+          for (const std::string& o : c.outputs) EXPECT_TRUE(fs::exists(dir / o)) << o;
+          if (c.check) c.check(dir);
+        }
+      } else {
+        EXPECT_FALSE(c.error_mentions.empty()) << "a failing case must say what the error names";
+        EXPECT_TRUE(code >= 1 && code <= 125) << "exit " << code << " for: " << command << "\n"
+                                              << output;
+        EXPECT_EQ(CountLines(output), 1) << command << "\n" << output;
         EXPECT_THAT(output, ::testing::HasSubstr(c.error_mentions)) << command;
-      }
-      if (code == 0) {
-        for (const std::string& o : c.outputs) EXPECT_TRUE(fs::exists(dir / o)) << o;
       }
       const auto after = Snapshot(dir, {"out", "out.partial"});
       EXPECT_TRUE(before == after) << "files outside out/ changed: " << command;
@@ -144,9 +187,11 @@ class HostileInputTest : public ::testing::Test {
   }
 
   static testing::TempDir* base_;
+  static testing::TempDir* baseline_;
 };
 
 testing::TempDir* HostileInputTest::base_ = nullptr;
+testing::TempDir* HostileInputTest::baseline_ = nullptr;
 
 void Write(const fs::path& path, const std::string& contents) {
   fs::create_directories(path.parent_path());
@@ -160,6 +205,45 @@ std::string Read(const fs::path& path) {
   return ss.str();
 }
 
+// Checks a successful `sft render` of the two-view dataset into out/: render.json parses and
+// lists one entry per view whose "image" is `images[v]`; every image is a finite 16×16 EXR (the
+// dataset's camera) that is black exactly when `black` (the test meshes cover part of every
+// view). `skipped` lists the views whose comparison with the dataset image must be skipped
+// (with a reason) rather than made.
+std::function<void(const fs::path&)> RenderOutputs(const std::vector<std::string>& images,
+                                                   bool black = false,
+                                                   const std::vector<int>& skipped = {}) {
+  return [images, black, skipped](const fs::path& dir) {
+    const nlohmann::json report =
+        nlohmann::json::parse(Read(dir / "out/render.json"), nullptr, /*allow_exceptions=*/false);
+    ASSERT_TRUE(report.is_object()) << "render.json does not parse";
+    ASSERT_TRUE(report["views"].is_array());
+    ASSERT_EQ(report["views"].size(), images.size());
+    for (size_t v = 0; v < images.size(); ++v) {
+      const nlohmann::json& view = report["views"][v];
+      EXPECT_EQ(view.value("image", ""), images[v]) << "view " << v;
+      const bool skip =
+          std::find(skipped.begin(), skipped.end(), static_cast<int>(v)) != skipped.end();
+      EXPECT_EQ(view["comparison"].is_null(), skip) << "view " << v;
+      if (skip) {
+        EXPECT_FALSE(view.value("comparison_skipped", "").empty()) << "view " << v;
+      }
+      Image image;
+      ASSERT_TRUE(ReadImage((dir / "out" / images[v]).string(), &image).ok()) << images[v];
+      EXPECT_EQ(image.width, 16) << images[v];
+      EXPECT_EQ(image.height, 16) << images[v];
+      double sum = 0.0;
+      bool finite = true;
+      for (float x : image.data) {
+        finite = finite && std::isfinite(x);
+        sum += x;
+      }
+      EXPECT_TRUE(finite) << images[v];
+      EXPECT_EQ(sum == 0.0, black) << images[v] << ": sum of values " << sum;
+    }
+  };
+}
+
 // Replaces the first occurrence of `from` in ds/scene.json by `to`.
 std::function<void(const fs::path&)> EditScene(const std::string& from, const std::string& to) {
   return [from, to](const fs::path& dir) {
@@ -170,8 +254,6 @@ std::function<void(const fs::path&)> EditScene(const std::string& from, const st
     Write(dir / "ds/scene.json", scene);
   };
 }
-
-constexpr char kRender[] = "render --quiet --dataset {ds} --mesh {mesh} --spp 2 --out {out}";
 
 TEST_F(HostileInputTest, Datasets) {
   const std::string render = kRender;
@@ -233,8 +315,9 @@ TEST_F(HostileInputTest, Datasets) {
        [](const fs::path& d) { fs::remove(d / "ds/images/001.exr"); },
        render,
        true,
-       {"out/images/001.exr", "out/render.json"},
-       ""},
+       {"out/images/000.exr", "out/images/001.exr", "out/render.json"},
+       "",
+       RenderOutputs({"images/000.exr", "images/001.exr"}, false, {1})},
       {"image of the wrong size (render, comparison skipped with a warning)",
        [](const fs::path& d) {
          ASSERT_TRUE(WritePng((d / "ds/images/x.png").string(), Image(8, 5, 3, 0.5f)).ok());
@@ -242,8 +325,9 @@ TEST_F(HostileInputTest, Datasets) {
        },
        render,
        true,
-       {"out/images/000.exr", "out/images/x.exr"},
-       ""},
+       {"out/images/000.exr", "out/images/x.exr", "out/render.json"},
+       "",
+       RenderOutputs({"images/000.exr", "images/x.exr"}, false, {1})},
       {"unknown camera",
        EditScene("\"camera\": \"zoom0\"", "\"camera\": \"nope\""),
        render,
@@ -270,8 +354,13 @@ TEST_F(HostileInputTest, Datasets) {
        EditScene("\"images/001.exr\"", "\"images/000.exr\""),
        render,
        true,
-       {"out/images/000.exr", "out/images/000_view001.exr"},
-       ""},
+       {"out/images/000.exr", "out/images/000_view001.exr", "out/render.json"},
+       "",
+       [](const fs::path& d) {
+         RenderOutputs({"images/000.exr", "images/000_view001.exr"})(d);
+         // Two renders from two poses, not one file written twice.
+         EXPECT_NE(Read(d / "out/images/000.exr"), Read(d / "out/images/000_view001.exr"));
+       }},
       {"views in per-camera subfolders stay apart",
        [](const fs::path& d) {
          fs::create_directories(d / "ds/images/a");
@@ -283,8 +372,12 @@ TEST_F(HostileInputTest, Datasets) {
        },
        render,
        true,
-       {"out/images/a/0.exr", "out/images/b/0.exr"},
-       ""},
+       {"out/images/a/0.exr", "out/images/b/0.exr", "out/render.json"},
+       "",
+       [](const fs::path& d) {
+         RenderOutputs({"images/a/0.exr", "images/b/0.exr"})(d);
+         EXPECT_NE(Read(d / "out/images/a/0.exr"), Read(d / "out/images/b/0.exr"));
+       }},
   });
 }
 
@@ -324,8 +417,9 @@ TEST_F(HostileInputTest, Meshes) {
        mesh("v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n"),
        render,
        true,
-       {"out/render.json"},
-       ""},
+       {"out/images/000.exr", "out/images/001.exr", "out/render.json"},
+       "",
+       RenderOutputs({"images/000.exr", "images/001.exr"}, /*black=*/true)},
       {"truncated PLY",
        [](const fs::path& d) {
          Write(d / "mesh.obj",
@@ -346,13 +440,19 @@ TEST_F(HostileInputTest, Meshes) {
        "m.off"},
       {"unreferenced vertex at 1e23 (renders as without it)",
        [](const fs::path& d) {
+         // Appended: a vertex put first would become OBJ index 1 and move every face onto it.
          std::string obj = Read(d / "mesh.obj");
-         Write(d / "mesh.obj", "v 1e23 0 0\n" + obj);
+         if (!obj.empty() && obj.back() != '\n') obj += '\n';
+         Write(d / "mesh.obj", obj + "v 1e23 0 0\n");
        },
        render,
        true,
-       {"out/images/000.exr"},
-       ""},
+       {"out/images/000.exr", "out/images/001.exr", "out/render.json"},
+       "",
+       [](const fs::path& d) {
+         RenderOutputs({"images/000.exr", "images/001.exr"})(d);
+         SameAsBaseline(d);
+       }},
       {"concave polygon that is not planar",
        mesh("v 0 0 0\nv 2 0 0\nv 2 2 1\nv 1 0.5 0\nv 0 2 0\nf 1 2 3 4 5\n"),
        render,
@@ -369,8 +469,12 @@ TEST_F(HostileInputTest, Meshes) {
        [](const fs::path& d) { Write(d / "mesh.obj", "\xEF\xBB\xBF" + Read(d / "mesh.obj")); },
        render,
        true,
-       {"out/images/000.exr"},
-       ""},
+       {"out/images/000.exr", "out/images/001.exr", "out/render.json"},
+       "",
+       [](const fs::path& d) {
+         RenderOutputs({"images/000.exr", "images/001.exr"})(d);
+         SameAsBaseline(d);
+       }},
       {"unknown extension",
        [](const fs::path& d) { Write(d / "m.stl", "solid x\n"); },
        "render --quiet --dataset {ds} --mesh {dir}/m.stl --spp 2 --out {out}",
