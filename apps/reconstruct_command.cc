@@ -144,7 +144,7 @@ Status PrepareSchedule(ReconstructCommandOptions* cli, Dataset* dataset,
   SFT_RETURN_IF_ERROR(ChooseStart(*dataset, cli->init, &start));
   ScheduleConfig config;
   SFT_RETURN_IF_ERROR(FreshStages(*cli, start, &config, &stages));
-  if (cli->print_schedule) return Status::Ok(std::printf("%s", FormatSchedule(stages).c_str()));
+  if (cli->print_schedule) return PrintSchedule(stages);
   SFT_RETURN_IF_ERROR(CheckViewsHaveLights(*dataset));
   const RunInputs inputs{{cli->dataset},
                          {start.path, MaterialFile(cli->material), cli->config, cli->reference}};
