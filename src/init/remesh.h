@@ -15,7 +15,8 @@
 //
 // Both first repair the input (src/init/cgal_surface_mesh.h): vertices with equal coordinates
 // are merged, faces with a repeated corner and repeated faces dropped, and vertices copied where
-// the faces around a vertex or edge are not one disk (non-manifold vertices and edges). The
+// the faces around a vertex or edge are not one disk (non-manifold vertices and edges); faces
+// with collinear corners are then removed by edge flips and collapses. The
 // output is oriented like the input and is a closed 2-manifold when the repaired input is closed
 // (checked: an error otherwise).
 //
@@ -71,7 +72,7 @@ struct RemeshReport {
   int vertices_after = 0;               // vertices of the output.
   int non_manifold_vertices_split = 0;  // vertex copies made by the repair (see above).
   int merged_vertices = 0;              // input vertices merged into one with equal coordinates.
-  int dropped_faces = 0;                // input faces dropped: a repeated corner, or a repeat.
+  int dropped_faces = 0;                // faces dropped by the repair, and zero-area faces removed.
   int faces_subdivided = 0;             // adaptive: faces after bisection, before decimation.
   int target_faces = 0;                 // A / (√3/4·L²) at the used L, at most max_faces.
   double edge_length_used = 0.0;        // the target edge length after the max_faces cap.
