@@ -171,8 +171,9 @@ Status Remesh(const TriMesh& mesh, const RemeshOptions& options, TriMesh* out,
   int degenerate = 0;
   SFT_RETURN_IF_ERROR(RemoveDegenerateFaces(&surface, &degenerate).Prefixed("remesh"));
   report->dropped_faces += degenerate;
-  if (surface.number_of_faces() == 0)
+  if (surface.number_of_faces() == 0) {
     return Status::Error("remesh: every face is degenerate (zero area)");
+  }
   std::vector<Eigen::Vector3d> positions;
   std::vector<Eigen::Vector3i> faces;
   SurfaceMeshToArrays(surface, &positions, &faces);
