@@ -11,20 +11,22 @@
 //    dense where the surface bends and sparse where it is flat.
 //  - kIsotropic: CGAL 5.5 Polygon_mesh_processing::isotropic_remeshing (Botsch & Kobbelt 2004:
 //    split edges longer than 4/3·L, collapse edges shorter than 4/5·L, flip towards valence 6,
-//    tangential relaxation, projection onto the input), giving near-uniform edges of length L.
+//    tangential relaxation, projection onto the input), giving near-uniform edges a little
+//    shorter than L (mean about 0.93 L), hence about 15% more faces than A/(√3/4·L²); the output
+//    is decimated to max_faces when it exceeds it.
 //
 // Both first repair the input (src/init/cgal_surface_mesh.h): vertices with equal coordinates
 // are merged, faces with a repeated corner and repeated faces dropped, and vertices copied where
 // the faces around a vertex or edge are not one disk (non-manifold vertices and edges); faces
-// with collinear corners are then removed by edge flips and collapses. The
-// output is oriented like the input and is a closed 2-manifold when the repaired input is closed
-// (checked: an error otherwise).
+// with collinear corners are then removed by edge flips and collapses. The output is oriented
+// like the input and is a closed 2-manifold when the repaired input is closed (checked: an error
+// otherwise).
 //
 // Face count implied by an edge length L over total area A: A / (√3/4·L²) (equilateral
 // triangles). When it exceeds max_faces, L is raised until it does not
-// (RemeshReport::edge_length_used), so that the subdivided mesh stays near max_faces in size.
-// Cost: the adaptive method holds the subdivided mesh (about 2-3x the output) in memory; OpenMesh's
-// decimation is single-threaded.
+// (RemeshReport::edge_length_used), so that the bisected mesh stays within a few times max_faces.
+// Cost: the adaptive method holds the bisected mesh (about 3x the target face count) and
+// decimates it single-threaded (OpenMesh); the isotropic one is single-threaded too.
 #ifndef SFT_INIT_REMESH_H_
 #define SFT_INIT_REMESH_H_
 
