@@ -58,11 +58,11 @@ struct RemeshOptions {
   // length; in [0.25, 1]. Smaller gives decimation more vertices to choose from, at a cost of
   // about ratio⁻² in time and memory.
   double subdivision_ratio = 1.0;
-  // Adaptive: decimation refuses collapses that turn a face normal by more than this; degrees,
-  // in (0, 180].
+  // Decimation (adaptive; isotropic only when over max_faces) refuses collapses that turn a face
+  // normal by more than this; degrees, in (0, 180].
   double max_normal_deviation_degrees = 60.0;
-  // Adaptive: decimation refuses collapses that leave a face whose longest edge over its height
-  // exceeds this (unless the collapse improves the worst face around it); 0 = off, else >= 1.2.
+  // Decimation refuses collapses that leave a face whose longest edge over its height exceeds
+  // this (unless the collapse improves the worst face around it); 0 = off, else >= 1.2.
   double max_aspect_ratio = 5.0;
 
   bool Check(std::string* why) const;
