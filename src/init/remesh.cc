@@ -1,6 +1,7 @@
 #include "src/init/remesh.h"
 
 #include <CGAL/Polygon_mesh_processing/remesh.h>
+#include <CGAL/Polygon_mesh_processing/repair_degeneracies.h>
 
 #include <OpenMesh/Tools/Subdivider/Uniform/LongestEdgeT.hh>
 #include <algorithm>
@@ -50,6 +51,22 @@ Status RemeshIsotropic(double edge_length, int iterations, SurfaceMesh* mesh) {
   } catch (const std::exception& e) {
     return Status::Error(std::string("CGAL isotropic_remeshing failed: ") + e.what());
   }
+  return Status::Ok();
+}
+
+// Removes faces with collinear corners by edge flips and collapses (CGAL 5.5
+// PMP::remove_degenerate_faces, present but not part of 5.5's documented API; the documented
+// alternative is still experimental): their zero normals would make the decimation's
+// normal-flipping guard refuse every collapse near them. Returns how many faces went.
+Status RemoveDegenerateFaces(SurfaceMesh* mesh, int* removed) {
+  const int before = static_cast<int>(mesh->number_of_faces());
+  try {
+    PMP::remove_degenerate_faces(*mesh);
+    mesh->collect_garbage();
+  } catch (const std::exception& e) {
+    return Status::Error(std::string("CGAL remove_degenerate_faces failed: ") + e.what());
+  }
+  *removed = before - static_cast<int>(mesh->number_of_faces());
   return Status::Ok();
 }
 
@@ -151,6 +168,12 @@ Status Remesh(const TriMesh& mesh, const RemeshOptions& options, TriMesh* out,
   report->non_manifold_vertices_split = repair.duplicated_points;
   report->merged_vertices = repair.merged_points;
   report->dropped_faces = repair.degenerate_faces + repair.duplicate_faces;
+  int degenerate = 0;
+  SFT_RETURN_IF_ERROR(RemoveDegenerateFaces(&surface, &degenerate).Prefixed("remesh"));
+  report->dropped_faces += degenerate;
+  if (surface.number_of_faces() == 0) {
+    return Status::Error("remesh: every face is degenerate (zero area)");
+  }
   std::vector<Eigen::Vector3d> positions;
   std::vector<Eigen::Vector3i> faces;
   SurfaceMeshToArrays(surface, &positions, &faces);

@@ -11,19 +11,22 @@
 //    dense where the surface bends and sparse where it is flat.
 //  - kIsotropic: CGAL 5.5 Polygon_mesh_processing::isotropic_remeshing (Botsch & Kobbelt 2004:
 //    split edges longer than 4/3·L, collapse edges shorter than 4/5·L, flip towards valence 6,
-//    tangential relaxation, projection onto the input), giving near-uniform edges of length L.
+//    tangential relaxation, projection onto the input), giving near-uniform edges a little
+//    shorter than L (mean about 0.93 L), hence about 15% more faces than A/(√3/4·L²); the output
+//    is decimated to max_faces when it exceeds it.
 //
 // Both first repair the input (src/init/cgal_surface_mesh.h): vertices with equal coordinates
 // are merged, faces with a repeated corner and repeated faces dropped, and vertices copied where
-// the faces around a vertex or edge are not one disk (non-manifold vertices and edges). The
-// output is oriented like the input and is a closed 2-manifold when the repaired input is closed
-// (checked: an error otherwise).
+// the faces around a vertex or edge are not one disk (non-manifold vertices and edges); faces
+// with collinear corners are then removed by edge flips and collapses. The output is oriented
+// like the input and is a closed 2-manifold when the repaired input is closed (checked: an error
+// otherwise).
 //
 // Face count implied by an edge length L over total area A: A / (√3/4·L²) (equilateral
 // triangles). When it exceeds max_faces, L is raised until it does not
-// (RemeshReport::edge_length_used), so that the subdivided mesh stays near max_faces in size.
-// Cost: the adaptive method holds the subdivided mesh (about 2-3x the output) in memory; OpenMesh's
-// decimation is single-threaded.
+// (RemeshReport::edge_length_used), so that the bisected mesh stays within a few times max_faces.
+// Cost: the adaptive method holds the bisected mesh (about 3x the target face count) and
+// decimates it single-threaded (OpenMesh); the isotropic one is single-threaded too.
 #ifndef SFT_INIT_REMESH_H_
 #define SFT_INIT_REMESH_H_
 
@@ -55,11 +58,11 @@ struct RemeshOptions {
   // length; in [0.25, 1]. Smaller gives decimation more vertices to choose from, at a cost of
   // about ratio⁻² in time and memory.
   double subdivision_ratio = 1.0;
-  // Adaptive: decimation refuses collapses that turn a face normal by more than this; degrees,
-  // in (0, 180].
+  // Decimation (adaptive; isotropic only when over max_faces) refuses collapses that turn a face
+  // normal by more than this; degrees, in (0, 180].
   double max_normal_deviation_degrees = 60.0;
-  // Adaptive: decimation refuses collapses that leave a face whose longest edge over its height
-  // exceeds this (unless the collapse improves the worst face around it); 0 = off, else >= 1.2.
+  // Decimation refuses collapses that leave a face whose longest edge over its height exceeds
+  // this (unless the collapse improves the worst face around it); 0 = off, else >= 1.2.
   double max_aspect_ratio = 5.0;
 
   bool Check(std::string* why) const;
@@ -71,7 +74,7 @@ struct RemeshReport {
   int vertices_after = 0;               // vertices of the output.
   int non_manifold_vertices_split = 0;  // vertex copies made by the repair (see above).
   int merged_vertices = 0;              // input vertices merged into one with equal coordinates.
-  int dropped_faces = 0;                // input faces dropped: a repeated corner, or a repeat.
+  int dropped_faces = 0;                // faces dropped by the repair, and zero-area faces removed.
   int faces_subdivided = 0;             // adaptive: faces after bisection, before decimation.
   int target_faces = 0;                 // A / (√3/4·L²) at the used L, at most max_faces.
   double edge_length_used = 0.0;        // the target edge length after the max_faces cap.
