@@ -1,6 +1,7 @@
 #include "src/optim/schedule.h"
 
 #include <chrono>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -272,7 +273,9 @@ Status Schedule::RunStageOuter(const ScheduleCallbacks& callbacks, bool* stop) {
   SFT_RETURN_IF_ERROR(OuterRecord(callbacks, outer, &record));
   outer_records_.push_back(record);
   const bool stage_done = progress_.stage_outer_done >= stage.fit.outer_iterations;
-  const int folds = record["flipped_faces"].get<int>() + record["self_intersecting_faces"].get<int>();
+  // CountSelfIntersectingFaces is -1 when CGAL fails: no evidence of folds then.
+  const int folds = record["flipped_faces"].get<int>() +
+                    std::max(0, record["self_intersecting_faces"].get<int>());
   if (!*stop && !stage_done && stage.topology.resample_fold_fraction > 0.0 &&
       folds > stage.topology.resample_fold_fraction * current_.mesh.n_faces()) {
     SFT_RETURN_IF_ERROR(ChangeTopology(TopologyChange::kResample, callbacks));
