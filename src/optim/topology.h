@@ -28,7 +28,7 @@ struct TopologyOptions {
   std::string remesh = "none";
   // Target edge length of remeshing, in pixels of the stage's image scale: the mean over the
   // fitted views of the surface's pixel footprint times this; (0, 64].
-  double remesh_edge_pixels = 2.0;
+  double remesh_edge_pixels = 1.0;
   bool resample = false;  // resample the surface before the stage (after remeshing).
   // After an outer iteration, resample when folded plus self-intersecting faces exceed this
   // fraction of the faces; [0, 1], 0 = never.
