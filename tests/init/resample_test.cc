@@ -284,7 +284,7 @@ TEST(ResampleTest, UnseenPartIsTrimmedToTheVisualHull) {
   EXPECT_LT(MaxAbsZ(trimmed), kHalfHeight + h);
 }
 
-TEST(ResampleTest, NoViewSeeingTheMeshIsAnError) {
+TEST(ResampleTest, NoViewSeeingTheMeshAndOtherBadInputsAreErrors) {
   // Cameras around the sphere looking away from it.
   std::vector<ViewSetup> views;
   for (int k = 0; k < 4; ++k) {
@@ -306,6 +306,22 @@ TEST(ResampleTest, NoViewSeeingTheMeshIsAnError) {
   status = ResampleSurface(TriMesh(), OrbitViews(4, 32), nullptr, ResampleOptions(), &out, &report);
   ASSERT_FALSE(status.ok());
   EXPECT_NE(status.message().find("no faces"), std::string::npos) << status.message();
+
+  // A flat quad seen from above: samples that enclose no volume.
+  TriMesh quad;
+  std::vector<TriMesh::VertexHandle> corners;
+  for (const Eigen::Vector3d& p : testing::QuadPositions(0.5)) {
+    corners.push_back(quad.add_vertex({p.x(), p.y(), p.z()}));
+  }
+  for (const Eigen::Vector3i& f : testing::QuadFaces()) {
+    quad.add_face(corners[f[0]], corners[f[1]], corners[f[2]]);
+  }
+  ResampleOptions fine;
+  fine.faces = 20000;  // enough cells on the quad for the Poisson solve to be reached.
+  status =
+      ResampleSurface(quad, {testing::TopDownView(2.0, 64, 64.0)}, nullptr, fine, &out, &report);
+  ASSERT_FALSE(status.ok());
+  EXPECT_NE(status.message().find("flat"), std::string::npos) << status.message();
 
   ResampleOptions bad;
   bad.pixel_stride = 0;
