@@ -35,6 +35,10 @@
 // (depth / focal length × pixel_stride) is coarser than h, cells stay empty and Poisson
 // interpolates between the samples as it does across any gap.
 // The grid is dense: its longest side is at most kMaxGridSide voxels (h grows when needed).
+//
+// Cost. CGAL's refinement and solve dominate and grow faster than linearly with the samples;
+// halving spacing_factor quadruples the samples and the extracted faces (and so the decimation's
+// work). The default spacing puts about one sample per output vertex.
 #ifndef SFT_INIT_RESAMPLE_H_
 #define SFT_INIT_RESAMPLE_H_
 

@@ -1,6 +1,6 @@
 // Surface resampling (src/init/resample.h): a sphere comes back as a sphere, a fold is removed,
-// Poisson's closure of an unseen part is trimmed to the visual hull, and a mesh that no view sees
-// is a clear error.
+// Poisson's closure of an unseen part is trimmed to the visual hull, and bad inputs (a mesh that no
+// view sees, a flat one, no views, bad options) are clear errors.
 #include "src/init/resample.h"
 
 #include <gtest/gtest.h>
