@@ -145,8 +145,9 @@ Status Resample(const TriMesh& mesh, const std::vector<ViewSetup>& views,
                          " rays from " + std::to_string(views.size()) +
                          " views hits it (check the cameras and the mesh's position)");
   }
-  samples = ThinSamples(samples, h);
+  // The grid first: it may coarsen h, which the thinning then uses.
   const VoxelBox box = MakeGridBox(samples, &h);
+  samples = ThinSamples(samples, h);
   report->points = static_cast<int>(samples.size());
   report->spacing = h;
   report->grid = box.dims;
