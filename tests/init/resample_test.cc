@@ -10,6 +10,7 @@
 #include <numeric>
 #include <string>
 
+#include "src/init/view_samples.h"
 #include "src/render/camera_rig.h"
 #include "src/render/scene.h"
 #include "tests/testing/views.h"
@@ -187,6 +188,24 @@ void ExpectClosedSingleOutward(const TriMesh& mesh) {
   EXPECT_TRUE(IsClosedManifold(mesh, &why)) << why;
   EXPECT_EQ(Components(mesh), 1);
   EXPECT_GT(EnclosedVolume(mesh), 0.0);
+}
+
+TEST(ResampleTest, ThinningKeepsOneSamplePerCellAndNormalDirection) {
+  // Cells of side 1 from the samples' lowest corner (0.1, 0.1, 0.1): the first cell's centre is
+  // (0.6, 0.6, 0.6).
+  const Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
+  const std::vector<OrientedPoint> samples = {
+      {{0.10, 0.10, 0.10}, up},   // first cell, +z, 0.87 from the centre.
+      {{0.40, 0.45, 0.50}, up},   // same cell and direction, 0.27 from the centre: kept.
+      {{0.40, 0.45, 0.50}, -up},  // the other side of a thin sheet: kept too.
+      {{1.50, 0.50, 0.50}, up},   // the next cell along x.
+  };
+  const std::vector<OrientedPoint> kept = ThinSamples(samples, 1.0);
+  ASSERT_EQ(kept.size(), 3u);
+  EXPECT_EQ(kept[0].position, samples[1].position);
+  EXPECT_EQ(kept[0].normal, up);
+  EXPECT_EQ(kept[1].normal, -up);
+  EXPECT_EQ(kept[2].position, samples[3].position);
 }
 
 // Bound on the radial deviation from the sphere of a result resampled at spacing h (the views of
