@@ -43,6 +43,7 @@
 #define SFT_INIT_RESAMPLE_H_
 
 #include <Eigen/Core>
+#include <cstdint>
 #include <string>
 #include <vector>
 
