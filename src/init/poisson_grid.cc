@@ -51,8 +51,8 @@ double EvaluateAt(const Triangulation& tr, const Eigen::Vector3d& p, CellHandle*
   for (int c = 0; c < 3; ++c) edges.col(c) = ToEigen(cell->vertex(c)->point()) - p3;
   const Eigen::Vector3d w = edges.partialPivLu().solve(p - p3);
   if (!w.allFinite()) return cell->vertex(0)->f();  // flat tetrahedron: any corner's value.
-  return w[0] * cell->vertex(0)->f() + w[1] * cell->vertex(1)->f() +
-         w[2] * cell->vertex(2)->f() + (1.0 - w.sum()) * cell->vertex(3)->f();
+  return w[0] * cell->vertex(0)->f() + w[1] * cell->vertex(1)->f() + w[2] * cell->vertex(2)->f() +
+         (1.0 - w.sum()) * cell->vertex(3)->f();
 }
 
 // Error unless the samples spread at least half a voxel across their flattest direction.
@@ -110,9 +110,9 @@ Status EvaluatePoissonGrid(const std::vector<OrientedPoint>& samples, const Voxe
                            double band, std::vector<float>* field, PoissonGridReport* report) {
   *report = PoissonGridReport();
   if (static_cast<int>(samples.size()) < kMinPoissonSamples) {
-    return Status::Error("too few samples for the Poisson reconstruction: " +
-                         std::to_string(samples.size()) + " (at least " +
-                         std::to_string(kMinPoissonSamples) + ")");
+    return Status::Error(
+        "too few samples for the Poisson reconstruction: " + std::to_string(samples.size()) +
+        " (at least " + std::to_string(kMinPoissonSamples) + ")");
   }
   SFT_RETURN_IF_ERROR(CheckSpansVolume(samples, box.voxel_size));
   try {
@@ -128,8 +128,10 @@ Status EvaluatePoissonGrid(const std::vector<OrientedPoint>& samples, const Voxe
     start = std::chrono::steady_clock::now();
     report->slope = MedianSlope(tr, samples, box.voxel_size);
     if (!(report->slope > 0) || !std::isfinite(report->slope)) {
-      return Status::Error("the Poisson field does not increase along the sample normals (median "
-                           "slope " + std::to_string(report->slope) + ")");
+      return Status::Error(
+          "the Poisson field does not increase along the sample normals (median "
+          "slope " +
+          std::to_string(report->slope) + ")");
     }
     const double scale = 1.0 / report->slope;
     const Eigen::Vector3i& dims = box.dims;

@@ -23,7 +23,8 @@ double TotalArea(const std::vector<Eigen::Vector3d>& positions,
                  const std::vector<Eigen::Vector3i>& faces) {
   double area = 0.0;
   for (const Eigen::Vector3i& f : faces) {
-    area += 0.5 * (positions[f[1]] - positions[f[0]]).cross(positions[f[2]] - positions[f[0]]).norm();
+    area +=
+        0.5 * (positions[f[1]] - positions[f[0]]).cross(positions[f[2]] - positions[f[0]]).norm();
   }
   return area;
 }
@@ -59,9 +60,8 @@ VoxelBox MakeGridBox(const std::vector<OrientedPoint>& samples, double* h) {
 Status TrimToHull(const std::vector<CarvingView>& views, const ResampleOptions& options,
                   const VoxelBox& box, std::vector<float>* field, ResampleReport* report) {
   VisualHullOptions hull_options;
-  hull_options.resolution =
-      std::clamp(box.dims.maxCoeff(), VisualHullOptions::kMinResolution,
-                 VisualHullOptions::kMaxResolution);
+  hull_options.resolution = std::clamp(box.dims.maxCoeff(), VisualHullOptions::kMinResolution,
+                                       VisualHullOptions::kMaxResolution);
   hull_options.min_view_fraction = options.hull_min_view_fraction;
   const Eigen::Vector3d hi = box.lo + box.voxel_size * box.dims.cast<double>();
   hull_options.bounds = box.lo.cwiseAbs().cwiseMax(hi.cwiseAbs()).maxCoeff();
@@ -95,8 +95,7 @@ Status ExtractSurface(const VoxelBox& box, double band, std::vector<float> field
   level_set.box = box;
   level_set.band = band;
   level_set.field = std::move(field);
-  if (std::none_of(level_set.field.begin(), level_set.field.end(),
-                   [](float v) { return v < 0; })) {
+  if (std::none_of(level_set.field.begin(), level_set.field.end(), [](float v) { return v < 0; })) {
     return Status::Error("the reconstructed solid is empty (no voxel inside it" +
                          std::string(report->hull_views > 0 ? " and the visual hull)" : ")"));
   }
@@ -111,8 +110,8 @@ Status ExtractSurface(const VoxelBox& box, double band, std::vector<float> field
 }
 
 Status Resample(const TriMesh& mesh, const std::vector<ViewSetup>& views,
-                const std::vector<CarvingView>* hull, const ResampleOptions& options,
-                TriMesh* out, ResampleReport* report) {
+                const std::vector<CarvingView>* hull, const ResampleOptions& options, TriMesh* out,
+                ResampleReport* report) {
   const auto start = std::chrono::steady_clock::now();
   std::vector<Eigen::Vector3d> positions;
   std::vector<Eigen::Vector3i> faces;
@@ -146,8 +145,9 @@ Status Resample(const TriMesh& mesh, const std::vector<ViewSetup>& views,
                          " rays from " + std::to_string(views.size()) +
                          " views hits it (check the cameras and the mesh's position)");
   }
-  samples = ThinSamples(samples, h);
+  // The grid first: it may coarsen h, which the thinning then uses.
   const VoxelBox box = MakeGridBox(samples, &h);
+  samples = ThinSamples(samples, h);
   report->points = static_cast<int>(samples.size());
   report->spacing = h;
   report->grid = box.dims;
@@ -157,9 +157,10 @@ Status Resample(const TriMesh& mesh, const std::vector<ViewSetup>& views,
   const double band = kBandVoxels * h;
   std::vector<float> field;
   PoissonGridReport poisson;
-  SFT_RETURN_IF_ERROR(EvaluatePoissonGrid(samples, box, band, &field, &poisson)
-                          .Prefixed("Poisson reconstruction"));
+  SFT_RETURN_IF_ERROR(
+      EvaluatePoissonGrid(samples, box, band, &field, &poisson).Prefixed("Poisson reconstruction"));
   report->triangulation_vertices = poisson.triangulation_vertices;
+  report->solve_seconds = poisson.solve_seconds;
   report->poisson_seconds = SecondsSince(stage);
 
   stage = std::chrono::steady_clock::now();
@@ -202,8 +203,8 @@ bool ResampleOptions::Check(std::string* why) const {
     return false;
   }
   if (!(hull_min_view_fraction > 0 && hull_min_view_fraction <= 1)) {
-    *why = "hull_min_view_fraction: must be in (0, 1], got " +
-           std::to_string(hull_min_view_fraction);
+    *why =
+        "hull_min_view_fraction: must be in (0, 1], got " + std::to_string(hull_min_view_fraction);
     return false;
   }
   return true;

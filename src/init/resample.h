@@ -31,13 +31,19 @@
 //
 // Limits. The result only knows what the views see: a concavity that no ray reaches is closed
 // over; features thinner than about h are lost (Poisson smooths at the sample spacing); surface
-// detail is that of the grid and the samples (the pixel footprint at the surface bounds the
-// sample density: when it is coarser than h, pixel_stride should be 1 and h follows the pixels).
+// detail is that of the grid and of the samples: where the pixel footprint at the surface
+// (depth / focal length × pixel_stride) is coarser than h, cells stay empty and Poisson
+// interpolates between the samples as it does across any gap.
 // The grid is dense: its longest side is at most kMaxGridSide voxels (h grows when needed).
+//
+// Cost. CGAL's refinement and solve dominate and grow faster than linearly with the samples;
+// halving spacing_factor quadruples the samples and the extracted faces (and so the decimation's
+// work). The default spacing puts about one sample per output vertex.
 #ifndef SFT_INIT_RESAMPLE_H_
 #define SFT_INIT_RESAMPLE_H_
 
 #include <Eigen/Core>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -87,8 +93,8 @@ struct ResampleReport {
   int64_t hits = 0;            // rays that hit the mesh (samples before thinning).
   int64_t back_face_hits = 0;  // of those, first hits on back faces (folds, inverted faces).
   int views_with_hits = 0;
-  int points = 0;                  // samples after thinning, given to the Poisson solve.
-  double spacing = 0.0;            // h: thinning cell and voxel size (scene units).
+  int points = 0;        // samples after thinning, given to the Poisson solve.
+  double spacing = 0.0;  // h: thinning cell and voxel size (scene units).
   Eigen::Vector3i grid = Eigen::Vector3i::Zero();  // voxels of the field's grid.
   int triangulation_vertices = 0;  // CGAL's Delaunay triangulation (samples + Steiner points).
   int hull_views = 0;              // carving views used for trimming (0 = no trimming).
@@ -100,7 +106,8 @@ struct ResampleReport {
   int vertices_after = 0;  // the result.
   int faces_after = 0;
   double cast_seconds = 0.0;     // ray casting and thinning.
-  double poisson_seconds = 0.0;  // CGAL's refinement and solve, and the grid evaluation.
+  double poisson_seconds = 0.0;  // CGAL's refinement and solve, and the grid evaluation;
+  double solve_seconds = 0.0;    // of which the refinement and solve.
   double trim_seconds = 0.0;     // carving the hull and intersecting.
   double extract_seconds = 0.0;  // OpenVDB extraction and clean-up.
   double decimate_seconds = 0.0;

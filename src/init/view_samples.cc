@@ -74,8 +74,8 @@ void CastViewSamples(const RenderScene& scene, const std::vector<ViewSetup>& vie
   }
   std::vector<RowSamples> rows(first_row.back());
   tbb::parallel_for(0, first_row.back(), [&](int task) {
-    const int v = static_cast<int>(
-        std::upper_bound(first_row.begin(), first_row.end(), task) - first_row.begin() - 1);
+    const int v = static_cast<int>(std::upper_bound(first_row.begin(), first_row.end(), task) -
+                                   first_row.begin() - 1);
     CastRow(scene, views[v], pixel_stride, task - first_row[v], &rows[task]);
   });
   for (size_t v = 0; v < views.size(); ++v) {

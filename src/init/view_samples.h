@@ -32,10 +32,10 @@ struct OrientedPoint {
 };
 
 struct ViewSamplesReport {
-  int64_t rays = 0;             // camera rays cast (pixel blocks with a valid ray).
-  int64_t hits = 0;             // rays that hit a non-degenerate face.
-  int64_t back_face_hits = 0;   // of those, first hits on a face whose winding faces away.
-  int views_with_hits = 0;      // views that saw the mesh at least once.
+  int64_t rays = 0;            // camera rays cast (pixel blocks with a valid ray).
+  int64_t hits = 0;            // rays that hit a non-degenerate face.
+  int64_t back_face_hits = 0;  // of those, first hits on a face whose winding faces away.
+  int views_with_hits = 0;     // views that saw the mesh at least once.
 };
 
 // Casts one ray through the centre of every pixel_stride × pixel_stride block of pixels of every
