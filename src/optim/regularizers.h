@@ -31,14 +31,15 @@ struct RegularizerOptions {
   double orientation_weight = 10.0;
   double orientation_min_fraction = 0.25;  // in (0, 1).
   // μ of the smoothing proximal term μ/2·‖(I + λL)(x − x_a)‖² (cost_functions/proximal_smoothing.h:
-  // the Levenberg–Marquardt form of Nicolet et al. 2021's "large steps" preconditioner), ≥ 0,
-  // finite; 0 = off. Unit: 1/length² (the residual is a length), given for scenes normalised to a
-  // bounding-box diagonal of 1 like laplacian_weight (for diagonal d the same effect needs μ/d²).
-  // x_a is the mesh at the start of the phase's Solve: re-anchored per outer iteration. A large μ
-  // turns the LM step into −μ⁻¹(I + λL)⁻²∇ (the large-steps update); small μ leaves LM as is.
+  // the Levenberg–Marquardt form of Nicolet et al. 2021's "large steps" preconditioner); range
+  // [0, ∞), finite (Check); 0 = off. Unit: cost per squared scene length (the residual is a
+  // length), given for scenes normalised to a bounding-box diagonal of 1 like laplacian_weight
+  // (for diagonal d the same effect needs μ/d²). x_a is the mesh at the start of the phase's
+  // Solve: re-anchored per outer iteration. A large μ turns the LM step into −μ⁻¹(I + λL)⁻²∇ (the
+  // large-steps update); μ → 0 gives plain LM.
   double proximal_weight = 0.0;
   // λ of the proximal term: smoothing strength of I + λL, L the combinatorial Laplacian D − A
-  // (dimensionless); finite, in [0, 1e6]; 0 = plain Tikhonov damping. The paper uses 19 to 49,
+  // (dimensionless); range [0, 1e6] (Check); 0 = plain Tikhonov damping. The paper uses 19 to 49,
   // Mitsuba 3's shape-optimisation tutorial 25.
   double proximal_lambda = 25.0;
   double albedo_smoothness = 0.0;     // weight of albedo differences of neighbouring texels, ≥ 0.

@@ -126,10 +126,15 @@ TEST_F(ReconstructTest, NonFiniteRenderFailsTheEvaluation) {
 // Every level's rows applied to δ equal the central difference of that level's image along δ
 // (albedo and light scale: the image is linear in them, so the difference is exact).
 TEST_F(ReconstructTest, CacheRowsMatchFiniteDifferencesOnEveryLevel) {
-  for (ParameterKind kind : {ParameterKind::kAlbedo, ParameterKind::kLight}) {
+  for (const auto& [filter, kind] : std::vector<std::pair<PyramidFilter, ParameterKind>>{
+           {PyramidFilter::kBox, ParameterKind::kAlbedo},
+           {PyramidFilter::kBox, ParameterKind::kLight},
+           {PyramidFilter::kBinomial, ParameterKind::kAlbedo}}) {
+    SCOPED_TRACE(PyramidFilterName(filter));
     FitSetup s;
     ActiveParameters active;
     active.lights = true;
+    options_.cache.pyramid_filter = filter;
     MakeSetup(dataset_, mesh_, truth_, options_.cache, active, &s);
     const std::vector<double> delta = RandomDirection(s.params, kind, 11);
     const std::vector<double> x0 = s.params.values();
@@ -258,67 +263,73 @@ TEST(PyramidPixelCostTest, CopiesRowsIntoBlocks) {
 // which is exactly quadratic in albedo here; and the trust-region problem's gradient Jᵀr against
 // the same, up to the Jacobian mass its frozen supersets drop.
 TEST_F(ReconstructTest, GradientsMatchFiniteDifferencesOfTheCost) {
-  FitSetup s;
-  ActiveParameters active;  // albedo and roughness.
-  MakeSetup(dataset_, mesh_, guess_, options_.cache, active, &s);
-  ceres::Problem empty;
-  AdjointObjective objective(s.cache.get(), &s.params, ParameterBounds(), nullptr);
-  std::vector<double> x = objective.Current();
-  std::vector<double> gradient(x.size());
-  double cost = 0.0;
-  ASSERT_TRUE(objective.Evaluate(x.data(), &cost, gradient.data()));
-  std::mt19937 rng(4);
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  std::vector<double> delta(x.size(), 0.0);
-  for (size_t k = 0; k < x.size(); ++k) {
-    if (s.params.layout().KindOf(objective.active_indices()[k]) == ParameterKind::kAlbedo) {
-      delta[k] = u(rng);
+  // Both pyramid filters: the adjoint weights (DownsampleMeanAdjoint) and the coarse rows
+  // (DownsampleRows) must follow the filter of the levels.
+  for (PyramidFilter filter : {PyramidFilter::kBox, PyramidFilter::kBinomial}) {
+    SCOPED_TRACE(PyramidFilterName(filter));
+    options_.cache.pyramid_filter = filter;
+    FitSetup s;
+    ActiveParameters active;  // albedo and roughness.
+    MakeSetup(dataset_, mesh_, guess_, options_.cache, active, &s);
+    ceres::Problem empty;
+    AdjointObjective objective(s.cache.get(), &s.params, ParameterBounds(), nullptr);
+    std::vector<double> x = objective.Current();
+    std::vector<double> gradient(x.size());
+    double cost = 0.0;
+    ASSERT_TRUE(objective.Evaluate(x.data(), &cost, gradient.data()));
+    std::mt19937 rng(4);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    std::vector<double> delta(x.size(), 0.0);
+    for (size_t k = 0; k < x.size(); ++k) {
+      if (s.params.layout().KindOf(objective.active_indices()[k]) == ParameterKind::kAlbedo) {
+        delta[k] = u(rng);
+      }
     }
-  }
-  const double h = 1e-3;
-  double costs[2];
-  for (int side = 0; side < 2; ++side) {
-    std::vector<double> y = x;
-    for (size_t k = 0; k < x.size(); ++k) y[k] += (side == 0 ? h : -h) * delta[k];
-    ASSERT_TRUE(objective.Evaluate(y.data(), &costs[side], nullptr));
-  }
-  const double fd = (costs[0] - costs[1]) / (2 * h);
-  double directional = 0.0;
-  for (size_t k = 0; k < x.size(); ++k) directional += gradient[k] * delta[k];
-  ASSERT_GT(std::abs(fd), 0.0);
-  EXPECT_NEAR(directional / fd, 1.0, 1e-3);
+    const double h = 1e-3;
+    double costs[2];
+    for (int side = 0; side < 2; ++side) {
+      std::vector<double> y = x;
+      for (size_t k = 0; k < x.size(); ++k) y[k] += (side == 0 ? h : -h) * delta[k];
+      ASSERT_TRUE(objective.Evaluate(y.data(), &costs[side], nullptr));
+    }
+    const double fd = (costs[0] - costs[1]) / (2 * h);
+    double directional = 0.0;
+    for (size_t k = 0; k < x.size(); ++k) directional += gradient[k] * delta[k];
+    ASSERT_GT(std::abs(fd), 0.0);
+    EXPECT_NEAR(directional / fd, 1.0, 1e-3);
 
-  // The Ceres problem at the same point and seed.
-  objective.Store(x.data());
-  std::unique_ptr<ReconstructionProblem> problem;
-  ProblemOptions problem_options;
-  problem_options.superset_renders = 4;
-  ASSERT_TRUE(
-      ReconstructionProblem::Build(s.cache.get(), &s.params, problem_options, &problem).ok());
-  std::vector<double*> blocks;
-  problem->problem()->GetParameterBlocks(&blocks);
-  ceres::Problem::EvaluateOptions evaluate;
-  evaluate.parameter_blocks = blocks;
-  double problem_cost = 0.0;
-  std::vector<double> problem_gradient;
-  ASSERT_TRUE(
-      problem->problem()->Evaluate(evaluate, &problem_cost, nullptr, &problem_gradient, nullptr));
-  // Measured at the rows of this evaluation (not of the superset renders).
-  const double dropped = problem->DroppedJacobianFraction(*s.cache);
-  double problem_directional = 0.0;
-  size_t k = 0;
-  for (double* block : blocks) {
-    const int offset = static_cast<int>(block - s.params.data());
-    for (int i = 0; i < problem->problem()->ParameterBlockSize(block); ++i, ++k) {
-      const auto it = std::lower_bound(objective.active_indices().begin(),
-                                       objective.active_indices().end(), offset + i);
-      problem_directional += problem_gradient[k] * delta[it - objective.active_indices().begin()];
+    // The Ceres problem at the same point and seed.
+    objective.Store(x.data());
+    std::unique_ptr<ReconstructionProblem> problem;
+    ProblemOptions problem_options;
+    problem_options.superset_renders = 4;
+    ASSERT_TRUE(
+        ReconstructionProblem::Build(s.cache.get(), &s.params, problem_options, &problem).ok());
+    std::vector<double*> blocks;
+    problem->problem()->GetParameterBlocks(&blocks);
+    ceres::Problem::EvaluateOptions evaluate;
+    evaluate.parameter_blocks = blocks;
+    double problem_cost = 0.0;
+    std::vector<double> problem_gradient;
+    ASSERT_TRUE(
+        problem->problem()->Evaluate(evaluate, &problem_cost, nullptr, &problem_gradient, nullptr));
+    // Measured at the rows of this evaluation (not of the superset renders).
+    const double dropped = problem->DroppedJacobianFraction(*s.cache);
+    double problem_directional = 0.0;
+    size_t k = 0;
+    for (double* block : blocks) {
+      const int offset = static_cast<int>(block - s.params.data());
+      for (int i = 0; i < problem->problem()->ParameterBlockSize(block); ++i, ++k) {
+        const auto it = std::lower_bound(objective.active_indices().begin(),
+                                         objective.active_indices().end(), offset + i);
+        problem_directional += problem_gradient[k] * delta[it - objective.active_indices().begin()];
+      }
     }
+    // Pixels with no parameters are left out of the problem but are constant: same cost up to them.
+    EXPECT_LE(problem_cost, cost * (1 + 1e-9));
+    EXPECT_LT(dropped, 0.05);
+    EXPECT_NEAR(problem_directional / fd, 1.0, 1e-3 + 2 * std::sqrt(dropped)) << dropped;
   }
-  // Pixels with no parameters are left out of the problem but are constant: same cost up to them.
-  EXPECT_LE(problem_cost, cost * (1 + 1e-9));
-  EXPECT_LT(dropped, 0.05);
-  EXPECT_NEAR(problem_directional / fd, 1.0, 1e-3 + 2 * std::sqrt(dropped)) << dropped;
 }
 
 // Texture only, from a constant grey guess: Levenberg–Marquardt recovers the albedo texels that
