@@ -169,12 +169,13 @@ Status PrepareSchedule(ReconstructCommandOptions* cli, Dataset* dataset,
 
 Status RunReconstruct(const ReconstructCommandOptions& cli_in) {
   ReconstructCommandOptions cli = cli_in;
+  // The reference first: a bad one must not leave an output folder behind.
+  TriMesh reference;
+  if (!cli.reference.empty()) SFT_RETURN_IF_ERROR(ReadMesh(cli.reference, &reference));
   Dataset dataset;
   std::unique_ptr<Schedule> schedule;
   SFT_RETURN_IF_ERROR(PrepareSchedule(&cli, &dataset, &schedule));
   if (!schedule) return Status::Ok();  // --print-schedule.
-  TriMesh reference;
-  if (!cli.reference.empty()) SFT_RETURN_IF_ERROR(ReadMesh(cli.reference, &reference));
   Progress progress("reconstruct", schedule->RemainingWork(), !cli.quiet);
   ScheduleCallbacks callbacks;
   callbacks.on_iteration = [&](const IterationRecord& record) {

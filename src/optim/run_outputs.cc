@@ -31,6 +31,7 @@ Status WriteRunState(const std::string& out, const RunState& state) {
             {"stage_prepared", p.stage_prepared},
             {"outer_done", p.outer_done},
             {"topology_changes", p.topology_changes},
+            {"stage_outers_done", p.stage_outers_done},
             {"seconds", p.seconds},
             {"finished", state.finished}};
   return WriteTextFile(JoinPath(out, "state.json"), j.dump(1) + "\n");
@@ -67,6 +68,11 @@ Status ReadRunState(const std::string& out, RunState* state) {
   p.stage_prepared = j.value("stage_prepared", false);
   p.outer_done = j["outer_done"].get<int>();
   p.topology_changes = j.value("topology_changes", 0);
+  if (j.contains("stage_outers_done") && j["stage_outers_done"].is_array()) {
+    for (const json& n : j["stage_outers_done"]) {
+      p.stage_outers_done.push_back(n.is_number_integer() ? n.get<int>() : 0);
+    }
+  }
   p.seconds = j.value("seconds", 0.0);
   state->finished = j.value("finished", false);
   if (p.stage > static_cast<int>(state->stages.size())) {

@@ -105,6 +105,16 @@ Status Schedule::Resume(const Dataset& dataset, const std::string& out,
   s->stages_ = stages;
   s->run_info_ = run_info;
   s->progress_ = progress;
+  s->progress_.stage_outers_done.resize(stages.size(), 0);
+  ScheduleProgress& p = s->progress_;
+  // A finished run whose last stage was given more outer iterations (--outer on resume)
+  // continues that stage.
+  if (p.stage >= static_cast<int>(stages.size()) &&
+      stages.back().fit.outer_iterations > p.stage_outers_done.back()) {
+    p.stage = static_cast<int>(stages.size()) - 1;
+    p.stage_outer_done = p.stage_outers_done.back();
+    p.stage_prepared = true;
+  }
   SFT_RETURN_IF_ERROR(ReadRunSnapshot(out, dataset, &s->current_.mesh, &s->current_.material,
                                       &s->current_.light_scales));
   const std::string baseline = JoinPath(out, kBaselineMesh);
@@ -268,6 +278,8 @@ Status Schedule::RunStageOuter(const ScheduleCallbacks& callbacks, bool* stop) {
   if (!*stop) {
     ++progress_.outer_done;
     ++progress_.stage_outer_done;
+    progress_.stage_outers_done.resize(stages_.size(), 0);
+    progress_.stage_outers_done[progress_.stage] = progress_.stage_outer_done;
   }
   json record;
   SFT_RETURN_IF_ERROR(OuterRecord(callbacks, outer, &record));
@@ -311,6 +323,12 @@ Status Schedule::Run(const ScheduleCallbacks& callbacks) {
       SFT_RETURN_IF_ERROR(PrepareStage(callbacks));
     } else if (!reconstruction_) {
       SFT_RETURN_IF_ERROR(CreateReconstruction());
+    }
+    if (progress_.stage_outer_done >= CurrentStage().fit.outer_iterations) {
+      // Resumed with fewer outer iterations than this stage already ran.
+      SFT_RETURN_IF_ERROR(FinishStage());
+      SFT_RETURN_IF_ERROR(Checkpoint());
+      continue;
     }
     bool stop = false;
     SFT_RETURN_IF_ERROR(RunStageOuter(callbacks, &stop));

@@ -50,6 +50,7 @@ struct ScheduleProgress {
   bool stage_prepared = false;   // the current stage's topology/texel change has been applied.
   int outer_done = 0;            // outer iterations completed over all stages (seeds, records).
   int topology_changes = 0;      // remeshings and resamplings so far.
+  std::vector<int> stage_outers_done;  // outer iterations completed per stage (index = stage).
   double seconds = 0.0;          // wall time of the run so far, all sessions.
 };
 

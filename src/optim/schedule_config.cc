@@ -40,12 +40,12 @@ StageKey OneOf(std::function<std::string&(StageOptions*)> field,
                std::vector<std::string> allowed, std::string later) {
   return {[field, allowed, later](const json& v, StageOptions* s) -> std::string {
             std::string list;
-            for (const std::string& a : allowed) {
-              if (v.is_string() && v.get<std::string>() == a) {
-                field(s) = a;
+            for (size_t k = 0; k < allowed.size(); ++k) {
+              if (v.is_string() && v.get<std::string>() == allowed[k]) {
+                field(s) = allowed[k];
                 return "";
               }
-              list += (list.empty() ? "" : ", ") + a;
+              list += (k == 0 ? "" : k + 1 == allowed.size() ? " or " : ", ") + allowed[k];
             }
             return "expected " + list + later;
           },
