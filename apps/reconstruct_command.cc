@@ -158,12 +158,12 @@ Status PrepareSchedule(ReconstructCommandOptions* cli, Dataset* dataset,
   SFT_RETURN_IF_ERROR(LoadStartMesh(*dataset, start, InitialMeshOptions(), &state.mesh));
   SFT_RETURN_IF_ERROR(LoadMaterial(cli->material.empty() ? kInitialGuess : cli->material,
                                    state.mesh, &state.material));
-  const nlohmann::json run_info = {{"dataset", cli->dataset},
-                                   {"start", start.Describe()},
-                                   {"init", start.path},
-                                   {"config", config.flat},
-                                   {"schedule", config.stages.is_null() ? config.schedule
-                                                                         : "explicit"}};
+  const nlohmann::json run_info = {
+      {"dataset", cli->dataset},
+      {"start", start.Describe()},
+      {"init", start.path},
+      {"config", config.flat},
+      {"schedule", config.stages.is_null() ? config.schedule : "explicit"}};
   return Schedule::Start(*dataset, cli->out, stages, state, run_info, schedule);
 }
 
@@ -192,10 +192,9 @@ Status RunReconstruct(const ReconstructCommandOptions& cli_in) {
   SFT_RETURN_IF_ERROR(schedule->Run(callbacks));
   progress.Finish();
   if (!cli.no_report && schedule->reconstruction() != nullptr) {
-    SFT_RETURN_IF_ERROR(WriteReconstructReport(cli.out, dataset, schedule->records(),
-                                               schedule->reconstruction(),
-                                               schedule->outer_records(),
-                                               schedule->stage_records()));
+    SFT_RETURN_IF_ERROR(
+        WriteReconstructReport(cli.out, dataset, schedule->records(), schedule->reconstruction(),
+                               schedule->outer_records(), schedule->stage_records()));
   }
   const ScheduleProgress& p = schedule->progress();
   if (schedule->stopped()) {
@@ -232,8 +231,9 @@ CommandRunner SetupReconstructCommand(CLI::App* app) {
   key_flag(app->add_option("--solver", opts->solver, "lm | dogleg | lbfgs | adam"), "solver");
   key_flag(app->add_option("--outer", opts->outer, "Outer iterations of every stage"),
            "outer_iterations");
-  key_flag(app->add_option("--steps", opts->steps, "Solver iterations per outer iteration and phase"),
-           "steps");
+  key_flag(
+      app->add_option("--steps", opts->steps, "Solver iterations per outer iteration and phase"),
+      "steps");
   key_flag(app->add_option("--spp", opts->spp, "Samples per pixel of the fit's renders"), "spp");
   key_flag(app->add_option("--bounces", opts->bounces, "Path segments"), "bounces");
   key_flag(app->add_option("--threads", opts->threads, "Render threads (0 = all cores)"),

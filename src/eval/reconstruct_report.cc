@@ -51,9 +51,8 @@ Status AddStages(const nlohmann::json& stages, HtmlReport* html) {
   ImageRow row;
   row.label = "stages";
   for (const auto& s : stages) {
-    const std::string caption = s.value("stage", "?") + ": " +
-                                std::to_string(s.value("faces", 0)) + " faces, " +
-                                FormatNumber(s.value("end_seconds", 0.0)) + " s";
+    const std::string caption = s.value("stage", "?") + ": " + std::to_string(s.value("faces", 0)) +
+                                " faces, " + FormatNumber(s.value("end_seconds", 0.0)) + " s";
     row.images.push_back({s.value("normals", ""), caption, nullptr});
   }
   return html->AddImageRow(row);

@@ -77,7 +77,7 @@ class Reconstruction {
   // Renders every fitted view at the current state (seed `seed`) and returns level-0 images.
   std::vector<Image> RenderViews(uint64_t seed);
   // The normal pass of fitted view `v` at the current state (RGB: world-space geometric normals
-  // facing the camera; alpha: coverage), at the fit's image scale.
+  // facing the camera; alpha: coverage), at the dataset's resolution.
   Image RenderNormals(int v);
   const RenderCache& cache() const { return *cache_; }
   const std::vector<PhaseRecord>& phases() const { return phase_records_; }

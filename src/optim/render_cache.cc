@@ -150,9 +150,11 @@ Image RenderCache::RenderPassImage(int v, RenderPass pass) {
   render.seed = seed_;
   render.pass = pass;
   render.spp = 4;  // antialiasing only: the pass has no noise.
+  ViewSetup view = ScaledView(v);
+  view.camera = views_->views[view_indices_[v]].camera;  // the dataset's resolution.
   Image image;
   RenderStats stats;
-  RenderView(*scene_, material_, ScaledView(v), render, &image, &stats);
+  RenderView(*scene_, material_, view, render, &image, &stats);
   return image;
 }
 

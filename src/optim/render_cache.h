@@ -65,7 +65,8 @@ class RenderCache : public ceres::EvaluationCallback {
 
   void PrepareForEvaluation(bool evaluate_jacobians, bool new_evaluation_point) override;
 
-  // Renders view v's `pass` (RenderOptions::pass) at the current parameters (not stored).
+  // Renders view v's `pass` (RenderOptions::pass) at the current parameters and the dataset's
+  // full resolution (not stored).
   Image RenderPassImage(int v, RenderPass pass);
   // Renders every view at the current parameters: rows of the `active` kinds when `rows`.
   void Render(bool rows);

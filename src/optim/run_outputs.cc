@@ -111,8 +111,7 @@ Status WriteMetrics(const std::string& out, const std::vector<IterationRecord>& 
     for (double p : r.view_psnr) mean += p / std::max<size_t>(1, r.view_psnr.size());
     char line[256];
     std::snprintf(line, sizeof(line), "%d,%s,%s,%d,%.9g,%.3f,%d,%.4f", r.outer, r.stage.c_str(),
-                  r.phase.c_str(),
-                  r.iteration, r.cost, r.seconds, r.accepted ? 1 : 0, mean);
+                  r.phase.c_str(), r.iteration, r.cost, r.seconds, r.accepted ? 1 : 0, mean);
     csv += line;
     for (double p : r.view_psnr) {
       std::snprintf(line, sizeof(line), ",%.4f", p);

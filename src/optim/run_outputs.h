@@ -1,8 +1,9 @@
 // What `sft reconstruct` writes into its output folder, each file atomically:
 //   mesh.ply, mesh.obj          the current mesh;
-//   material.json, material_albedo.meshcolors, material_roughness.meshcolors   the material (mesh colors; `sft render` reads it);
-//   lights.json                 the fitted light scales (src/io/light_scales.h);
-//   metrics.csv, metrics.json   per iteration: outer, stage, phase, iteration, cost, seconds,
+//   material.json, material_albedo.meshcolors, material_roughness.meshcolors   the material (mesh
+//   colors; `sft render` reads it); lights.json                 the fitted light scales
+//   (src/io/light_scales.h); metrics.csv, metrics.json   per iteration: outer, stage, phase,
+//   iteration, cost, seconds,
 //                               accepted, per-view PSNR; metrics.json adds per-phase solver
 //                               statistics, per-outer records, topology changes and stages;
 //   state.json                  what --resume needs (format sft-reconstruct-state/2): the run's

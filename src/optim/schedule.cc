@@ -1,7 +1,7 @@
 #include "src/optim/schedule.h"
 
-#include <chrono>
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 
@@ -118,8 +118,8 @@ Status Schedule::Resume(const Dataset& dataset, const std::string& out,
   SFT_RETURN_IF_ERROR(ReadRunSnapshot(out, dataset, &s->current_.mesh, &s->current_.material,
                                       &s->current_.light_scales));
   const std::string baseline = JoinPath(out, kBaselineMesh);
-  SFT_RETURN_IF_ERROR(ReadMesh(FileExists(baseline) ? baseline : JoinPath(out, "mesh.ply"),
-                               &s->baseline_));
+  SFT_RETURN_IF_ERROR(
+      ReadMesh(FileExists(baseline) ? baseline : JoinPath(out, "mesh.ply"), &s->baseline_));
   if (s->baseline_.n_faces() != s->current_.mesh.n_faces()) {
     return Status::Error(baseline + ": " + std::to_string(s->baseline_.n_faces()) +
                          " faces, the checkpoint's mesh.ply has " +
@@ -128,7 +128,8 @@ Status Schedule::Resume(const Dataset& dataset, const std::string& out,
   SFT_RETURN_IF_ERROR(ReadIterationRecords(out, &s->records_));
   json metrics;
   SFT_RETURN_IF_ERROR(ReadMetricsJson(out, &metrics));
-  if (metrics.contains("outer") && metrics["outer"].is_array()) s->outer_records_ = metrics["outer"];
+  if (metrics.contains("outer") && metrics["outer"].is_array())
+    s->outer_records_ = metrics["outer"];
   if (metrics.contains("topology_changes") && metrics["topology_changes"].is_array()) {
     s->topology_records_ = metrics["topology_changes"];
   }
@@ -166,9 +167,8 @@ Status Schedule::ChangeTopology(TopologyChange change, const ScheduleCallbacks& 
   const double start = NowSeconds();
   json record;
   SFT_RETURN_IF_ERROR(ApplyTopologyChange(change, stage.topology, *dataset_, views,
-                                          stage.fit.cache.image_scale_log2,
-                                          stage.texel_resolution, &current_.mesh,
-                                          &current_.material, &record));
+                                          stage.fit.cache.image_scale_log2, stage.texel_resolution,
+                                          &current_.mesh, &current_.material, &record));
   record["stage"] = stage.name;
   record["outer"] = progress_.outer_done;
   record["seconds"] = NowSeconds() - start;
@@ -193,7 +193,8 @@ Status Schedule::PrepareStage(const ScheduleCallbacks& callbacks) {
   const StageOptions& stage = stages_[progress_.stage];
   if (callbacks.on_event) {
     char line[256];
-    std::snprintf(line, sizeof(line), "stage %d/%zu %s: %s at 1/%d scale, %d spp, %d outer x %d steps",
+    std::snprintf(line, sizeof(line),
+                  "stage %d/%zu %s: %s at 1/%d scale, %d spp, %d outer x %d steps",
                   progress_.stage + 1, stages_.size(), stage.name.c_str(),
                   PhaseScheduleName(stage.fit.phases), 1 << stage.fit.cache.image_scale_log2,
                   stage.fit.cache.render.spp, stage.fit.outer_iterations, stage.fit.solver.steps);
@@ -267,13 +268,13 @@ Status Schedule::RunStageOuter(const ScheduleCallbacks& callbacks, bool* stop) {
   const StageOptions& stage = stages_[progress_.stage];
   const int outer = progress_.outer_done;
   SFT_RETURN_IF_ERROR(reconstruction_->RunOuter(outer, [&](const IterationRecord& record) {
-        IterationRecord r = record;
-        r.stage = stage.name;
-        records_.push_back(r);
-        const bool go_on = !callbacks.on_iteration || callbacks.on_iteration(r);
-        *stop = *stop || !go_on;
-        return go_on;
-      }));
+    IterationRecord r = record;
+    r.stage = stage.name;
+    records_.push_back(r);
+    const bool go_on = !callbacks.on_iteration || callbacks.on_iteration(r);
+    *stop = *stop || !go_on;
+    return go_on;
+  }));
   SyncCurrent();
   if (!*stop) {
     ++progress_.outer_done;
@@ -299,8 +300,8 @@ Status Schedule::RunStageOuter(const ScheduleCallbacks& callbacks, bool* stop) {
 
 Status Schedule::Checkpoint() {
   progress_.seconds = Elapsed();
-  SFT_RETURN_IF_ERROR(WriteRunSnapshot(out_, *dataset_, current_.mesh, current_.material,
-                                       current_.light_scales));
+  SFT_RETURN_IF_ERROR(
+      WriteRunSnapshot(out_, *dataset_, current_.mesh, current_.material, current_.light_scales));
   json info = run_info_;
   info["outer"] = outer_records_;
   info["topology_changes"] = topology_records_;

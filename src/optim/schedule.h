@@ -45,13 +45,13 @@ struct StageOptions {
 
 // Where a run stands; state.json records it (format sft-reconstruct-state/2).
 struct ScheduleProgress {
-  int stage = 0;                 // index of the current stage (== stages.size() when finished).
-  int stage_outer_done = 0;      // outer iterations completed within the current stage.
-  bool stage_prepared = false;   // the current stage's topology/texel change has been applied.
-  int outer_done = 0;            // outer iterations completed over all stages (seeds, records).
-  int topology_changes = 0;      // remeshings and resamplings so far.
+  int stage = 0;                // index of the current stage (== stages.size() when finished).
+  int stage_outer_done = 0;     // outer iterations completed within the current stage.
+  bool stage_prepared = false;  // the current stage's topology/texel change has been applied.
+  int outer_done = 0;           // outer iterations completed over all stages (seeds, records).
+  int topology_changes = 0;     // remeshings and resamplings so far.
   std::vector<int> stage_outers_done;  // outer iterations completed per stage (index = stage).
-  double seconds = 0.0;          // wall time of the run so far, all sessions.
+  double seconds = 0.0;                // wall time of the run so far, all sessions.
 };
 
 // The state a schedule starts from (or a checkpoint holds).
@@ -132,7 +132,7 @@ class Schedule {
   nlohmann::json outer_records_ = nlohmann::json::array();
   nlohmann::json topology_records_ = nlohmann::json::array();
   nlohmann::json stage_records_ = nlohmann::json::array();
-  size_t phases_seen_ = 0;  // phase records of reconstruction_ already collected.
+  size_t phases_seen_ = 0;      // phase records of reconstruction_ already collected.
   double session_start_ = 0.0;  // steady-clock seconds when this session's Run began.
   double seconds_at_start_ = 0.0;
   bool stopped_ = false;

@@ -36,8 +36,8 @@ struct StageKey {
   std::function<json(const StageOptions&)> get;
 };
 
-StageKey OneOf(std::function<std::string&(StageOptions*)> field,
-               std::vector<std::string> allowed, std::string later) {
+StageKey OneOf(std::function<std::string&(StageOptions*)> field, std::vector<std::string> allowed,
+               std::string later) {
   return {[field, allowed, later](const json& v, StageOptions* s) -> std::string {
             std::string list;
             for (size_t k = 0; k < allowed.size(); ++k) {
@@ -234,8 +234,9 @@ std::string FormatSchedule(const std::vector<StageOptions>& stages) {
     if (s.topology.resample) before += std::string(before.empty() ? "" : ", ") + "resample";
     if (before.empty()) before = "-";
     char line[256];
-    std::snprintf(line, sizeof(line), "%5zu  %-10s  %-9s  1/%-4d %4d  %6d  %5d  %5d  %6s  %-6s  %s\n",
-                  k, s.name.c_str(), PhaseScheduleName(f.phases), 1 << f.cache.image_scale_log2,
+    std::snprintf(line, sizeof(line),
+                  "%5zu  %-10s  %-9s  1/%-4d %4d  %6d  %5d  %5d  %6s  %-6s  %s\n", k,
+                  s.name.c_str(), PhaseScheduleName(f.phases), 1 << f.cache.image_scale_log2,
                   f.cache.render.spp, f.cache.pyramid_levels, f.outer_iterations, f.solver.steps,
                   s.texel_resolution > 0 ? std::to_string(s.texel_resolution).c_str() : "keep",
                   SolverKindName(f.solver.kind), before.c_str());

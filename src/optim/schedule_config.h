@@ -39,8 +39,7 @@ Status ResolveStages(const ScheduleConfig& config, bool carved_start,
                      std::vector<StageOptions>* stages);
 
 // Applies stage keys (a stage object or flat keys) to one stage.
-Status ApplyStageConfig(const nlohmann::json& keys, const std::string& source,
-                        StageOptions* stage);
+Status ApplyStageConfig(const nlohmann::json& keys, const std::string& source, StageOptions* stage);
 
 // Every key of a stage with its value (ApplyStageConfig of it reproduces the stage).
 nlohmann::json StageJson(const StageOptions& stage);

@@ -104,8 +104,7 @@ double PixelFootprint(const TriMesh& mesh, const Dataset& dataset,
   int count = 0;
   for (int v : view_indices) {
     const ViewSpec& view = dataset.views[v];
-    const Camera camera =
-        DownscaledCamera(dataset.cameras[view.camera], image_scale_log2);
+    const Camera camera = DownscaledCamera(dataset.cameras[view.camera], image_scale_log2);
     const Eigen::Vector3d centre = view.cam_from_world.Inverse().translation;
     const Eigen::Vector2d focal = camera.Focal();
     sum += (centroid - centre).norm() * 2.0 / (focal.x() + focal.y());
@@ -120,14 +119,13 @@ Status ApplyTopologyChange(TopologyChange change, const TopologyOptions& options
                            Material* material, json* record) {
   const TriMesh old_mesh = *mesh;
   if (change == TopologyChange::kRemesh) {
-    const double edge = options.remesh_edge_pixels *
-                        PixelFootprint(*mesh, dataset, view_indices, image_scale_log2);
+    const double edge =
+        options.remesh_edge_pixels * PixelFootprint(*mesh, dataset, view_indices, image_scale_log2);
     SFT_RETURN_IF_ERROR(Remesh(options, edge, mesh, record));
   } else {
     SFT_RETURN_IF_ERROR(Resample(options, dataset, view_indices, image_scale_log2, mesh, record));
   }
-  const int resolution =
-      texel_resolution > 0 ? texel_resolution : material->albedo.resolution();
+  const int resolution = texel_resolution > 0 ? texel_resolution : material->albedo.resolution();
   Material transferred;
   SFT_RETURN_IF_ERROR(TransferMaterial(old_mesh, *material, *mesh, resolution, &transferred));
   *material = std::move(transferred);

@@ -50,9 +50,8 @@ double PixelFootprint(const TriMesh& mesh, const Dataset& dataset,
 // (kind, faces before and after, seconds, the parts' reports).
 Status ApplyTopologyChange(TopologyChange change, const TopologyOptions& options,
                            const Dataset& dataset, const std::vector<int>& view_indices,
-                           int image_scale_log2,
-                           int texel_resolution, TriMesh* mesh, Material* material,
-                           nlohmann::json* record);
+                           int image_scale_log2, int texel_resolution, TriMesh* mesh,
+                           Material* material, nlohmann::json* record);
 
 // The material at another mesh-colours resolution on the same mesh (values read at the new
 // texels' representative points).

@@ -15,8 +15,8 @@
 namespace sft {
 namespace {
 
-using testing::RunSft;
 using ::testing::HasSubstr;
+using testing::RunSft;
 namespace fs = std::filesystem;
 
 nlohmann::json ReadJson(const std::string& path) {
@@ -28,11 +28,11 @@ nlohmann::json ReadJson(const std::string& path) {
 
 TEST(ReconstructHullTest, CarveRefineRemeshResampleTexture) {
   testing::TempDir tmp;
-  ASSERT_EQ(testing::SynthIcosphere(
-                tmp.Join("ds"),
-                "--cameras 8 --zooms 1 --res 48 --spp 32 --bounces 1 "
-                "--material '{\"albedo\": [0.7, 0.5, 0.3], \"roughness\": 0.5}'"),
-            "");
+  ASSERT_EQ(
+      testing::SynthIcosphere(tmp.Join("ds"),
+                              "--cameras 8 --zooms 1 --res 48 --spp 32 --bounces 1 "
+                              "--material '{\"albedo\": [0.7, 0.5, 0.3], \"roughness\": 0.5}'"),
+      "");
   std::string out;
   ASSERT_EQ(RunSft("reconstruct --dataset " + tmp.Join("ds") + " --out " + tmp.Join("r") +
                        " --reference " + tmp.Join("ds/gt/mesh.ply") +

@@ -44,9 +44,9 @@ TEST(ScheduleConfigTest, FlatKeysOverrideEveryStage) {
   EXPECT_EQ(stages[1].fit.cache.image_scale_log2, 0);  // the default, not stage a's.
   // StageJson round-trips.
   std::vector<StageOptions> again;
-  ASSERT_TRUE(StagesFromJson(json::array({StageJson(stages[0]), StageJson(stages[1])}), "state",
-                             &again)
-                  .ok());
+  ASSERT_TRUE(
+      StagesFromJson(json::array({StageJson(stages[0]), StageJson(stages[1])}), "state", &again)
+          .ok());
   EXPECT_EQ(StageJson(again[0]), StageJson(stages[0]));
   EXPECT_EQ(StageJson(again[1]), StageJson(stages[1]));
   const std::string table = FormatSchedule(stages);
@@ -117,10 +117,9 @@ class ScheduleRunTest : public ::testing::Test {
   void SetUp() override {
     ASSERT_TRUE(ReadDataset(dir_->Join("ds"), &dataset_).ok());
     ASSERT_TRUE(ReadMesh(dir_->Join("ds/gt/mesh.ply"), &start_.mesh).ok());
-    ASSERT_TRUE(
-        LoadMaterial(R"({"albedo": [0.5, 0.5, 0.5], "roughness": 0.5})", start_.mesh,
-                     &start_.material)
-            .ok());
+    ASSERT_TRUE(LoadMaterial(R"({"albedo": [0.5, 0.5, 0.5], "roughness": 0.5})", start_.mesh,
+                             &start_.material)
+                    .ok());
   }
   std::vector<StageOptions> Stages(const std::string& text) {
     ScheduleConfig config;
@@ -172,9 +171,9 @@ TEST_F(ScheduleRunTest, StagesRunInOrderWithCheckpoints) {
       "stages": [{"name": "coarse", "image_scale": 0.5, "outer_iterations": 2},
                  {"name": "fine", "texel_resolution": 2, "outer_iterations": 1}]})");
   std::unique_ptr<Schedule> schedule;
-  ASSERT_TRUE(Schedule::Start(dataset_, out.Join("r"), stages, start_, {{"dataset", "ds"}},
-                              &schedule)
-                  .ok());
+  ASSERT_TRUE(
+      Schedule::Start(dataset_, out.Join("r"), stages, start_, {{"dataset", "ds"}}, &schedule)
+          .ok());
   std::vector<std::string> events;
   ScheduleCallbacks callbacks;
   callbacks.on_event = [&](const std::string& line) { events.push_back(line); };
@@ -222,9 +221,9 @@ TEST_F(ScheduleRunTest, StagesRunInOrderWithCheckpoints) {
 
   // Resuming a finished run runs nothing and keeps the records.
   std::unique_ptr<Schedule> resumed;
-  ASSERT_TRUE(Schedule::Resume(dataset_, out.Join("r"), stages, state.run_info, state.progress,
-                               &resumed)
-                  .ok());
+  ASSERT_TRUE(
+      Schedule::Resume(dataset_, out.Join("r"), stages, state.run_info, state.progress, &resumed)
+          .ok());
   int iterations = 0;
   callbacks.on_iteration = [&](const IterationRecord&) { return ++iterations > 0; };
   ASSERT_TRUE(resumed->Run(callbacks).ok());
@@ -240,9 +239,9 @@ TEST_F(ScheduleRunTest, StopAndResumeMidStage) {
       "stages": [{"name": "a", "image_scale": 0.5, "outer_iterations": 1},
                  {"name": "b", "outer_iterations": 3}]})");
   std::unique_ptr<Schedule> schedule;
-  ASSERT_TRUE(Schedule::Start(dataset_, out.Join("r"), stages, start_, {{"dataset", "ds"}},
-                              &schedule)
-                  .ok());
+  ASSERT_TRUE(
+      Schedule::Start(dataset_, out.Join("r"), stages, start_, {{"dataset", "ds"}}, &schedule)
+          .ok());
   ScheduleCallbacks callbacks;
   int calls = 0;
   // Stop at stage b's first iteration after its first outer iteration finished.
@@ -260,9 +259,9 @@ TEST_F(ScheduleRunTest, StopAndResumeMidStage) {
   EXPECT_FALSE(state.finished);
 
   std::unique_ptr<Schedule> resumed;
-  ASSERT_TRUE(Schedule::Resume(dataset_, out.Join("r"), stages, state.run_info, state.progress,
-                               &resumed)
-                  .ok());
+  ASSERT_TRUE(
+      Schedule::Resume(dataset_, out.Join("r"), stages, state.run_info, state.progress, &resumed)
+          .ok());
   std::vector<int> outers;
   callbacks.on_iteration = [&](const IterationRecord& r) {
     outers.push_back(r.outer);
