@@ -291,6 +291,23 @@ Status WriteMesh(const std::string& path, const TriMesh& mesh) {
   return Status::Error(path + ": unknown mesh extension '" + ext + "' (expected obj, ply, off)");
 }
 
+double SurfaceArea(const std::vector<Eigen::Vector3d>& positions,
+                   const std::vector<Eigen::Vector3i>& faces) {
+  double area = 0.0;
+  for (const Eigen::Vector3i& f : faces) {
+    area +=
+        0.5 * (positions[f[1]] - positions[f[0]]).cross(positions[f[2]] - positions[f[0]]).norm();
+  }
+  return area;
+}
+
+double SurfaceArea(const TriMesh& mesh) {
+  std::vector<Eigen::Vector3d> positions;
+  std::vector<Eigen::Vector3i> faces;
+  MeshToArrays(mesh, &positions, &faces);
+  return SurfaceArea(positions, faces);
+}
+
 void MeshToArrays(const TriMesh& mesh, std::vector<Eigen::Vector3d>* positions,
                   std::vector<Eigen::Vector3i>* faces) {
   if (positions != nullptr) {

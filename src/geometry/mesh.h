@@ -50,6 +50,11 @@ Status WriteMesh(const std::string& path, const TriMesh& mesh);
 void MeshToArrays(const TriMesh& mesh, std::vector<Eigen::Vector3d>* positions,
                   std::vector<Eigen::Vector3i>* faces);
 
+// Total area of the faces; scene units squared.
+double SurfaceArea(const std::vector<Eigen::Vector3d>& positions,
+                   const std::vector<Eigen::Vector3i>& faces);
+double SurfaceArea(const TriMesh& mesh);
+
 // Per-face corner UVs (3 per face, corner order = face vertex order); empty when the mesh has none.
 std::vector<Eigen::Vector2d> FaceCornerUvs(const TriMesh& mesh);
 

@@ -24,16 +24,6 @@ constexpr double kEquilateralArea = 0.43301270189221932;
 constexpr int kMinFaces = 4;  // a tetrahedron.
 constexpr int kMaxFacesLimit = 20000000;
 
-double ArraysArea(const std::vector<Eigen::Vector3d>& positions,
-                  const std::vector<Eigen::Vector3i>& faces) {
-  double area = 0.0;
-  for (const Eigen::Vector3i& f : faces) {
-    area +=
-        0.5 * (positions[f[1]] - positions[f[0]]).cross(positions[f[2]] - positions[f[0]]).norm();
-  }
-  return area;
-}
-
 DecimationGuards GuardsOf(const RemeshOptions& options) {
   DecimationGuards guards;
   guards.max_normal_deviation_degrees = options.max_normal_deviation_degrees;
@@ -143,13 +133,6 @@ bool RemeshOptions::Check(std::string* why) const {
   return GuardsOf(*this).Check(why);
 }
 
-double SurfaceArea(const TriMesh& mesh) {
-  std::vector<Eigen::Vector3d> positions;
-  std::vector<Eigen::Vector3i> faces;
-  MeshToArrays(mesh, &positions, &faces);
-  return ArraysArea(positions, faces);
-}
-
 Status Remesh(const TriMesh& mesh, const RemeshOptions& options, TriMesh* out,
               RemeshReport* report) {
   const auto start = std::chrono::steady_clock::now();
@@ -177,7 +160,7 @@ Status Remesh(const TriMesh& mesh, const RemeshOptions& options, TriMesh* out,
   std::vector<Eigen::Vector3d> positions;
   std::vector<Eigen::Vector3i> faces;
   SurfaceMeshToArrays(surface, &positions, &faces);
-  const double area = ArraysArea(positions, faces);
+  const double area = SurfaceArea(positions, faces);
   if (!(area > 0.0 && std::isfinite(area))) {
     return Status::Error("remesh: the surface area is " + std::to_string(area));
   }

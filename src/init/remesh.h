@@ -91,9 +91,6 @@ struct RemeshReport {
 Status Remesh(const TriMesh& mesh, const RemeshOptions& options, TriMesh* out,
               RemeshReport* report);
 
-// Total face area; scene units squared.
-double SurfaceArea(const TriMesh& mesh);
-
 }  // namespace sft
 
 #endif  // SFT_INIT_REMESH_H_

@@ -19,16 +19,6 @@ double SecondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-double TotalArea(const std::vector<Eigen::Vector3d>& positions,
-                 const std::vector<Eigen::Vector3i>& faces) {
-  double area = 0.0;
-  for (const Eigen::Vector3i& f : faces) {
-    area +=
-        0.5 * (positions[f[1]] - positions[f[0]]).cross(positions[f[2]] - positions[f[0]]).norm();
-  }
-  return area;
-}
-
 // The grid over the samples' bounding box grown by the margin; *h grows when the longest side
 // would exceed kMaxGridSide voxels.
 VoxelBox MakeGridBox(const std::vector<OrientedPoint>& samples, double* h) {
@@ -125,7 +115,7 @@ Status Resample(const TriMesh& mesh, const std::vector<ViewSetup>& views,
     }
   }
   const int target_faces = options.faces > 0 ? options.faces : static_cast<int>(faces.size());
-  const double area = TotalArea(positions, faces);
+  const double area = SurfaceArea(positions, faces);
   double h = options.spacing_factor * std::sqrt(4.0 * area / (std::sqrt(3.0) * target_faces));
   if (!(h > 0) || !std::isfinite(h)) return Status::Error("the mesh has no area");
 

@@ -1,5 +1,5 @@
-// Image pyramids for the multi-scale residual (docs/reconstruct.md). Level 0 is the image; level l+1
-// has ⌈w/2⌉ × ⌈h/2⌉ pixels, each a weighted mean of its children at level l (PyramidFilter: the
+// Image pyramids for the multi-scale residual (docs/reconstruct.md). Level 0 is the image; level
+// l+1 has ⌈w/2⌉ × ⌈h/2⌉ pixels, each a weighted mean of its children at level l (PyramidFilter: the
 // 2 × 2 box by default, or a binomial filter), the same for renderings and targets. Because the
 // map is linear, the pyramid of the expected rendering equals the expected pyramid of the
 // renderings, and the Jacobian row of a coarse pixel is the same weighted mean of its children's

@@ -220,6 +220,8 @@ std::vector<Image> Reconstruction::RenderViews(uint64_t seed) {
   return images;
 }
 
-Image Reconstruction::RenderNormals(int v) { return cache_->RenderPassImage(v, RenderPass::kNormal); }
+Image Reconstruction::RenderNormals(int v) {
+  return cache_->RenderPassImage(v, RenderPass::kNormal);
+}
 
 }  // namespace sft

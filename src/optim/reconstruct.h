@@ -1,7 +1,8 @@
 // One fit of the reconstruction (a stage of the schedule, src/optim/schedule.h): outer iterations,
-// each one phase or two (texture, then geometry) of at most `solver.steps` solver iterations with a fixed seed; fresh
-// seeds per outer iteration. Each outer iteration of a trust-region solver builds a new problem
-// (supersets from renders at the current state), so that pixel supersets follow the moving mesh.
+// each one phase or two (texture, then geometry) of at most `solver.steps` solver iterations with a
+// fixed seed; fresh seeds per outer iteration. Each outer iteration of a trust-region solver builds
+// a new problem (supersets from renders at the current state), so that pixel supersets follow the
+// moving mesh.
 #ifndef SFT_OPTIM_RECONSTRUCT_H_
 #define SFT_OPTIM_RECONSTRUCT_H_
 

@@ -1,5 +1,5 @@
-// The render cache (docs/reconstruct.md): a ceres::EvaluationCallback that, before Ceres evaluates a
-// point, moves the mesh (refitting one Embree scene), writes the material and light scales from
+// The render cache (docs/reconstruct.md): a ceres::EvaluationCallback that, before Ceres evaluates
+// a point, moves the mesh (refitting one Embree scene), writes the material and light scales from
 // the flat parameter vector, renders every view once — with Jacobian rows of the active parameter
 // kinds whenever Ceres may ask for them — and turns each render into its pyramid levels and their
 // rows. Residual blocks (cost_functions/pyramid_pixel.h) then only copy from it.

@@ -94,13 +94,11 @@ class Schedule {
   const StageOptions& CurrentStage() const {
     return stages_[std::min<size_t>(progress_.stage, stages_.size() - 1)];
   }
-  const std::vector<StageOptions>& stages() const { return stages_; }
   const std::vector<IterationRecord>& records() const { return records_; }
   const nlohmann::json& outer_records() const { return outer_records_; }
   const nlohmann::json& stage_records() const { return stage_records_; }
   // The reconstruction of the stage run last (the final state once finished); null before Run.
   Reconstruction* reconstruction() { return reconstruction_.get(); }
-  TriMesh Mesh() const { return current_.mesh; }
 
   // Total solver steps of the remaining work, each weighted by its relative cost (image pixels ×
   // spp), for a progress line whose ETA holds across stages of different scales.

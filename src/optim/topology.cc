@@ -1,6 +1,5 @@
 #include "src/optim/topology.h"
 
-#include <chrono>
 #include <cmath>
 
 #include "src/geometry/mesh_colors_resample.h"

@@ -24,13 +24,6 @@ using testing::CountLines;
 using ::testing::HasSubstr;
 using testing::RunSft;
 
-std::string ReadAll(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 // The fields of one CSV line (no quoting: sft compare writes none).
 std::vector<std::string> SplitCsv(const std::string& line) {
   std::vector<std::string> fields;
@@ -105,7 +98,7 @@ TEST_F(CompareCommandTest, CsvAndReportNameEveryRunWithFiniteNumbers) {
   ASSERT_TRUE(fs::exists(out_dir + "/comparison.csv"));
   ASSERT_TRUE(fs::exists(out_dir + "/report.html"));
 
-  std::stringstream csv(ReadAll(out_dir + "/comparison.csv"));
+  std::stringstream csv(testing::ReadTestFile(out_dir + "/comparison.csv"));
   std::string line;
   ASSERT_TRUE(std::getline(csv, line));
   const std::vector<std::string> header = SplitCsv(line);
@@ -145,7 +138,7 @@ TEST_F(CompareCommandTest, CsvAndReportNameEveryRunWithFiniteNumbers) {
     EXPECT_EQ(outer_rows[run], 2) << run;
   }
 
-  const std::string html = ReadAll(out_dir + "/report.html");
+  const std::string html = testing::ReadTestFile(out_dir + "/report.html");
   EXPECT_THAT(html, HasSubstr("sft compare: 3 runs"));
   for (const char* run : {"<td>lm</td>", "<td>adam</td>", "<td>plain</td>"}) {
     EXPECT_THAT(html, HasSubstr(run));

@@ -25,18 +25,12 @@ using ::testing::HasSubstr;
 using testing::RunSft;
 using ::testing::StartsWith;
 
-std::string ReadAll(const std::string& path) {
-  std::ifstream file(path, std::ios::binary);
-  std::stringstream text;
-  text << file.rdbuf();
-  return text.str();
-}
-
 // Every regular file under `dir` with its bytes.
 std::map<std::string, std::string> Snapshot(const std::string& dir) {
   std::map<std::string, std::string> files;
   for (const auto& entry : fs::recursive_directory_iterator(dir)) {
-    if (entry.is_regular_file()) files[entry.path().string()] = ReadAll(entry.path().string());
+    if (entry.is_regular_file())
+      files[entry.path().string()] = testing::ReadTestFile(entry.path().string());
   }
   return files;
 }
@@ -54,7 +48,7 @@ TEST(InitCommandTest, DefaultOutputGoesIntoTheDatasetAndAddsTheKey) {
   const std::string d = MakeDataset(tmp);
   const std::map<std::string, std::string> before = Snapshot(d);
   const nlohmann::ordered_json scene_before =
-      nlohmann::ordered_json::parse(ReadAll(d + "/scene.json"));
+      nlohmann::ordered_json::parse(testing::ReadTestFile(d + "/scene.json"));
   std::string out;
   ASSERT_EQ(RunSft("init --quiet --dataset " + d + " --resolution 48 --faces 400", &out), 0) << out;
   const nlohmann::json summary = nlohmann::json::parse(out);
@@ -70,7 +64,8 @@ TEST(InitCommandTest, DefaultOutputGoesIntoTheDatasetAndAddsTheKey) {
 
   // scene.json: the same keys in the same order with the same values, plus initial_mesh at the
   // end; every other file unchanged and only init/mesh.ply added.
-  nlohmann::ordered_json scene_after = nlohmann::ordered_json::parse(ReadAll(d + "/scene.json"));
+  nlohmann::ordered_json scene_after =
+      nlohmann::ordered_json::parse(testing::ReadTestFile(d + "/scene.json"));
   ASSERT_TRUE(scene_after.contains("initial_mesh"));
   EXPECT_EQ(scene_after["initial_mesh"], "init/mesh.ply");
   EXPECT_EQ(scene_after.back(), "init/mesh.ply");
@@ -85,7 +80,7 @@ TEST(InitCommandTest, DefaultOutputGoesIntoTheDatasetAndAddsTheKey) {
   EXPECT_TRUE(after == expected) << "files of the dataset other than scene.json changed";
 
   // A second run refuses to replace the mesh; --overwrite replaces it and leaves scene.json alone.
-  const std::string scene_text = ReadAll(d + "/scene.json");
+  const std::string scene_text = testing::ReadTestFile(d + "/scene.json");
   ASSERT_NE(RunSft("init --quiet --dataset " + d + " --resolution 48 --faces 400", &out), 0);
   EXPECT_EQ(CountLines(out), 1) << out;
   EXPECT_THAT(out, StartsWith("sft init: error: " + d + "/init/mesh.ply: exists"));
@@ -93,7 +88,7 @@ TEST(InitCommandTest, DefaultOutputGoesIntoTheDatasetAndAddsTheKey) {
       RunSft("init --quiet --overwrite --dataset " + d + " --resolution 32 --faces 300", &out), 0)
       << out;
   EXPECT_EQ(nlohmann::json::parse(out)["scene_json"], "initial_mesh already set");
-  EXPECT_EQ(ReadAll(d + "/scene.json"), scene_text);
+  EXPECT_EQ(testing::ReadTestFile(d + "/scene.json"), scene_text);
 }
 
 TEST(InitCommandTest, OutElsewhereLeavesTheDatasetByteIdentical) {
@@ -166,7 +161,8 @@ TEST(InitCommandTest, ErrorsAreOneLine) {
   EXPECT_TRUE(Snapshot(d) == before);
 
   // A dataset without masks.
-  nlohmann::ordered_json scene = nlohmann::ordered_json::parse(ReadAll(d + "/scene.json"));
+  nlohmann::ordered_json scene =
+      nlohmann::ordered_json::parse(testing::ReadTestFile(d + "/scene.json"));
   for (auto& view : scene["views"]) view.erase("mask");
   const std::string no_masks = tmp.Join("nomasks");
   fs::copy(d, no_masks, fs::copy_options::recursive);
@@ -180,7 +176,8 @@ TEST(InitCommandTest, ErrorsAreOneLine) {
   // An empty mask names the view.
   const std::string empty_mask = tmp.Join("emptymask");
   fs::copy(d, empty_mask, fs::copy_options::recursive);
-  const nlohmann::json view2 = nlohmann::json::parse(ReadAll(d + "/scene.json"))["views"][2];
+  const nlohmann::json view2 =
+      nlohmann::json::parse(testing::ReadTestFile(d + "/scene.json"))["views"][2];
   const std::string mask = empty_mask + "/" + view2["mask"].get<std::string>();
   ASSERT_TRUE(WritePng(mask, Image(48, 48, 1, 0.f), false).ok());
   EXPECT_NE(RunSft("init --quiet --dataset " + empty_mask, &out), 0);

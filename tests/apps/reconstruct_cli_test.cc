@@ -20,13 +20,6 @@ using testing::RunSft;
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 
-std::string ReadAll(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 // Geometry and texture from a perturbed sphere: the run writes every output, the cost drops,
 // eval scores it, a resumed run continues from the checkpoint, render re-renders it.
 TEST(ReconstructCliTest, ReconstructEvalResume) {
@@ -53,24 +46,27 @@ TEST(ReconstructCliTest, ReconstructEvalResume) {
                            "metrics.json", "state.json", "report.html", "initial_mesh.ply"}) {
     EXPECT_TRUE(fs::exists(tmp.Join(std::string("r/") + file))) << file;
   }
-  const nlohmann::json metrics = nlohmann::json::parse(ReadAll(tmp.Join("r/metrics.json")));
+  const nlohmann::json metrics =
+      nlohmann::json::parse(testing::ReadTestFile(tmp.Join("r/metrics.json")));
   const auto& iterations = metrics["iterations"];
   ASSERT_GE(iterations.size(), 2u);
   EXPECT_EQ(iterations.front()["phase"], "texture");
   EXPECT_EQ(iterations.back()["phase"], "geometry");
   EXPECT_EQ(iterations.front()["view_psnr"].size(), 4u);
-  EXPECT_EQ(CountLines(ReadAll(tmp.Join("r/metrics.csv"))),
+  EXPECT_EQ(CountLines(testing::ReadTestFile(tmp.Join("r/metrics.csv"))),
             1 + static_cast<int>(iterations.size()));
 
   // Resume to two outer iterations: the earlier records are kept, new ones follow, and folded
   // faces are still counted against the run's start (initial_mesh.ply, not rewritten).
-  const std::string initial_mesh = ReadAll(tmp.Join("r/initial_mesh.ply"));
+  const std::string initial_mesh = testing::ReadTestFile(tmp.Join("r/initial_mesh.ply"));
   ASSERT_EQ(RunSft("reconstruct --quiet --resume " + tmp.Join("r") + " --outer 2", &out), 0) << out;
-  EXPECT_EQ(ReadAll(tmp.Join("r/initial_mesh.ply")), initial_mesh);
-  const nlohmann::json resumed = nlohmann::json::parse(ReadAll(tmp.Join("r/metrics.json")));
+  EXPECT_EQ(testing::ReadTestFile(tmp.Join("r/initial_mesh.ply")), initial_mesh);
+  const nlohmann::json resumed =
+      nlohmann::json::parse(testing::ReadTestFile(tmp.Join("r/metrics.json")));
   EXPECT_GT(resumed["iterations"].size(), iterations.size());
   EXPECT_EQ(resumed["iterations"].back()["outer"], 1);
-  const nlohmann::json state = nlohmann::json::parse(ReadAll(tmp.Join("r/state.json")));
+  const nlohmann::json state =
+      nlohmann::json::parse(testing::ReadTestFile(tmp.Join("r/state.json")));
   EXPECT_EQ(state["outer_done"], 2);
   EXPECT_TRUE(state["finished"].get<bool>());
   EXPECT_EQ(state["run"]["init"], tmp.Join("init.ply"));
@@ -123,7 +119,8 @@ TEST(ReconstructCliTest, InterruptWritesACheckpointAndResumes) {
   ASSERT_EQ(testing::RunCommand("bash -c '" + script + "'", &out), 0) << out;
   EXPECT_THAT(out, HasSubstr("exit=130"));
   EXPECT_THAT(out, HasSubstr("--resume"));
-  const nlohmann::json state = nlohmann::json::parse(ReadAll(tmp.Join("r/state.json")));
+  const nlohmann::json state =
+      nlohmann::json::parse(testing::ReadTestFile(tmp.Join("r/state.json")));
   EXPECT_FALSE(state["finished"].get<bool>());
   const int done = state["outer_done"].get<int>();
   EXPECT_GE(done, 1);
@@ -133,7 +130,8 @@ TEST(ReconstructCliTest, InterruptWritesACheckpointAndResumes) {
                    &out),
             0)
       << out;
-  const nlohmann::json resumed = nlohmann::json::parse(ReadAll(tmp.Join("r/state.json")));
+  const nlohmann::json resumed =
+      nlohmann::json::parse(testing::ReadTestFile(tmp.Join("r/state.json")));
   EXPECT_EQ(resumed["outer_done"].get<int>(), done + 1);
   EXPECT_TRUE(resumed["finished"].get<bool>());
 }

@@ -20,10 +20,7 @@ using testing::RunSft;
 namespace fs = std::filesystem;
 
 nlohmann::json ReadJson(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return nlohmann::json::parse(ss.str());
+  return nlohmann::json::parse(testing::ReadTestFile(path));
 }
 
 TEST(ReconstructHullTest, CarveRefineRemeshResampleTexture) {

@@ -24,13 +24,6 @@ using testing::CountLines;
 using ::testing::HasSubstr;
 using testing::RunSft;
 
-std::string ReadAll(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 // A tiny geometry run (2 views of 16², 2 outer iterations of 1 LM step) from a perturbed start,
 // with the true mesh as --reference and a tolerance other than the default, so that the flag's
 // value is seen to reach metrics.json.
@@ -54,7 +47,7 @@ TEST(ReconstructReferenceTest, EveryOuterEntryCarriesChamferAndF1) {
             0)
       << out;
   const nlohmann::json metrics =
-      nlohmann::json::parse(ReadAll(tmp.Join("r/metrics.json")), nullptr, false);
+      nlohmann::json::parse(testing::ReadTestFile(tmp.Join("r/metrics.json")), nullptr, false);
   ASSERT_TRUE(metrics.is_object()) << "metrics.json does not parse";
   ASSERT_TRUE(metrics.contains("outer") && metrics["outer"].is_array());
   ASSERT_EQ(metrics["outer"].size(), 2u);

@@ -40,13 +40,6 @@ constexpr double kBallRadius = 0.5;   // sparse points: uniform in a ball around
 constexpr double kOrbitRadius = 4.0;  // camera centres' distance from it.
 const Eigen::Vector3d kObjectCentre(1.0, -2.0, 0.5);
 
-std::string ReadAll(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 // Frame `i` of the video: a window panned over a fixed random-block texture, so that consecutive
 // frames differ (frame selection keeps them all) and are sharp.
 cv::Mat PannedFrame(int i) {
@@ -201,7 +194,8 @@ TEST(VideoImportFakeColmapTest, EveryFrameRegisteredBecomesAViewWithTheModelsPos
       0)
       << out;
   EXPECT_EQ(out, "");
-  EXPECT_EQ(ReadAll(tmp.Join("calls.txt")), "feature_extractor\nexhaustive_matcher\nmapper\n");
+  EXPECT_EQ(testing::ReadTestFile(tmp.Join("calls.txt")),
+            "feature_extractor\nexhaustive_matcher\nmapper\n");
   EXPECT_FALSE(fs::exists(out_dir + ".video-work")) << "the COLMAP workspace is left behind";
 
   Dataset dataset;
@@ -253,7 +247,7 @@ TEST(VideoImportFakeColmapTest, EveryFrameRegisteredBecomesAViewWithTheModelsPos
 
   // OUT/colmap: the selection record and COLMAP's log (the stand-in's lines).
   const nlohmann::json frames =
-      nlohmann::json::parse(ReadAll(out_dir + "/colmap/frames.json"), nullptr, false);
+      nlohmann::json::parse(testing::ReadTestFile(out_dir + "/colmap/frames.json"), nullptr, false);
   ASSERT_TRUE(frames.is_object());
   EXPECT_EQ(frames["frames_decoded"], kFrames);
   EXPECT_EQ(frames["selected"].size(), static_cast<size_t>(kFrames));
@@ -261,7 +255,7 @@ TEST(VideoImportFakeColmapTest, EveryFrameRegisteredBecomesAViewWithTheModelsPos
   EXPECT_EQ(frames["matcher"], "exhaustive_matcher");
   EXPECT_EQ(frames["width"], kWidth);
   EXPECT_EQ(frames["height"], kHeight);
-  const std::string log = ReadAll(out_dir + "/colmap/log.txt");
+  const std::string log = testing::ReadTestFile(out_dir + "/colmap/log.txt");
   for (const char* stage : {"feature_extractor", "exhaustive_matcher", "mapper"}) {
     EXPECT_THAT(log, HasSubstr(std::string("stand-in colmap: ") + stage));
   }

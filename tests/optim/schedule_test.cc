@@ -91,13 +91,6 @@ TEST(ScheduleConfigTest, ErrorsNameTheStageAndKey) {
   EXPECT_THAT(error(R"({"texel_resolution": 65})"), HasSubstr("texel_resolution"));
 }
 
-std::string ReadAll(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 // A textured icosphere at 32², 4 views, flash-lit, one segment.
 class ScheduleRunTest : public ::testing::Test {
  protected:
@@ -206,7 +199,7 @@ TEST_F(ScheduleRunTest, StagesRunInOrderWithCheckpoints) {
   EXPECT_TRUE(state.finished);
   EXPECT_TRUE(std::filesystem::exists(out.Join("r/stages/00_coarse_normals.png")));
   EXPECT_TRUE(std::filesystem::exists(out.Join("r/stages/01_fine_normals.png")));
-  const json metrics = json::parse(ReadAll(out.Join("r/metrics.json")));
+  const json metrics = json::parse(testing::ReadTestFile(out.Join("r/metrics.json")));
   EXPECT_EQ(metrics["outer"].size(), 3u);
   EXPECT_EQ(metrics["outer"][0]["stage"], "coarse");
   EXPECT_EQ(metrics["outer"][0]["self_intersecting_faces"], 0);

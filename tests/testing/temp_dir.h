@@ -26,6 +26,8 @@ class TempDir {
 std::string DataDir();
 // Absolute path of the built `sft` executable (for CLI tests).
 std::string SftBinary();
+// The whole file at `path` as is (binary); "" when it cannot be read.
+std::string ReadTestFile(const std::string& path);
 // Writes `contents` to `path` as is (binary), for fixtures written by tests.
 void WriteTestFile(const std::string& path, const std::string& contents);
 // Runs `sft ARGS` (the built binary), returns its exit code; output as RunCommand.
