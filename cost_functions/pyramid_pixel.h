@@ -1,9 +1,10 @@
 // The image residual of one pyramid pixel (docs/reconstruct.md): for view v, level l, pixel p,
 //
-//   r_c = √w_l · (P_l(I(θ))_pc − P_l(T)_pc),   c ∈ {R, G, B},
+//   r_c = √w_l · √w_lp · (P_l(I(θ))_pc − P_l(T)_pc),   c ∈ {R, G, B},
 //
-// with I(θ) the path-traced rendering, T the photograph and P_l the level-l box pyramid
-// (src/optim/pyramid.h). 3 residuals.
+// with I(θ) the path-traced rendering, T the photograph, P_l the level-l pyramid
+// (src/optim/pyramid.h), w_l the level's weight and w_lp the pixel's weight (1 for the L2 loss;
+// for the relative loss a function of the target alone, src/optim/render_cache.h). 3 residuals.
 //
 // Parameter blocks: a fixed superset chosen when the problem is built (the blocks that the
 // pixel's samples touched in a few renders), each a span [offset, offset + size) of the flat
@@ -59,6 +60,14 @@ struct LevelCache {
   Image target;              // the target's pyramid level, RGB.
   LevelRows rows;            // Jacobian rows of `render`; empty when not rendered with derivatives.
   double sqrt_weight = 1.0;  // the level's residual weight √w_l.
+  // Per-pixel weights √w_lp (row-major, width × height); empty = all 1. Fixed for a run: they
+  // depend on the target only, so the loss stays an unbiased function of the render.
+  std::vector<float> pixel_sqrt_weight;
+
+  // √w_l · √w_lp of pixel p.
+  double SqrtWeight(int p) const {
+    return pixel_sqrt_weight.empty() ? sqrt_weight : sqrt_weight * pixel_sqrt_weight[p];
+  }
 };
 
 class PyramidPixelCost : public ceres::CostFunction {
@@ -78,8 +87,9 @@ class PyramidPixelCost : public ceres::CostFunction {
                 double** jacobians) const override {
     if (!*finite_) return false;
     const int x = pixel_ % level_->render.width, y = pixel_ / level_->render.width;
+    const double sqrt_weight = level_->SqrtWeight(pixel_);
     for (int c = 0; c < 3; ++c) {
-      residuals[c] = level_->sqrt_weight *
+      residuals[c] = sqrt_weight *
                      (static_cast<double>(level_->render.at(x, y, c)) - level_->target.at(x, y, c));
     }
     if (jacobians == nullptr) return true;
@@ -97,7 +107,7 @@ class PyramidPixelCost : public ceres::CostFunction {
       if (b == offsets_.size()) break;
       if (e.param < offsets_[b] || jacobians[b] == nullptr) continue;
       const int col = e.param - offsets_[b];
-      for (int c = 0; c < 3; ++c) jacobians[b][c * sizes[b] + col] = level_->sqrt_weight * e.d[c];
+      for (int c = 0; c < 3; ++c) jacobians[b][c * sizes[b] + col] = sqrt_weight * e.d[c];
     }
     return true;
   }

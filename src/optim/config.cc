@@ -124,6 +124,12 @@ const std::map<std::string, Key>& Keys() {
                                                                        : "expected box or binomial";
            },
            [](const O& o) { return std::string(PyramidFilterName(o.cache.pyramid_filter)); })},
+      {"image_loss",
+       Choice(
+           [](const std::string& s, O* o) -> std::string {
+             return ImageLossFromName(s, &o->cache.image_loss) ? "" : "expected l2 or relative";
+           },
+           [](const O& o) { return std::string(ImageLossName(o.cache.image_loss)); })},
       {"mask_dilation", Int([](O* o) -> int& { return o->cache.mask_dilation; }, 0, 64)},
       {"primary_edge_ratio",
        Real([](O* o) -> double& { return o->cache.edges.primary_edge_ratio; }, 0, 16)},

@@ -36,7 +36,52 @@ Status ActivePixels(const Dataset& dataset, int view, int width, int height, int
   return Status::Ok();
 }
 
+// The relative loss's per-pixel weights of each level (render_cache.h, ImageLoss::kRelative):
+// √w_p = 2m / (m + ȳ_p) with m the median of ȳ over the active level-0 pixels that are not
+// black (so that a black background without a mask does not set the scale). A black view keeps
+// weights 1.
+void SetRelativeWeights(const std::vector<uint8_t>& active0,
+                        std::vector<std::unique_ptr<LevelCache>>* levels) {
+  auto mean_rgb = [](const Image& image, int p) {
+    const int x = p % image.width, y = p / image.width;
+    return (static_cast<double>(image.at(x, y, 0)) + image.at(x, y, 1) + image.at(x, y, 2)) / 3.0;
+  };
+  const Image& target0 = (*levels)[0]->target;
+  std::vector<double> values;
+  for (size_t p = 0; p < active0.size(); ++p) {
+    const double y = active0[p] ? mean_rgb(target0, static_cast<int>(p)) : 0.0;
+    if (y > 0.0) values.push_back(y);
+  }
+  if (values.empty()) return;
+  std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
+  const double m = values[values.size() / 2];
+  if (!(m > 0.0)) return;
+  for (auto& level : *levels) {
+    const int n = level->target.width * level->target.height;
+    level->pixel_sqrt_weight.resize(n);
+    for (int p = 0; p < n; ++p) {
+      const double y = std::max(0.0, mean_rgb(level->target, p));
+      level->pixel_sqrt_weight[p] = static_cast<float>(2.0 * m / (m + y));
+    }
+  }
+}
+
 }  // namespace
+
+bool ImageLossFromName(const std::string& name, ImageLoss* loss) {
+  if (name == "l2") {
+    *loss = ImageLoss::kL2;
+  } else if (name == "relative") {
+    *loss = ImageLoss::kRelative;
+  } else {
+    return false;
+  }
+  return true;
+}
+
+const char* ImageLossName(ImageLoss loss) {
+  return loss == ImageLoss::kRelative ? "relative" : "l2";
+}
 
 bool RenderCacheOptions::Check(std::string* why) const {
   if (!render.Check(why)) return false;
@@ -63,6 +108,10 @@ bool RenderCacheOptions::Check(std::string* why) const {
   }
   if (pyramid_filter != PyramidFilter::kBox && pyramid_filter != PyramidFilter::kBinomial) {
     *why = "pyramid_filter: must be box or binomial";
+    return false;
+  }
+  if (image_loss != ImageLoss::kL2 && image_loss != ImageLoss::kRelative) {
+    *why = "image_loss: must be l2 or relative";
     return false;
   }
   return true;
@@ -111,6 +160,7 @@ Status RenderCache::Create(const Dataset& dataset, const DatasetViews* views,
           std::sqrt(options.image_weight) * std::pow(options.level_weight, 0.5 * l);
       levels.push_back(std::move(level));
     }
+    if (options.image_loss == ImageLoss::kRelative) SetRelativeWeights(targets.active[0], &levels);
     c->targets_.push_back(std::move(targets));
     c->levels_.push_back(std::move(levels));
   }
@@ -226,17 +276,23 @@ void RenderCache::StoreRender(int v, const Image& image, const JacobianRows* row
 
 namespace {
 
-// Σ over the active pixels and RGB of (render − target)², and the count of terms.
-void SquaredError(const LevelCache& level, const std::vector<uint8_t>& active, double* sum,
-                  int64_t* count) {
+// Σ over the active pixels and RGB of (render − target)² (times the pixel weights w_lp when
+// `weighted`), and the count of terms.
+void SquaredError(const LevelCache& level, const std::vector<uint8_t>& active, bool weighted,
+                  double* sum, int64_t* count) {
   *sum = 0.0;
   *count = 0;
   for (int y = 0; y < level.render.height; ++y) {
     for (int x = 0; x < level.render.width; ++x) {
-      if (!active[static_cast<size_t>(y) * level.render.width + x]) continue;
+      const size_t p = static_cast<size_t>(y) * level.render.width + x;
+      if (!active[p]) continue;
+      const double w = weighted && !level.pixel_sqrt_weight.empty()
+                           ? static_cast<double>(level.pixel_sqrt_weight[p]) *
+                                 level.pixel_sqrt_weight[p]
+                           : 1.0;
       for (int c = 0; c < 3; ++c) {
         const double r = level.render.at(x, y, c) - level.target.at(x, y, c);
-        *sum += r * r;
+        *sum += w * r * r;
       }
       *count += 3;
     }
@@ -252,7 +308,7 @@ double RenderCache::ImageCost() const {
       const LevelCache& level = *levels_[v][l];
       double sum = 0.0;
       int64_t count = 0;
-      SquaredError(level, targets_[v].active[l], &sum, &count);
+      SquaredError(level, targets_[v].active[l], /*weighted=*/true, &sum, &count);
       cost += 0.5 * level.sqrt_weight * level.sqrt_weight * sum;
     }
   }
@@ -264,7 +320,7 @@ std::vector<double> RenderCache::ViewMse() const {
   for (int v = 0; v < num_views(); ++v) {
     double sum = 0.0;
     int64_t count = 0;
-    SquaredError(*levels_[v][0], targets_[v].active[0], &sum, &count);
+    SquaredError(*levels_[v][0], targets_[v].active[0], /*weighted=*/false, &sum, &count);
     mse[v] = count > 0 ? sum / count : 0.0;
   }
   return mse;
@@ -288,10 +344,12 @@ Image RenderCache::AdjointWeights(int v) const {
     }
     if (acc.empty()) acc = Image(level.render.width, level.render.height, 3);
     const std::vector<uint8_t>& active = targets_[v].active[l];
-    const double w = level.sqrt_weight * level.sqrt_weight;
     for (int y = 0; y < level.render.height; ++y) {
       for (int x = 0; x < level.render.width; ++x) {
-        if (!active[static_cast<size_t>(y) * level.render.width + x]) continue;
+        const int p = y * level.render.width + x;
+        if (!active[p]) continue;
+        const double sqrt_w = level.SqrtWeight(p);
+        const double w = sqrt_w * sqrt_w;
         for (int c = 0; c < 3; ++c) {
           acc.at(x, y, c) +=
               static_cast<float>(w * (level.render.at(x, y, c) - level.target.at(x, y, c)));

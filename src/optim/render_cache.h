@@ -28,6 +28,19 @@
 
 namespace sft {
 
+// The image term's per-pixel weighting (docs/reconstruct.md, "The image loss").
+//   kL2        every pixel weighs 1: ½ Σ (I − T)².
+//   kRelative  pixel p weighs √w_p = 2m / (m + ȳ_p), ȳ_p the target's mean over RGB at p and m
+//              the median of ȳ over the view's active, non-black level-0 pixels: a median
+//              pixel weighs 1,
+//              a highlight k times brighter than the median about 2/(k + 1). Monte Carlo noise
+//              grows with a pixel's radiance, so a few bright, noisy highlight pixels otherwise
+//              decide every step (the relative MSE of Rousselle et al. 2011, with the target in
+//              the denominator so the loss stays unbiased in the render).
+enum class ImageLoss { kL2, kRelative };
+bool ImageLossFromName(const std::string& name, ImageLoss* loss);
+const char* ImageLossName(ImageLoss loss);
+
 struct RenderCacheOptions {
   RenderOptions render;       // spp, bounces, effects, threads (seed: see SetSeed).
   DerivativeRequest edges;    // edge-sampling budgets of vertex derivatives (params ignored).
@@ -42,6 +55,7 @@ struct RenderCacheOptions {
   // The filter between pyramid levels (src/optim/pyramid.h), of renders, targets, Jacobian rows,
   // masks and the adjoint alike: kBox (2 × 2 means) or kBinomial ([1 2 1]/4 separable).
   PyramidFilter pyramid_filter = PyramidFilter::kBox;
+  ImageLoss image_loss = ImageLoss::kL2;  // per-pixel weighting of the image term (above).
 
   bool Check(std::string* why) const;
 };

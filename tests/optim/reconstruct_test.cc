@@ -259,15 +259,87 @@ TEST(PyramidPixelCostTest, CopiesRowsIntoBlocks) {
   EXPECT_FALSE(cost.Evaluate(params, residuals, jacobians));
 }
 
+// A pixel weight scales the residual and every Jacobian entry of its block.
+TEST(PyramidPixelCostTest, PixelWeightScalesResidualAndRow) {
+  LevelCache level;
+  level.render = Image(2, 1, 3, 0.5f);
+  level.target = Image(2, 1, 3, 0.25f);
+  level.sqrt_weight = 2.0;
+  level.pixel_sqrt_weight = {1.0f, 0.25f};
+  level.rows.width = 2;
+  level.rows.height = 1;
+  level.rows.entries = {{0, {1, 2, 3}}};
+  level.rows.offsets = {0, 0, 1};
+  bool finite = true;
+  PyramidPixelCost cost(&level, &finite, 1, {0}, {1});
+  double a[1] = {0};
+  const double* params[] = {a};
+  double residuals[3], ja[3];
+  double* jacobians[] = {ja};
+  ASSERT_TRUE(cost.Evaluate(params, residuals, jacobians));
+  for (int k = 0; k < 3; ++k) EXPECT_DOUBLE_EQ(residuals[k], 2.0 * 0.25 * 0.25);
+  EXPECT_DOUBLE_EQ(ja[0], 2.0 * 0.25 * 1);
+  EXPECT_DOUBLE_EQ(ja[2], 2.0 * 0.25 * 3);
+}
+
+// The relative loss weighs a pixel at the view's median 1 and a pixel k times brighter
+// 2/(k + 1), on every level; the L2 loss leaves the weights empty.
+TEST_F(ReconstructTest, RelativeLossWeightsFollowTheTarget) {
+  options_.cache.image_loss = ImageLoss::kRelative;
+  FitSetup s;
+  MakeSetup(dataset_, mesh_, guess_, options_.cache, ActiveParameters(), &s);
+  const RenderCache& cache = *s.cache;
+  for (int l = 0; l < cache.num_levels(0); ++l) {
+    const LevelCache& level = cache.level(0, l);
+    ASSERT_EQ(level.pixel_sqrt_weight.size(),
+              static_cast<size_t>(level.target.width) * level.target.height);
+  }
+  // Recover m from any pixel: w = 2m/(m + y) ⇒ m = w·y/(2 − w); every pixel must agree.
+  const LevelCache& level0 = cache.level(0, 0);
+  std::vector<double> ms;
+  for (int p = 0; p < level0.target.width * level0.target.height; ++p) {
+    const int x = p % level0.target.width, y = p / level0.target.width;
+    const double mean =
+        (level0.target.at(x, y, 0) + level0.target.at(x, y, 1) + level0.target.at(x, y, 2)) / 3.0;
+    const double w = level0.pixel_sqrt_weight[p];
+    EXPECT_GT(w, 0.0);
+    EXPECT_LE(w, 2.0 + 1e-6);
+    if (mean > 1e-3) ms.push_back(w * mean / (2.0 - w));
+  }
+  ASSERT_FALSE(ms.empty());
+  for (double m : ms) EXPECT_NEAR(m / ms[0], 1.0, 1e-4);
+  // m is the median of the active, non-black pixels' means: about half of them weigh more than 1.
+  int above = 0, active = 0;
+  for (int p = 0; p < level0.target.width * level0.target.height; ++p) {
+    const int x = p % level0.target.width, y = p / level0.target.width;
+    const float sum = level0.target.at(x, y, 0) + level0.target.at(x, y, 1) + level0.target.at(x, y, 2);
+    if (!cache.targets(0).active[0][p] || !(sum > 0.0f)) continue;
+    ++active;
+    above += level0.pixel_sqrt_weight[p] > 1.0f;
+  }
+  EXPECT_NEAR(static_cast<double>(above) / active, 0.5, 0.05);
+
+  options_.cache.image_loss = ImageLoss::kL2;
+  FitSetup plain;
+  MakeSetup(dataset_, mesh_, guess_, options_.cache, ActiveParameters(), &plain);
+  EXPECT_TRUE(plain.cache->level(0, 0).pixel_sqrt_weight.empty());
+}
+
 // The adjoint objective's gradient (lbfgs, adam) against the central difference of its cost,
 // which is exactly quadratic in albedo here; and the trust-region problem's gradient Jᵀr against
 // the same, up to the Jacobian mass its frozen supersets drop.
 TEST_F(ReconstructTest, GradientsMatchFiniteDifferencesOfTheCost) {
   // Both pyramid filters: the adjoint weights (DownsampleMeanAdjoint) and the coarse rows
   // (DownsampleRows) must follow the filter of the levels.
-  for (PyramidFilter filter : {PyramidFilter::kBox, PyramidFilter::kBinomial}) {
-    SCOPED_TRACE(PyramidFilterName(filter));
+  // And both image losses: the relative loss's pixel weights must reach the adjoint and the rows.
+  const std::pair<PyramidFilter, ImageLoss> cases[] = {
+      {PyramidFilter::kBox, ImageLoss::kL2},
+      {PyramidFilter::kBinomial, ImageLoss::kL2},
+      {PyramidFilter::kBox, ImageLoss::kRelative}};
+  for (const auto& [filter, loss] : cases) {
+    SCOPED_TRACE(std::string(PyramidFilterName(filter)) + " " + ImageLossName(loss));
     options_.cache.pyramid_filter = filter;
+    options_.cache.image_loss = loss;
     FitSetup s;
     ActiveParameters active;  // albedo and roughness.
     MakeSetup(dataset_, mesh_, guess_, options_.cache, active, &s);
