@@ -44,8 +44,9 @@ bool StageOptions::Check(std::string* why) const {
     *why = "name: must not be empty";
     return false;
   }
-  if (texel_resolution < 0 || texel_resolution > 64) {
-    *why = "texel_resolution: must be in [0, 64]";
+  if ((texel_resolution < 0 && texel_resolution != kTexelResolutionAuto) ||
+      texel_resolution > 64) {
+    *why = "texel_resolution: must be in [0, 64] or auto";
     return false;
   }
   if (effect_plan != "fixed") {
@@ -206,9 +207,18 @@ Status Schedule::PrepareStage(const ScheduleCallbacks& callbacks) {
   if (stage.topology.resample) {
     SFT_RETURN_IF_ERROR(ChangeTopology(TopologyChange::kResample, callbacks));
   }
-  if (stage.texel_resolution > 0 &&
-      stage.texel_resolution != current_.material.albedo.resolution()) {
-    current_.material = ResampleMaterial(current_.material, stage.texel_resolution);
+  std::vector<int> views;
+  SFT_RETURN_IF_ERROR(
+      SelectViews(stage.fit.views, static_cast<int>(dataset_->views.size()), &views));
+  const int resolution = ResolveTexelResolution(
+      stage.texel_resolution, current_.material.albedo.resolution(), current_.mesh, *dataset_,
+      views, stage.fit.cache.image_scale_log2);
+  if (resolution != current_.material.albedo.resolution()) {
+    current_.material = ResampleMaterial(current_.material, resolution);
+    if (callbacks.on_event) {
+      callbacks.on_event("texels: mesh-colours resolution " + std::to_string(resolution) +
+                         (stage.texel_resolution == kTexelResolutionAuto ? " (auto)" : ""));
+    }
   }
   progress_.stage_prepared = true;
   return CreateReconstruction();

@@ -33,7 +33,9 @@ struct StageOptions {
   std::string name = "refine";  // shown on the progress line, in metrics.json and the report.
   ReconstructOptions fit;       // phases, outer iterations, steps, spp, image scale, solver...
   // Mesh-colours resolution of albedo and roughness during the stage, [1, 64]; 0 = keep the
-  // current one. Texels are resampled (same mesh) or re-projected (after a topology change).
+  // current one; kTexelResolutionAuto (-1, "auto" in the config) = texels about one pixel apart
+  // at the stage's scale (ResolveTexelResolution). Texels are resampled (same mesh) or
+  // re-projected (after a topology change).
   int texel_resolution = 0;
   TopologyOptions topology;  // remeshing / resampling before the stage, and on folds.
   // Slots for the next stages of the project; each accepts its one current value:

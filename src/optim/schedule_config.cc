@@ -72,13 +72,20 @@ const std::map<std::string, StageKey>& StageKeys() {
   static const std::map<std::string, StageKey> keys = {
       {"texel_resolution",
        {[](const json& v, S* s) -> std::string {
+          if (v.is_string() && v.get<std::string>() == "auto") {
+            s->texel_resolution = kTexelResolutionAuto;
+            return "";
+          }
           if (!v.is_number_integer() || v.get<int64_t>() < 0 || v.get<int64_t>() > 64) {
-            return "expected an integer in [0, 64] (0 = keep)";
+            return "expected \"auto\" or an integer in [0, 64] (0 = keep)";
           }
           s->texel_resolution = v.get<int>();
           return "";
         },
-        [](const S& s) { return json(s.texel_resolution); }}},
+        [](const S& s) {
+          return s.texel_resolution == kTexelResolutionAuto ? json("auto")
+                                                            : json(s.texel_resolution);
+        }}},
       {"remesh", OneOf([](S* s) -> std::string& { return s->topology.remesh; },
                        {"none", "adaptive", "isotropic"}, "")},
       {"remesh_edge_pixels",
@@ -238,7 +245,9 @@ std::string FormatSchedule(const std::vector<StageOptions>& stages) {
                   "%5zu  %-10s  %-9s  1/%-4d %4d  %6d  %5d  %5d  %6s  %-6s  %s\n", k,
                   s.name.c_str(), PhaseScheduleName(f.phases), 1 << f.cache.image_scale_log2,
                   f.cache.render.spp, f.cache.pyramid_levels, f.outer_iterations, f.solver.steps,
-                  s.texel_resolution > 0 ? std::to_string(s.texel_resolution).c_str() : "keep",
+                  s.texel_resolution > 0                       ? std::to_string(s.texel_resolution).c_str()
+                  : s.texel_resolution == kTexelResolutionAuto ? "auto"
+                                                               : "keep",
                   SolverKindName(f.solver.kind), before.c_str());
     text += line;
   }

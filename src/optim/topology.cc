@@ -112,6 +112,23 @@ double PixelFootprint(const TriMesh& mesh, const Dataset& dataset,
   return count > 0 ? sum / count : 0.0;
 }
 
+int ResolveTexelResolution(int requested, int current, const TriMesh& mesh,
+                           const Dataset& dataset, const std::vector<int>& view_indices,
+                           int image_scale_log2) {
+  if (requested > 0) return requested;
+  if (requested != kTexelResolutionAuto) return current;
+  double sum = 0.0;
+  int64_t count = 0;
+  for (const auto& edge : mesh.edges()) {
+    sum += mesh.calc_edge_length(edge);
+    ++count;
+  }
+  const double footprint = PixelFootprint(mesh, dataset, view_indices, image_scale_log2);
+  if (count == 0 || !(footprint > 0.0)) return 1;
+  const double r = std::round(sum / count / footprint);
+  return static_cast<int>(std::clamp(r, 1.0, static_cast<double>(kMaxAutoTexelResolution)));
+}
+
 Status ApplyTopologyChange(TopologyChange change, const TopologyOptions& options,
                            const Dataset& dataset, const std::vector<int>& view_indices,
                            int image_scale_log2, int texel_resolution, TriMesh* mesh,
@@ -124,7 +141,8 @@ Status ApplyTopologyChange(TopologyChange change, const TopologyOptions& options
   } else {
     SFT_RETURN_IF_ERROR(Resample(options, dataset, view_indices, image_scale_log2, mesh, record));
   }
-  const int resolution = texel_resolution > 0 ? texel_resolution : material->albedo.resolution();
+  const int resolution = ResolveTexelResolution(texel_resolution, material->albedo.resolution(),
+                                                *mesh, dataset, view_indices, image_scale_log2);
   Material transferred;
   SFT_RETURN_IF_ERROR(TransferMaterial(old_mesh, *material, *mesh, resolution, &transferred));
   *material = std::move(transferred);

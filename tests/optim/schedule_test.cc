@@ -155,6 +155,34 @@ TEST_F(ScheduleRunTest, HalfScaleTargetsMatchHalfScaleRenders) {
   EXPECT_GT(psnr[1], psnr[0] - 0.5) << psnr[0] << " " << psnr[1];
 }
 
+// "auto" picks the texel resolution whose spacing (mean edge / r) is closest to the pixel
+// footprint: computed independently here from the mesh and the cameras' focal lengths; it
+// halves (to the floor of 1) when the images are halved; "auto" parses and prints.
+TEST_F(ScheduleRunTest, AutoTexelResolutionFollowsThePixelFootprint) {
+  std::vector<int> views(dataset_.views.size());
+  for (size_t v = 0; v < views.size(); ++v) views[v] = static_cast<int>(v);
+  double edge_sum = 0.0;
+  for (const auto& e : start_.mesh.edges()) edge_sum += start_.mesh.calc_edge_length(e);
+  const double mean_edge = edge_sum / start_.mesh.n_edges();
+  const double footprint = PixelFootprint(start_.mesh, dataset_, views, 0);
+  ASSERT_GT(footprint, 0.0);
+  const int full = ResolveTexelResolution(kTexelResolutionAuto, 1, start_.mesh, dataset_, views, 0);
+  const int expected = std::clamp(static_cast<int>(std::lround(mean_edge / footprint)), 1,
+                                  kMaxAutoTexelResolution);
+  EXPECT_EQ(full, expected);
+  EXPECT_GE(full, 1);
+  const int half = ResolveTexelResolution(kTexelResolutionAuto, 1, start_.mesh, dataset_, views, 1);
+  EXPECT_EQ(half, std::clamp(static_cast<int>(std::lround(mean_edge / (2 * footprint))), 1,
+                             kMaxAutoTexelResolution));
+  EXPECT_LE(half, full);
+  EXPECT_EQ(ResolveTexelResolution(0, 5, start_.mesh, dataset_, views, 0), 5);  // keep.
+  EXPECT_EQ(ResolveTexelResolution(3, 5, start_.mesh, dataset_, views, 0), 3);
+  const std::vector<StageOptions> stages = Stages(R"({"texel_resolution": "auto"})");
+  EXPECT_EQ(stages[0].texel_resolution, kTexelResolutionAuto);
+  EXPECT_THAT(FormatSchedule(stages), HasSubstr("auto"));
+  EXPECT_EQ(StageJson(stages[0])["texel_resolution"], "auto");
+}
+
 // Two stages: texture at half scale, then texture at full scale with twice the texel
 // resolution. The run records both, changes the texel resolution, lowers the cost, writes the
 // stage images; a resumed finished run does nothing; the state is format 2.
@@ -181,9 +209,11 @@ TEST_F(ScheduleRunTest, StagesRunInOrderWithCheckpoints) {
   // The weights add up to at most the ETA's total (a solve may stop early when it converges).
   EXPECT_LE(done, work);
   EXPECT_GT(done, work / 2);
-  ASSERT_EQ(events.size(), 2u);
+  // One line per stage start, and one per texel-resolution change (the second stage doubles it).
+  ASSERT_EQ(events.size(), 3u);
   EXPECT_THAT(events[0], HasSubstr("stage 1/2 coarse"));
   EXPECT_THAT(events[1], HasSubstr("stage 2/2 fine"));
+  EXPECT_THAT(events[2], HasSubstr("texels: mesh-colours resolution"));
   const auto& records = schedule->records();
   ASSERT_FALSE(records.empty());
   EXPECT_EQ(records.front().stage, "coarse");
