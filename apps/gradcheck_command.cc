@@ -8,6 +8,7 @@
 
 #include "apps/commands.h"
 #include "src/core/file_util.h"
+#include "src/eval/derivative_consistency.h"
 #include "src/eval/gradcheck.h"
 #include "src/geometry/material.h"
 #include "src/geometry/mesh.h"
@@ -26,7 +27,49 @@ struct GradcheckCommandOptions {
   std::string effects = "all";  // enabled effects (Effects::Parse).
   std::string json;             // optional JSON report path.
   GradcheckOptions check;       // spp, bounces, views, step, block, tolerance, seeds.
+  int consistency_seeds = 0;    // > 0: measure seed-to-seed consistency instead, [2, 64].
 };
+
+// --consistency-seeds: the derivative image at K seeds against itself
+// (src/eval/derivative_consistency.h). Informative: exit 0 unless the input is bad.
+int RunConsistency(const GradcheckCommandOptions& opts, const GradcheckOptions& check,
+                   const Dataset& dataset, const TriMesh& mesh, const Material& material) {
+  ConsistencyResult result;
+  const Status status =
+      MeasureDerivativeConsistency(dataset, mesh, material, check, opts.consistency_seeds, &result);
+  if (!status.ok()) return PrintError("gradcheck", status);
+  nlohmann::json per_view = nlohmann::json::array();
+  for (const ConsistencyViewResult& v : result.views) {
+    std::printf(
+        "view %3d: seed-to-seed correlation %.3f per pixel, %.3f on %dx%d blocks; "
+        "noise/signal %.3f\n",
+        v.view, v.pixel_correlation, v.block_correlation, result.block, result.block,
+        v.noise_to_signal);
+    per_view.push_back({{"view", v.view},
+                        {"pixel_correlation", v.pixel_correlation},
+                        {"block_correlation", v.block_correlation},
+                        {"noise_to_signal", v.noise_to_signal}});
+  }
+  std::printf(
+      "consistency %s over %zu views, %d seeds at %d spp: correlation %.3f per pixel, "
+      "%.3f on %dx%d blocks; noise/signal %.3f\n",
+      opts.param.c_str(), result.views.size(), result.seeds, check.render.spp,
+      result.pixel_correlation, result.block_correlation, result.block, result.block,
+      result.noise_to_signal);
+  if (opts.json.empty()) return 0;
+  const nlohmann::json report = {{"param", opts.param},
+                                 {"spp", check.render.spp},
+                                 {"bounces", check.render.bounces},
+                                 {"effects", check.render.effects.ToString()},
+                                 {"seeds", result.seeds},
+                                 {"block", result.block},
+                                 {"views", per_view},
+                                 {"pixel_correlation", result.pixel_correlation},
+                                 {"block_correlation", result.block_correlation},
+                                 {"noise_to_signal", result.noise_to_signal}};
+  const Status written = WriteTextFile(opts.json, report.dump(1) + "\n");
+  return written.ok() ? 0 : PrintError("gradcheck", written);
+}
 
 int RunGradcheckCommand(const GradcheckCommandOptions& opts) {
   GradcheckOptions check = opts.check;
@@ -54,6 +97,7 @@ int RunGradcheckCommand(const GradcheckCommandOptions& opts) {
   Material material;
   status = LoadMaterial(opts.material, mesh, &material);
   if (!status.ok()) return PrintError("gradcheck", status);
+  if (opts.consistency_seeds > 0) return RunConsistency(opts, check, dataset, mesh, material);
   GradcheckResult result;
   status = RunGradcheck(dataset, mesh, material, check, &result);
   if (!status.ok()) return PrintError("gradcheck", status);
@@ -175,6 +219,10 @@ CommandRunner SetupGradcheckCommand(CLI::App* app) {
                   "Write per-view analytic/finite-difference derivative images (EXR) and a "
                   "comparison PNG into this directory");
   app->add_option("--json", opts->json, "Write the results as JSON to this file");
+  app->add_option("--consistency-seeds", opts->consistency_seeds,
+                  "Instead of finite differences: render the derivative image at K seeds and "
+                  "report how alike they are (correlation, noise/signal), [2, 64]; 0 = off")
+      ->capture_default_str();
   return [opts]() { return RunGradcheckCommand(*opts); };
 }
 

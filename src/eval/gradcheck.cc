@@ -52,8 +52,8 @@ std::unique_ptr<RenderScene> DisplacedScene(const RenderScene& base,
   return std::make_unique<RenderScene>(positions, base.faces());
 }
 
-// Sums a width × height × 3 image (pixel-major, RGB) over block × block tiles (partial tiles at
-// the right and bottom borders).
+}  // namespace
+
 std::vector<double> BlockSums(const std::vector<double>& image, int width, int height, int block) {
   const int bw = (width + block - 1) / block, bh = (height + block - 1) / block;
   std::vector<double> sums(3 * static_cast<size_t>(bw) * bh, 0.0);
@@ -67,6 +67,8 @@ std::vector<double> BlockSums(const std::vector<double>& image, int width, int h
   }
   return sums;
 }
+
+namespace {
 
 // ‖error‖/‖reference‖ from squared norms; 1 when the reference vanishes but the error does not.
 double RelativeError(double err2, double ref2) {
@@ -191,6 +193,36 @@ std::vector<double> SmoothDisplacementField(const std::vector<Eigen::Vector3d>& 
   return delta;
 }
 
+std::vector<double> GradcheckDirection(const RenderScene& scene, const ParameterLayout& layout,
+                                       ParameterKind kind, uint64_t direction_seed) {
+  std::vector<double> delta(layout.size(), 0.0);
+  if (kind == ParameterKind::kVertex) {
+    const std::vector<double> field =
+        SmoothDisplacementField(scene.positions(), direction_seed, &scene.faces());
+    std::copy(field.begin(), field.end(), delta.begin() + layout.VertexOffset());
+    return delta;
+  }
+  std::mt19937_64 rng(direction_seed);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  for (int i = 0; i < layout.size(); ++i) {
+    if (layout.KindOf(i) == kind) delta[i] = uniform(rng);
+  }
+  return delta;
+}
+
+std::vector<double> DirectionalDerivativeImage(const JacobianRows& rows,
+                                               const std::vector<double>& delta) {
+  const size_t pixels = static_cast<size_t>(rows.width) * rows.height;
+  std::vector<double> image(3 * pixels, 0.0);
+  for (size_t p = 0; p < pixels; ++p) {
+    for (uint64_t e = rows.offsets[p]; e < rows.offsets[p + 1]; ++e) {
+      const JacobianEntry& entry = rows.entries[e];
+      for (int c = 0; c < 3; ++c) image[3 * p + c] += entry.d[c] * delta[entry.param];
+    }
+  }
+  return image;
+}
+
 bool GradcheckOptions::Check(std::string* why) const {
   if (!render.Check(why)) return false;
   if (!derivatives.Check(why)) return false;
@@ -232,16 +264,14 @@ Status RunGradcheck(const Dataset& dataset, const TriMesh& mesh, const Material&
   const bool vertices = options.kind == ParameterKind::kVertex;
   const int block = options.block > 0 ? options.block : (vertices ? 8 : 1);
 
+  std::vector<double> delta =
+      GradcheckDirection(scene, layout, options.kind, options.direction_seed);
+  // The adjoint check's random pixel weights (drawn after the direction's own stream).
   std::mt19937_64 rng(options.direction_seed);
   std::uniform_real_distribution<double> uniform(-1.0, 1.0);
-  std::vector<double> delta(layout.size(), 0.0);
-  if (vertices) {
-    const std::vector<double> field =
-        SmoothDisplacementField(scene.positions(), options.direction_seed, &scene.faces());
-    std::copy(field.begin(), field.end(), delta.begin() + layout.VertexOffset());
-  } else {
+  if (!vertices) {
     for (int i = 0; i < layout.size(); ++i) {
-      if (layout.KindOf(i) == options.kind) delta[i] = uniform(rng);
+      if (layout.KindOf(i) == options.kind) uniform(rng);
     }
   }
   double step = options.step;
@@ -301,13 +331,10 @@ Status RunGradcheck(const Dataset& dataset, const TriMesh& mesh, const Material&
 
     // The directional derivative images, RGB per pixel.
     const size_t pixels = static_cast<size_t>(width) * height;
-    std::vector<double> analytic(3 * pixels, 0.0), fd(3 * pixels, 0.0);
+    const std::vector<double> analytic = DirectionalDerivativeImage(out.rows, delta);
+    std::vector<double> fd(3 * pixels, 0.0);
     double weighted = 0.0, weighted_abs = 0.0;
     for (size_t p = 0; p < pixels; ++p) {
-      for (uint64_t e = out.rows.offsets[p]; e < out.rows.offsets[p + 1]; ++e) {
-        const JacobianEntry& entry = out.rows.entries[e];
-        for (int c = 0; c < 3; ++c) analytic[3 * p + c] += entry.d[c] * delta[entry.param];
-      }
       for (int c = 0; c < 3; ++c) {
         fd[3 * p + c] =
             (static_cast<double>(plus.data[4 * p + c]) - minus.data[4 * p + c]) / fd_span;

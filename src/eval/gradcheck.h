@@ -53,6 +53,7 @@
 #include "src/io/dataset.h"
 #include "src/render/derivatives.h"
 #include "src/render/render.h"
+#include "src/render/scene.h"
 
 namespace sft {
 
@@ -119,6 +120,19 @@ struct GradcheckResult {
 
 Status RunGradcheck(const Dataset& dataset, const TriMesh& mesh, const Material& material,
                     const GradcheckOptions& options, GradcheckResult* result);
+
+// The direction δ of a check of `kind` (file comment): the smooth displacement field for
+// vertices, uniform in [−1, 1] per parameter of the kind otherwise; zero elsewhere.
+std::vector<double> GradcheckDirection(const RenderScene& scene, const ParameterLayout& layout,
+                                       ParameterKind kind, uint64_t direction_seed);
+
+// Σ_θ J_θ·δ_θ per pixel and channel (pixel-major, RGB) from a view's Jacobian rows.
+std::vector<double> DirectionalDerivativeImage(const JacobianRows& rows,
+                                               const std::vector<double>& delta);
+
+// Sums a width × height × 3 image (pixel-major, RGB) over block × block tiles (partial tiles at
+// the right and bottom borders).
+std::vector<double> BlockSums(const std::vector<double>& image, int width, int height, int block);
 
 // The displacement field of a vertex gradcheck (see the file comment): 3·positions.size()
 // values, vertex v coordinate k at 3v + k, with max_v |δ(v)| = 1 (all zero when every position

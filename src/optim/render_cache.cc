@@ -286,10 +286,10 @@ void SquaredError(const LevelCache& level, const std::vector<uint8_t>& active, b
     for (int x = 0; x < level.render.width; ++x) {
       const size_t p = static_cast<size_t>(y) * level.render.width + x;
       if (!active[p]) continue;
-      const double w = weighted && !level.pixel_sqrt_weight.empty()
-                           ? static_cast<double>(level.pixel_sqrt_weight[p]) *
-                                 level.pixel_sqrt_weight[p]
-                           : 1.0;
+      const double w =
+          weighted && !level.pixel_sqrt_weight.empty()
+              ? static_cast<double>(level.pixel_sqrt_weight[p]) * level.pixel_sqrt_weight[p]
+              : 1.0;
       for (int c = 0; c < 3; ++c) {
         const double r = level.render.at(x, y, c) - level.target.at(x, y, c);
         *sum += w * r * r;

@@ -44,8 +44,7 @@ bool StageOptions::Check(std::string* why) const {
     *why = "name: must not be empty";
     return false;
   }
-  if ((texel_resolution < 0 && texel_resolution != kTexelResolutionAuto) ||
-      texel_resolution > 64) {
+  if ((texel_resolution < 0 && texel_resolution != kTexelResolutionAuto) || texel_resolution > 64) {
     *why = "texel_resolution: must be in [0, 64] or auto";
     return false;
   }
@@ -210,9 +209,9 @@ Status Schedule::PrepareStage(const ScheduleCallbacks& callbacks) {
   std::vector<int> views;
   SFT_RETURN_IF_ERROR(
       SelectViews(stage.fit.views, static_cast<int>(dataset_->views.size()), &views));
-  const int resolution = ResolveTexelResolution(
-      stage.texel_resolution, current_.material.albedo.resolution(), current_.mesh, *dataset_,
-      views, stage.fit.cache.image_scale_log2);
+  const int resolution =
+      ResolveTexelResolution(stage.texel_resolution, current_.material.albedo.resolution(),
+                             current_.mesh, *dataset_, views, stage.fit.cache.image_scale_log2);
   if (resolution != current_.material.albedo.resolution()) {
     current_.material = ResampleMaterial(current_.material, resolution);
     if (callbacks.on_event) {

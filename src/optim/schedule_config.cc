@@ -245,7 +245,7 @@ std::string FormatSchedule(const std::vector<StageOptions>& stages) {
                   "%5zu  %-10s  %-9s  1/%-4d %4d  %6d  %5d  %5d  %6s  %-6s  %s\n", k,
                   s.name.c_str(), PhaseScheduleName(f.phases), 1 << f.cache.image_scale_log2,
                   f.cache.render.spp, f.cache.pyramid_levels, f.outer_iterations, f.solver.steps,
-                  s.texel_resolution > 0                       ? std::to_string(s.texel_resolution).c_str()
+                  s.texel_resolution > 0 ? std::to_string(s.texel_resolution).c_str()
                   : s.texel_resolution == kTexelResolutionAuto ? "auto"
                                                                : "keep",
                   SolverKindName(f.solver.kind), before.c_str());

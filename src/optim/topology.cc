@@ -112,9 +112,8 @@ double PixelFootprint(const TriMesh& mesh, const Dataset& dataset,
   return count > 0 ? sum / count : 0.0;
 }
 
-int ResolveTexelResolution(int requested, int current, const TriMesh& mesh,
-                           const Dataset& dataset, const std::vector<int>& view_indices,
-                           int image_scale_log2) {
+int ResolveTexelResolution(int requested, int current, const TriMesh& mesh, const Dataset& dataset,
+                           const std::vector<int>& view_indices, int image_scale_log2) {
   if (requested > 0) return requested;
   if (requested != kTexelResolutionAuto) return current;
   double sum = 0.0;

@@ -53,14 +53,13 @@ constexpr int kMaxAutoTexelResolution = 8;
 // (mean edge length / r) is closest to the pixel footprint at 2^-image_scale_log2 of the
 // dataset's resolution: finer texels than pixels cannot be told apart by the images, coarser
 // ones cannot hold what the images show.
-int ResolveTexelResolution(int requested, int current, const TriMesh& mesh,
-                           const Dataset& dataset, const std::vector<int>& view_indices,
-                           int image_scale_log2);
+int ResolveTexelResolution(int requested, int current, const TriMesh& mesh, const Dataset& dataset,
+                           const std::vector<int>& view_indices, int image_scale_log2);
 
 // Applies `change` to `mesh` and carries `material` across (texel resolution resolved by
-// ResolveTexelResolution on the new mesh). `views` are the fitted views (ray casting, footprint); the dataset's
-// masks bound resampling (visual hull) when every view has one. `record` receives what was done
-// (kind, faces before and after, seconds, the parts' reports).
+// ResolveTexelResolution on the new mesh). `views` are the fitted views (ray casting, footprint);
+// the dataset's masks bound resampling (visual hull) when every view has one. `record` receives
+// what was done (kind, faces before and after, seconds, the parts' reports).
 Status ApplyTopologyChange(TopologyChange change, const TopologyOptions& options,
                            const Dataset& dataset, const std::vector<int>& view_indices,
                            int image_scale_log2, int texel_resolution, TriMesh* mesh,

@@ -312,7 +312,8 @@ TEST_F(ReconstructTest, RelativeLossWeightsFollowTheTarget) {
   int above = 0, active = 0;
   for (int p = 0; p < level0.target.width * level0.target.height; ++p) {
     const int x = p % level0.target.width, y = p / level0.target.width;
-    const float sum = level0.target.at(x, y, 0) + level0.target.at(x, y, 1) + level0.target.at(x, y, 2);
+    const float sum =
+        level0.target.at(x, y, 0) + level0.target.at(x, y, 1) + level0.target.at(x, y, 2);
     if (!cache.targets(0).active[0][p] || !(sum > 0.0f)) continue;
     ++active;
     above += level0.pixel_sqrt_weight[p] > 1.0f;
@@ -332,10 +333,9 @@ TEST_F(ReconstructTest, GradientsMatchFiniteDifferencesOfTheCost) {
   // Both pyramid filters: the adjoint weights (DownsampleMeanAdjoint) and the coarse rows
   // (DownsampleRows) must follow the filter of the levels.
   // And both image losses: the relative loss's pixel weights must reach the adjoint and the rows.
-  const std::pair<PyramidFilter, ImageLoss> cases[] = {
-      {PyramidFilter::kBox, ImageLoss::kL2},
-      {PyramidFilter::kBinomial, ImageLoss::kL2},
-      {PyramidFilter::kBox, ImageLoss::kRelative}};
+  const std::pair<PyramidFilter, ImageLoss> cases[] = {{PyramidFilter::kBox, ImageLoss::kL2},
+                                                       {PyramidFilter::kBinomial, ImageLoss::kL2},
+                                                       {PyramidFilter::kBox, ImageLoss::kRelative}};
   for (const auto& [filter, loss] : cases) {
     SCOPED_TRACE(std::string(PyramidFilterName(filter)) + " " + ImageLossName(loss));
     options_.cache.pyramid_filter = filter;

@@ -167,8 +167,8 @@ TEST_F(ScheduleRunTest, AutoTexelResolutionFollowsThePixelFootprint) {
   const double footprint = PixelFootprint(start_.mesh, dataset_, views, 0);
   ASSERT_GT(footprint, 0.0);
   const int full = ResolveTexelResolution(kTexelResolutionAuto, 1, start_.mesh, dataset_, views, 0);
-  const int expected = std::clamp(static_cast<int>(std::lround(mean_edge / footprint)), 1,
-                                  kMaxAutoTexelResolution);
+  const int expected =
+      std::clamp(static_cast<int>(std::lround(mean_edge / footprint)), 1, kMaxAutoTexelResolution);
   EXPECT_EQ(full, expected);
   EXPECT_GE(full, 1);
   const int half = ResolveTexelResolution(kTexelResolutionAuto, 1, start_.mesh, dataset_, views, 1);
