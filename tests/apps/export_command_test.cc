@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <nlohmann/json.hpp>
 #include <random>
 #include <sstream>
@@ -160,6 +161,8 @@ TEST(ExportCommandTest, WithoutADatasetTheWorldFrameWithAWarning) {
 TEST(ExportCommandTest, BadInputIsOneLineAndWritesNothing) {
   testing::TempDir tmp;
   const std::string rec = MakeReconstruction(tmp);
+  std::filesystem::create_directories(tmp.Join("broken"));
+  std::filesystem::create_directories(tmp.Join("nomaterial"));
   testing::WriteTestFile(tmp.Join("broken/mesh.ply"), "ply\nformat ascii 1.0\nend_header\n");
   testing::WriteTestFile(tmp.Join("nomaterial/mesh.ply"), testing::ReadTestFile(rec + "/mesh.ply"));
   const struct {
@@ -174,7 +177,7 @@ TEST(ExportCommandTest, BadInputIsOneLineAndWritesNothing) {
        "texture-size"},
       {"--reconstruction " + rec + " --out " + rec + "/inside", "--out"},
       {"--reconstruction " + rec + " --out " + tmp.Join("o6") + " --dataset " + tmp.Join("nodata"),
-       "scene.json"},
+       "nodata"},
   };
   for (const auto& c : cases) {
     std::string output;

@@ -28,12 +28,14 @@ struct RoundTrip {
 };
 
 // Looks every mesh-colors texel's representative point up in the baked textures (nearest texel).
+// Texels with i + j = r are left out: their part of the triangle is a single point (a corner of
+// the barycentric grid on the face's far edge), which the renderer meets only on that edge.
 RoundTrip SampleBack(const UvAtlas& atlas, const Material& m, const BakedMaterial& baked) {
   RoundTrip result;
   const int r = m.albedo.resolution();
   for (size_t f = 0; f < atlas.chart_of_face.size(); ++f) {
     for (int i = 0; i <= r; ++i) {
-      for (int j = 0; i + j <= r; ++j) {
+      for (int j = 0; i + j < r; ++j) {
         const Eigen::Vector2d ab = MeshColors::TexelCenter(r, i, j);
         const Eigen::Vector2d uv = (1.0 - ab.x() - ab.y()) * atlas.corner_uv[3 * f] +
                                    ab.x() * atlas.corner_uv[3 * f + 1] +
@@ -69,9 +71,10 @@ TEST(BakeTest, RoundTripThroughTheAtlas) {
     const RoundTrip trip = SampleBack(atlas, m, baked);
     // Resolution 1 is one value per face: the texel under a face's centroid is that face's unless
     // the face is thinner than a texel. At resolution 3 a mesh-colors texel is a few atlas texels
-    // wide, and the nearest atlas texel's centre can fall into the neighbouring mesh-colors texel.
+    // wide, and the nearest atlas texel's centre can fall into the neighbouring mesh-colors texel
+    // (measured: 0.7% of the samples).
     const double fraction = static_cast<double>(trip.exact) / trip.samples;
-    EXPECT_GT(fraction, resolution == 1 ? 0.99 : 0.9) << resolution;
+    EXPECT_GT(fraction, resolution == 1 ? 0.999 : 0.98) << resolution;
     printf("resolution %d: %d of %d samples exact (%.4f); %d covered, %d edge, %d dilated texels\n",
            resolution, trip.exact, trip.samples, fraction, report.covered_texels,
            report.edge_texels, report.dilated_texels);
