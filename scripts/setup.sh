@@ -23,6 +23,8 @@ PACKAGES=(
   clang libclang-rt-14-dev
   # CLI, JSON
   libcli11-dev nlohmann-json3-dev
+  # glTF 2.0 writer (sft export)
+  libtinygltf-dev
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev
 )

@@ -412,8 +412,10 @@ Status WriteExr(const std::string& path, const Image& image) {
   });
 }
 
-Status WritePng(const std::string& path, const Image& image, bool srgb) {
-  SFT_RETURN_IF_ERROR(CheckWritable(path, image));
+namespace {
+
+// 8-bit OpenCV matrix (BGR(A) order) of `image`, sRGB-encoding colour channels when `srgb`.
+cv::Mat ToPngMat(const Image& image, bool srgb) {
   const int channels = image.channels;
   cv::Mat mat(image.height, image.width, CV_8UC(channels));
   // Output channel k (OpenCV's BGR(A) order) reads image channel map[k].
@@ -430,6 +432,32 @@ Status WritePng(const std::string& path, const Image& image, bool srgb) {
       }
     }
   }
+  return mat;
+}
+
+}  // namespace
+
+Status EncodePng(const Image& image, bool srgb, std::string* bytes) {
+  if (image.width <= 0 || image.height <= 0 ||
+      (image.channels != 1 && image.channels != 3 && image.channels != 4) ||
+      image.data.size() != static_cast<size_t>(image.width) * image.height * image.channels) {
+    return Status::Error("cannot encode PNG: empty image or unsupported channel count");
+  }
+  std::vector<uint8_t> buffer;
+  try {
+    if (!cv::imencode(".png", ToPngMat(image, srgb), buffer)) {
+      return Status::Error("cannot encode PNG");
+    }
+  } catch (const cv::Exception& e) {
+    return Status::Error("cannot encode PNG (" + std::string(e.what()) + ")");
+  }
+  bytes->assign(buffer.begin(), buffer.end());
+  return Status::Ok();
+}
+
+Status WritePng(const std::string& path, const Image& image, bool srgb) {
+  SFT_RETURN_IF_ERROR(CheckWritable(path, image));
+  const cv::Mat mat = ToPngMat(image, srgb);
   return WriteAtomically(path, [&](const std::string& tmp) {
     try {
       errno = 0;

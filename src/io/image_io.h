@@ -31,6 +31,9 @@ Status ReadMask(const std::string& path, Image* mask);
 Status WriteExr(const std::string& path, const Image& image);
 // Writes an 8-bit PNG, sRGB-encoding colour channels when `srgb`, clamping to [0, 1], atomically.
 Status WritePng(const std::string& path, const Image& image, bool srgb = true);
+// The same PNG file's bytes in memory (for containers such as glTF binaries). Error on an empty
+// image or a channel count other than 1, 3 or 4.
+Status EncodePng(const Image& image, bool srgb, std::string* bytes);
 // Writes by extension (.exr or .png).
 Status WriteImage(const std::string& path, const Image& image);
 

@@ -1,0 +1,206 @@
+#include "src/export/export.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "src/core/file_util.h"
+#include "src/export/bake.h"
+#include "src/export/export_formats.h"
+#include "src/geometry/material.h"
+#include "src/optim/run_outputs.h"
+
+namespace sft {
+namespace {
+
+using json = nlohmann::json;
+
+constexpr int kDefaultTextureSize = 1024;
+
+// The dataset to take the frame and cameras from; *found false (with a warning) when there is
+// none to read. An explicit --dataset that cannot be read is an error.
+Status FindDataset(const ExportOptions& options, Dataset* dataset, bool* found, json* warnings) {
+  *found = false;
+  if (!options.dataset.empty()) {
+    SFT_RETURN_IF_ERROR(ReadDataset(options.dataset, dataset));
+    *found = true;
+    return Status::Ok();
+  }
+  const std::string state_path = JoinPath(options.reconstruction, "state.json");
+  if (!FileExists(state_path)) {
+    warnings->push_back(state_path + " not found: no dataset, so sft's world frame is used");
+    return Status::Ok();
+  }
+  RunState state;
+  const Status read = ReadRunState(options.reconstruction, &state);
+  if (!read.ok()) {
+    warnings->push_back(read.message() + " (sft's world frame is used)");
+    return Status::Ok();
+  }
+  const Status dataset_read = ReadDataset(state.dataset(), dataset);
+  if (!dataset_read.ok()) {
+    warnings->push_back("the run's dataset cannot be read (" + dataset_read.message() +
+                        "); sft's world frame is used; give --dataset");
+    return Status::Ok();
+  }
+  *found = true;
+  return Status::Ok();
+}
+
+json Vector(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
+
+json AtlasJson(const UvAtlasReport& r, const BakeReport& b, int texture_size) {
+  return {{"texture_size", texture_size},
+          {"faces", r.faces},
+          {"charts", r.charts},
+          {"utilization", r.utilization},
+          {"covered_texels_fraction", static_cast<double>(b.covered_texels) /
+                                          (static_cast<double>(texture_size) * texture_size)},
+          {"max_stretch", r.max_stretch},
+          {"mean_stretch", r.mean_stretch},
+          {"stretch_definition", "Sander et al. 2001 L2 stretch per chart (1 = isometric)"},
+          {"splits", r.splits},
+          {"failed_parameterizations", r.failed_parameterizations},
+          {"degenerate_faces", r.degenerate_faces},
+          {"nonmanifold_edges", r.nonmanifold_edges},
+          {"inconsistent_edges", r.inconsistent_edges},
+          {"texels_per_unit", r.texels_per_unit},
+          {"chart_seconds", r.chart_seconds},
+          {"parameterize_seconds", r.parameterize_seconds},
+          {"pack_seconds", r.pack_seconds},
+          {"atlas_seconds", r.seconds},
+          {"bake_seconds", b.seconds},
+          {"dilation_rings", b.dilation_rings}};
+}
+
+}  // namespace
+
+bool ExportOptions::Check(std::string* why) const {
+  if (reconstruction.empty()) {
+    *why = "reconstruction: required";
+    return false;
+  }
+  if (format != "obj" && format != "gltf" && format != "ply" && format != "all") {
+    *why = "format: expected obj, gltf, ply or all, got \"" + format + "\"";
+    return false;
+  }
+  if (texture_size != 0 && (texture_size < 64 || texture_size > 16384)) {
+    *why = "texture-size: expected [64, 16384] (or 0 = automatic), got " +
+           std::to_string(texture_size);
+    return false;
+  }
+  UvAtlasOptions checked = atlas;
+  if (texture_size != 0) checked.texture_size = texture_size;
+  return checked.Check(why);
+}
+
+int TextureSizeFromFootprint(const Dataset& dataset, const Eigen::Vector3d& center, double area) {
+  double footprint = std::numeric_limits<double>::infinity();
+  for (const ViewSpec& view : dataset.views) {
+    if (view.camera < 0 || view.camera >= static_cast<int>(dataset.cameras.size())) continue;
+    const double focal = dataset.cameras[view.camera].Focal().maxCoeff();
+    const Eigen::Vector3d eye = view.cam_from_world.Inverse().translation;
+    const double distance = (eye - center).norm();
+    if (focal > 0.0 && distance > 0.0) footprint = std::min(footprint, distance / focal);
+  }
+  if (!std::isfinite(footprint) || !(area > 0.0)) return kDefaultTextureSize;
+  const double side = std::sqrt(area / (footprint * footprint) / 0.5);
+  int size = 256;
+  while (size < side && size < 4096) size *= 2;
+  return size;
+}
+
+Status ExportReconstruction(const ExportOptions& options, json* summary) {
+  const auto start = std::chrono::steady_clock::now();
+  std::string why;
+  if (!options.Check(&why)) return Status::Error("--" + why);
+  SFT_RETURN_IF_ERROR(
+      CheckOutputDirectory(options.out, {{options.reconstruction, options.dataset}, {}}, "--out"));
+  TriMesh mesh;
+  SFT_RETURN_IF_ERROR(ReadMesh(JoinPath(options.reconstruction, "mesh.ply"), &mesh));
+  Material material;
+  SFT_RETURN_IF_ERROR(
+      LoadMaterial(JoinPath(options.reconstruction, "material.json"), mesh, &material));
+  json warnings = json::array();
+  Dataset dataset;
+  bool have_dataset = false;
+  SFT_RETURN_IF_ERROR(FindDataset(options, &dataset, &have_dataset, &warnings));
+
+  std::vector<Eigen::Vector3d> world;
+  std::vector<Eigen::Vector3i> faces;
+  MeshToArrays(mesh, &world, &faces);
+  const bool source_frame = have_dataset && dataset.has_source_from_world;
+  std::vector<Eigen::Vector3d> positions = world;
+  if (source_frame) {
+    for (Eigen::Vector3d& p : positions) p = dataset.source_from_world * p;
+  }
+  const bool obj = options.format == "obj" || options.format == "all";
+  const bool gltf = options.format == "gltf" || options.format == "all";
+  const bool ply = options.format == "ply" || options.format == "all";
+  json files = json::array();
+  *summary = {{"reconstruction", options.reconstruction},
+              {"frame", source_frame ? "source" : "world"},
+              {"gltf_frame", "the export frame turned Z-up to Y-up: (x, y, z) -> (x, z, -y)"},
+              {"faces", faces.size()},
+              {"vertices", world.size()},
+              {"specular", material.specular},
+              {"fresnel", material.fresnel == FresnelMode::kSchlick ? "schlick" : "constant"}};
+  if (source_frame) {
+    const Similarity3d& s = dataset.source_from_world;
+    (*summary)["source_from_world"] = {
+        {"scale", s.scale},
+        {"rotation", {s.rotation.w(), s.rotation.x(), s.rotation.y(), s.rotation.z()}},
+        {"translation", Vector(s.translation)}};
+  }
+  SFT_RETURN_IF_ERROR(MakeDirectories(options.out));
+
+  if (obj || gltf) {
+    UvAtlasOptions atlas_options = options.atlas;
+    std::string texture_from = "--texture-size";
+    atlas_options.texture_size = options.texture_size;
+    if (options.texture_size == 0) {
+      Eigen::Vector3d lo, hi;
+      MeshBounds(mesh, &lo, &hi);
+      atlas_options.texture_size =
+          have_dataset ? TextureSizeFromFootprint(dataset, 0.5 * (lo + hi), SurfaceArea(mesh))
+                       : kDefaultTextureSize;
+      texture_from = have_dataset ? "pixel footprint" : "default";
+    }
+    UvAtlas atlas;
+    UvAtlasReport atlas_report;
+    SFT_RETURN_IF_ERROR(BuildUvAtlas(world, faces, atlas_options, &atlas, &atlas_report)
+                            .Prefixed(JoinPath(options.reconstruction, "mesh.ply")));
+    BakedMaterial baked;
+    BakeReport bake_report;
+    SFT_RETURN_IF_ERROR(BakeMaterial(atlas, material, &baked, &bake_report)
+                            .Prefixed(JoinPath(options.reconstruction, "material.json")));
+    (*summary)["atlas"] = AtlasJson(atlas_report, bake_report, atlas.texture_size);
+    (*summary)["atlas"]["texture_size_from"] = texture_from;
+    if (obj) {
+      SFT_RETURN_IF_ERROR(WriteObjExport(options.out, positions, faces, atlas, baked, material));
+      files.insert(files.end(), {kObjFile, kMtlFile, kAlbedoPngFile, kRoughnessPngFile});
+    }
+    if (gltf) {
+      std::vector<Eigen::Vector3d> y_up(positions.size());
+      for (size_t v = 0; v < positions.size(); ++v) {
+        y_up[v] = Eigen::Vector3d(positions[v].x(), positions[v].z(), -positions[v].y());
+      }
+      SFT_RETURN_IF_ERROR(
+          WriteGlbExport(JoinPath(options.out, kGlbFile), y_up, faces, atlas, baked, material));
+      files.push_back(kGlbFile);
+    }
+  }
+  if (ply) {
+    SFT_RETURN_IF_ERROR(
+        WriteColoredPly(JoinPath(options.out, kPlyFile), positions, faces, material));
+    files.push_back(kPlyFile);
+  }
+  files.push_back(kSummaryFile);
+  (*summary)["files"] = files;
+  (*summary)["warnings"] = warnings;
+  (*summary)["seconds"] =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return WriteTextFile(JoinPath(options.out, kSummaryFile), summary->dump(1) + "\n");
+}
+
+}  // namespace sft
