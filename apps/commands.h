@@ -51,6 +51,7 @@ CommandRunner SetupCompareCommand(CLI::App* app);
 CommandRunner SetupImportCommand(CLI::App* app);
 CommandRunner SetupAlignProbeCommand(CLI::App* app);
 CommandRunner SetupInitCommand(CLI::App* app);
+CommandRunner SetupSweepCommand(CLI::App* app);
 
 }  // namespace sft
 
