@@ -53,9 +53,10 @@ std::string LineChartSvg(const LineChart& chart) {
   }
   const double margin = std::clamp(chart.margin, 0.0, 1.0);
   const double x_pad = margin * (x_hi - x_lo), y_pad = margin * (y_hi - y_lo);
-  x_lo -= x_pad;
+  // The margin never takes a non-negative axis below zero (times, counts).
+  x_lo = x_lo >= 0.0 ? std::max(0.0, x_lo - x_pad) : x_lo - x_pad;
   x_hi += x_pad;
-  y_lo -= y_pad;
+  y_lo = (y_lo >= 0.0 && !chart.log_y) ? std::max(0.0, y_lo - y_pad) : y_lo - y_pad;
   y_hi += y_pad;
   auto px = [&](double x) { return left + (x - x_lo) / (x_hi - x_lo) * plot_w; };
   auto py = [&](double y) { return top + (1.0 - (ty(y) - y_lo) / (y_hi - y_lo)) * plot_h; };

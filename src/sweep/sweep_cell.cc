@@ -57,8 +57,8 @@ json MeasureLine(const json& pass) {
 
 // Scores the reconstruction in `dir`: images of the fitted views (dir/eval.json) and, with a
 // reference, Chamfer and F1 of dir/mesh.ply.
-Status ScoreCell(const SweepContext& context, const std::string& dir,
-                 const std::vector<int>& views, json* line) {
+Status ScoreCell(const SweepContext& context, const std::string& dir, const std::vector<int>& views,
+                 json* line) {
   const SweepGrid& grid = *context.grid;
   ReconstructionEvalOptions options;
   options.spp = grid.eval.spp;
@@ -103,7 +103,8 @@ Status Reconstruct(const SweepContext& context, const std::vector<StageOptions>&
   bool budget_spent = false;
   ScheduleCallbacks hooks;
   hooks.on_iteration = [&](const IterationRecord& record) {
-    if (callbacks.on_iteration && !callbacks.on_iteration(record.seconds, schedule->CurrentStage())) {
+    if (callbacks.on_iteration &&
+        !callbacks.on_iteration(record.seconds, schedule->CurrentStage())) {
       *interrupted = true;
       return false;
     }
@@ -167,7 +168,6 @@ Status RunCell(const SweepContext& context, const SweepCell& cell, const std::st
                const CellCallbacks& callbacks, json* line, bool* interrupted) {
   *interrupted = false;
   *line = {{"id", cell.id}, {"index", cell.index}, {"settings", cell.settings}};
-  SFT_RETURN_IF_ERROR(MakeDirectories(dir));
   auto fail = [&](const Status& status) {
     (*line)["status"] = "error";
     (*line)["error"] = status.message();
@@ -181,8 +181,8 @@ Status RunCell(const SweepContext& context, const SweepCell& cell, const std::st
   if (*interrupted) return Status::Ok();
   if (!status.ok()) return fail(status);
   std::vector<int> views;
-  status = SelectViews(stages.back().fit.views, static_cast<int>(context.dataset.views.size()),
-                       &views);
+  status =
+      SelectViews(stages.back().fit.views, static_cast<int>(context.dataset.views.size()), &views);
   if (!status.ok()) return fail(status);
   (*line)["views"] = views.size();
   const double start = NowSeconds();

@@ -25,9 +25,9 @@ struct SweepContext {
   const SweepGrid* grid = nullptr;
   Dataset dataset;
   StartChoice start;
-  ScheduleStart start_state;        // the start mesh and initial material.
-  TriMesh reference;                // when grid->reference is set.
-  nlohmann::json default_stages;    // the base configuration's stages (IsDefault compares).
+  ScheduleStart start_state;      // the start mesh and initial material.
+  TriMesh reference;              // when grid->reference is set.
+  nlohmann::json default_stages;  // the base configuration's stages (IsDefault compares).
 };
 
 // Reads the dataset, the reference and the start (carving a hull when the grid gives no mesh
@@ -50,11 +50,12 @@ struct CellCallbacks {
   std::function<bool(double seconds, const StageOptions& stage)> on_iteration;
 };
 
-// Runs the reconstruction of `stages` in `dir` (a fresh folder) and scores it. *line receives
-// the cell's JSON line (settings, status, seconds, scores). *interrupted is set when the
-// callback stopped it (then *line is not meaningful). A failure of the cell itself (config,
-// solver, scoring) is a line with "status": "error", not an error status; the returned status
-// is an error only for what stops the sweep (an unwritable folder).
+// Runs the cell's reconstruction in `dir` (created; absent or empty before) and scores it.
+// *line receives the cell's JSON line (settings, status, seconds, scores). *interrupted is set
+// when the callback stopped it (then *line is not meaningful). A failure of the cell (its
+// configuration, the run, writing its files, scoring) is a line with "status": "error" and the
+// message, and the sweep goes on; the returned status is OK today (kept for failures that must
+// stop the sweep).
 Status RunCell(const SweepContext& context, const SweepCell& cell, const std::string& dir,
                const CellCallbacks& callbacks, nlohmann::json* line, bool* interrupted);
 

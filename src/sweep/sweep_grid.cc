@@ -15,8 +15,8 @@
 
 namespace sft {
 
-const char* const kSweepAxes[9] = {"variant", "phases", "views",       "solver", "bounces",
-                                   "effects", "image_scale", "spp", "steps"};
+const char* const kSweepAxes[9] = {"variant", "phases",      "views", "solver", "bounces",
+                                   "effects", "image_scale", "spp",   "steps"};
 
 namespace {
 
@@ -25,9 +25,9 @@ using json = nlohmann::json;
 // The id prefix of each axis' values ("spp16", "scale0.5", "lm").
 const std::map<std::string, std::string>& IdPrefixes() {
   static const std::map<std::string, std::string> prefixes = {
-      {"variant", ""},     {"phases", ""},          {"views", "views"},
-      {"solver", ""},      {"bounces", "bounces"},  {"effects", "effects-"},
-      {"image_scale", "scale"}, {"spp", "spp"},     {"steps", "steps"}};
+      {"variant", ""},          {"phases", ""},         {"views", "views"},
+      {"solver", ""},           {"bounces", "bounces"}, {"effects", "effects-"},
+      {"image_scale", "scale"}, {"spp", "spp"},         {"steps", "steps"}};
   return prefixes;
 }
 
@@ -62,8 +62,8 @@ std::string Label(const json& value) {
 std::string IdSafe(const std::string& text) {
   std::string out = text;
   for (char& c : out) {
-    const bool keep = std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '+' ||
-                      c == '-';
+    const bool keep =
+        std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '+' || c == '-';
     if (!keep) c = '-';
   }
   return out;
@@ -99,7 +99,8 @@ Status ParseEval(const json& v, const std::string& where, SweepEvalOptions* eval
       if (!value.is_number()) return Status::Error(at + ": expected a number");
       eval->f1_tolerance = value.get<double>();
     } else {
-      return Status::Error(at + ": unknown key (expected spp, bounces, f1_tolerance or "
+      return Status::Error(at +
+                           ": unknown key (expected spp, bounces, f1_tolerance or "
                            "mesh_samples)");
     }
   }
@@ -113,7 +114,8 @@ Status ParseAxisValue(const std::string& axis, const json& v, const std::string&
                       SweepAxisValue* out) {
   out->value = v;
   if (axis == "variant") {
-    if (!v.is_object()) return Status::Error(where + ": expected {\"name\": ..., \"config\": {...}}");
+    if (!v.is_object())
+      return Status::Error(where + ": expected {\"name\": ..., \"config\": {...}}");
     for (const auto& [key, value] : v.items()) {
       if (key != "name" && key != "config") {
         return Status::Error(where + "." + key + ": unknown key (expected name and config)");
@@ -240,8 +242,9 @@ Status ParseSweepGrid(const json& grid, const std::string& source, const std::st
     if (key == "dataset" || key == "init" || key == "reference") {
       std::string path;
       SFT_RETURN_IF_ERROR(ParseString(value, where, &path));
-      (key == "dataset" ? g.dataset : key == "init" ? g.init : g.reference) =
-          AbsolutePath(base_dir, path);
+      (key == "dataset" ? g.dataset
+       : key == "init"  ? g.init
+                        : g.reference) = AbsolutePath(base_dir, path);
     } else if (key == "material") {
       SFT_RETURN_IF_ERROR(ParseString(value, where, &g.material));
       if (g.material[0] != '{') g.material = AbsolutePath(base_dir, g.material);
@@ -329,7 +332,8 @@ json SweepGridJson(const SweepGrid& grid) {
     }
     axes[axis.name] = values;
   }
-  json j = {{"dataset", grid.dataset}, {"config", grid.config},
+  json j = {{"dataset", grid.dataset},
+            {"config", grid.config},
             {"eval",
              {{"spp", grid.eval.spp},
               {"bounces", grid.eval.bounces},

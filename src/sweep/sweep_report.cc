@@ -28,7 +28,9 @@ double Number(const json& v) { return v.is_number() ? v.get<double>() : kNaN; }
 
 bool IsOk(const json& line) { return line.value("status", "") == "ok"; }
 
-std::string Cell(double v, int digits = 4) { return std::isfinite(v) ? FormatNumber(v, digits) : "–"; }
+std::string Cell(double v, int digits = 4) {
+  return std::isfinite(v) ? FormatNumber(v, digits) : "–";
+}
 
 std::string AxisLabel(const json& v) { return v.is_string() ? v.get<std::string>() : v.dump(); }
 
@@ -109,25 +111,24 @@ std::vector<std::pair<std::string, std::string>> Summary(const SweepGrid& grid,
     if (line.value("default", false)) default_id = line["id"].get<std::string>();
   }
   const std::string budget =
-      grid.time_budget > 0.0 ? FormatNumber(grid.time_budget) + " s of wall time per cell"
+      grid.time_budget > 0.0      ? FormatNumber(grid.time_budget) + " s of wall time per cell"
       : grid.outer_iterations > 0 ? std::to_string(grid.outer_iterations) + " outer iterations"
                                   : "the configuration's outer iterations";
-  return {{"dataset", grid.dataset},
-          {"start mesh", grid.init.empty() ? "the dataset's initial mesh or a carved hull"
-                                           : grid.init},
-          {"reference mesh", grid.reference.empty() ? "none (no Chamfer, F1)" : grid.reference},
-          {"cells", std::to_string(cells.size()) + " in the grid; " +
-                        std::to_string(lines.size()) + " finished, " +
-                        std::to_string(lines.size() - ok) + " of them errors"},
-          {"each cell runs", budget},
-          {"scoring", "re-renders of the fitted views at the dataset's resolution, " +
-                          std::to_string(grid.eval.spp) + " spp, " +
-                          std::to_string(grid.eval.bounces) + " bounces; F1 and Chamfer with " +
-                          std::to_string(grid.eval.mesh_samples) + " samples per surface"},
-          {"PSNR and SSIM",
-           "of the display images (linear values clipped to [0, 1], sRGB-encoded; peak 1): the "
-           "fronts use this PSNR"},
-          {"default configuration", default_id}};
+  return {
+      {"dataset", grid.dataset},
+      {"start mesh", grid.init.empty() ? "the dataset's initial mesh or a carved hull" : grid.init},
+      {"reference mesh", grid.reference.empty() ? "none (no Chamfer, F1)" : grid.reference},
+      {"cells", std::to_string(cells.size()) + " in the grid; " + std::to_string(lines.size()) +
+                    " finished, " + std::to_string(lines.size() - ok) + " of them errors"},
+      {"each cell runs", budget},
+      {"scoring", "re-renders of the fitted views at the dataset's resolution, " +
+                      std::to_string(grid.eval.spp) + " spp, " + std::to_string(grid.eval.bounces) +
+                      " bounces; F1 and Chamfer with " + std::to_string(grid.eval.mesh_samples) +
+                      " samples per surface"},
+      {"PSNR and SSIM",
+       "of the display images (linear values clipped to [0, 1], sRGB-encoded; peak 1): the "
+       "fronts use this PSNR"},
+      {"default configuration", default_id}};
 }
 
 }  // namespace

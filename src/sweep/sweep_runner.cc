@@ -26,10 +26,9 @@ constexpr int64_t kBudgetCellWork = 1000;
 
 // Refuses an OUT among the inputs.
 Status CheckFolder(const SweepGrid& grid, const SweepRunOptions& options) {
-  const RunInputs inputs{
-      {grid.dataset},
-      {grid.init, grid.material.rfind('{', 0) == 0 ? "" : grid.material, grid.reference,
-       options.grid_file}};
+  const RunInputs inputs{{grid.dataset},
+                         {grid.init, grid.material.rfind('{', 0) == 0 ? "" : grid.material,
+                          grid.reference, options.grid_file}};
   return CheckOutputDirectory(options.out, inputs, "--out");
 }
 
@@ -115,10 +114,10 @@ CellWork EstimateWork(const SweepContext& context, const SweepCell& cell) {
   work.fit = context.grid->time_budget > 0.0
                  ? kBudgetCellWork
                  : std::max<int64_t>(1, Schedule::TotalWork(stages) * work.view_fraction);
-  work.eval = context.grid->time_budget > 0.0
-                  ? 0
-                  : static_cast<int64_t>(250.0 * context.grid->eval.spp / 16.0 *
-                                         work.view_fraction);
+  work.eval =
+      context.grid->time_budget > 0.0
+          ? 0
+          : static_cast<int64_t>(250.0 * context.grid->eval.spp / 16.0 * work.view_fraction);
   return work;
 }
 
@@ -176,15 +175,16 @@ Status RunSweep(const SweepGrid& grid, const SweepRunOptions& options, SweepSumm
     const std::string dir = JoinPath(JoinPath(options.out, "cells"), cell.id);
     std::error_code error;
     fs::remove_all(dir, error);  // an unfinished cell of an earlier run starts over.
-    if (error) return Status::Error(dir + ": cannot remove the unfinished cell: " + error.message());
+    if (error)
+      return Status::Error(dir + ": cannot remove the unfinished cell: " + error.message());
     const CellWork& w = work[cell.index];
     int64_t advanced = 0, steps = 0;
     CellCallbacks callbacks;
     callbacks.on_iteration = [&](double seconds, const StageOptions& stage) {
       // Progress within the fit: time against the budget, or solver steps done.
       steps += Schedule::StepWork(stage);
-      const double fraction = grid.time_budget > 0.0 ? seconds / grid.time_budget
-                                                     : steps * w.view_fraction / w.fit;
+      const double fraction =
+          grid.time_budget > 0.0 ? seconds / grid.time_budget : steps * w.view_fraction / w.fit;
       const int64_t target = std::min<int64_t>(w.fit, static_cast<int64_t>(fraction * w.fit));
       if (target > advanced) progress.Advance(target - advanced);
       advanced = std::max(advanced, target);

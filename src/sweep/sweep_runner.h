@@ -28,12 +28,12 @@ struct SweepRunOptions {
 };
 
 struct SweepSummary {
-  int cells = 0;            // in the grid.
-  int done_before = 0;      // finished by earlier runs (skipped).
-  int run = 0;              // finished by this run.
-  int errors = 0;           // cells recorded with "status": "error" (all runs).
+  int cells = 0;             // in the grid.
+  int done_before = 0;       // finished by earlier runs (skipped).
+  int run = 0;               // finished by this run.
+  int errors = 0;            // cells recorded with "status": "error" (all runs).
   bool interrupted = false;  // stopped before the last cell.
-  std::string report;       // OUT/report.html.
+  std::string report;        // OUT/report.html.
 };
 
 Status RunSweep(const SweepGrid& grid, const SweepRunOptions& options, SweepSummary* summary);

@@ -47,16 +47,18 @@ TEST(LineChartTest, MarginKeepsPointsOffTheFrame) {
   LineChart chart;
   chart.width = 400;
   chart.height = 300;
-  LineSeries s{"s", {0, 10}, {0, 10}};
+  LineSeries s{"s", {-2, 10}, {0, 10}};
   s.line = false;
   s.marker_radius = 2;
   chart.series = {s};
-  // Frame: x from 70 to 400 - 150 = 250.
-  EXPECT_THAT(LineChartSvg(chart), HasSubstr("cx=\"70.0\""));
+  // Frame: x from 70 to 400 - 150 = 250, y from 30 to 300 - 42 = 258.
+  EXPECT_THAT(LineChartSvg(chart), HasSubstr("cx=\"70.0\" cy=\"258.0\""));
   chart.margin = 0.1;
   const std::string svg = LineChartSvg(chart);
   EXPECT_THAT(svg, Not(HasSubstr("cx=\"70.0\"")));
-  EXPECT_THAT(svg, HasSubstr("cx=\"85.0\""));  // 70 + 180 · 1/12.
+  // x: [-2, 10] widens to [-3.2, 11.2]: 70 + 180 · 1.2/14.4 = 85. y: [0, 10] stays at 0 below
+  // (non-negative) and widens to 11 above: the lowest point sits on the frame's bottom, 258.
+  EXPECT_THAT(svg, HasSubstr("cx=\"85.0\" cy=\"258.0\""));
 }
 
 }  // namespace

@@ -33,7 +33,7 @@ TEST(SweepGridTest, ParsesPathsConfigEvalAndAxesInOrder) {
   EXPECT_EQ(grid.dataset, tmp.Join("ds"));  // relative to the grid's folder, normalised.
   EXPECT_EQ(grid.init, tmp.Join("g/start.ply"));
   EXPECT_EQ(grid.reference, "/abs/gt.ply");
-  EXPECT_EQ(grid.material, "{\"albedo\": [0.5, 0.5, 0.5]}");  // inline JSON kept.
+  EXPECT_EQ(grid.material, "{\"albedo\": [0.5, 0.5, 0.5]}");             // inline JSON kept.
   EXPECT_EQ(grid.config, json::parse(R"({"steps": 3, "bounces": 1})"));  // the file, inlined.
   EXPECT_EQ(grid.time_budget, 12.5);
   EXPECT_EQ(grid.outer_iterations, 0);

@@ -17,11 +17,14 @@ using ::testing::HasSubstr;
 
 json Line(const std::string& id, double seconds, double chamfer, double f1, double psnr,
           bool is_default = false) {
-  const json pass = {{"psnr_srgb", psnr}, {"ssim_srgb", 0.9}, {"psnr_linear", psnr - 1},
-                     {"ssim_linear", 0.8}, {"rel_rmse", 0.1}};
-  return {{"id", id},       {"status", "ok"}, {"seconds", seconds}, {"chamfer", chamfer},
-          {"f1", f1},       {"full", pass},   {"albedo", pass},     {"roughness", pass},
-          {"default", is_default}};
+  const json pass = {{"psnr_srgb", psnr},
+                     {"ssim_srgb", 0.9},
+                     {"psnr_linear", psnr - 1},
+                     {"ssim_linear", 0.8},
+                     {"rel_rmse", 0.1}};
+  return {{"id", id},           {"status", "ok"},    {"seconds", seconds},
+          {"chamfer", chamfer}, {"f1", f1},          {"full", pass},
+          {"albedo", pass},     {"roughness", pass}, {"default", is_default}};
 }
 
 TEST(SweepReportTest, WritesFrontsTableAndDefault) {
@@ -45,11 +48,11 @@ TEST(SweepReportTest, WritesFrontsTableAndDefault) {
   size_t charts = 0;
   for (size_t p = html.find("<svg"); p != std::string::npos; p = html.find("<svg", p + 1)) ++charts;
   EXPECT_EQ(charts, 5u);
-  for (const char* text : {"Chamfer against wall time", "F1 against wall time",
-                           "full PSNR against wall time", "albedo PSNR against wall time",
-                           "roughness PSNR against wall time", "Pareto front",
-                           "default configuration", "not run yet", "the fronts use this PSNR",
-                           "error: bounces: &lt;bad&gt;"}) {
+  for (const char* text :
+       {"Chamfer against wall time", "F1 against wall time", "full PSNR against wall time",
+        "albedo PSNR against wall time", "roughness PSNR against wall time", "Pareto front",
+        "default configuration", "not run yet", "the fronts use this PSNR",
+        "error: bounces: &lt;bad&gt;"}) {
     EXPECT_THAT(html, HasSubstr(text)) << text;
   }
   // Table 1's column order after the settings.
