@@ -52,6 +52,7 @@ CommandRunner SetupImportCommand(CLI::App* app);
 CommandRunner SetupAlignProbeCommand(CLI::App* app);
 CommandRunner SetupInitCommand(CLI::App* app);
 CommandRunner SetupExportCommand(CLI::App* app);
+CommandRunner SetupSweepCommand(CLI::App* app);
 
 }  // namespace sft
 

@@ -47,8 +47,6 @@ struct ReconstructCommandOptions {
   bool no_report = false;
 };
 
-constexpr char kInitialGuess[] = R"({"albedo": [0.5, 0.5, 0.5], "roughness": 0.5})";
-
 // The flat keys of the command line (flags override the config file's keys in every stage).
 Status FlagKeys(const ReconstructCommandOptions& cli, ScheduleConfig* config) {
   const nlohmann::json all = {
@@ -156,7 +154,7 @@ Status PrepareSchedule(ReconstructCommandOptions* cli, Dataset* dataset,
   }
   ScheduleStart state;
   SFT_RETURN_IF_ERROR(LoadStartMesh(*dataset, start, InitialMeshOptions(), &state.mesh));
-  SFT_RETURN_IF_ERROR(LoadMaterial(cli->material.empty() ? kInitialGuess : cli->material,
+  SFT_RETURN_IF_ERROR(LoadMaterial(cli->material.empty() ? kInitialMaterial : cli->material,
                                    state.mesh, &state.material));
   const nlohmann::json run_info = {
       {"dataset", cli->dataset},

@@ -27,8 +27,8 @@ echo "== start mesh against the truth (F1 at 0.5% of the size, Chamfer) =="
 echo "== reconstructed mesh against the truth =="
 ./build/sft eval --reference "$out/dataset/gt/mesh.ply" --mesh "$out/reconstruction/mesh.ply" \
   --tolerance 0.005 --samples 200000 | grep -E '"(f1|chamfer)"'
-echo "== re-renders of the reconstruction against the images and the true albedo (PSNR dB, SSIM) =="
+echo "== re-renders of the reconstruction against the images and the true albedo (PSNR dB and SSIM of the sRGB display images; linear PSNR) =="
 ./build/sft eval --dataset "$out/dataset" --reconstruction "$out/reconstruction" --spp 32 \
   --bounces 1 --json "$out/eval.json" > /dev/null
-grep -E '^ "(full|albedo|roughness)"|^  "(psnr|ssim)"' "$out/eval.json"
+grep -E '^ "(full|albedo|roughness)"|^  "(psnr_srgb|ssim_srgb|psnr_linear)"' "$out/eval.json"
 echo "example: report in $out/reconstruction/report.html"

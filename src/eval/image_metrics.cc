@@ -2,9 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 #include <vector>
+
+#include "src/io/image_io.h"
 #ifdef SFT_HAVE_OPENCV_QUALITY
 #include <opencv2/quality/qualityssim.hpp>
 #endif
@@ -174,6 +177,51 @@ Status ComputeSsim(const Image& ours, const Image& reference, const Image& mask,
 #else
   return SsimGaussian(ours, reference, mask, options, ssim);
 #endif
+}
+
+Image DisplayImage(const Image& image) {
+  Image out = image;
+  const int colour = std::min(image.channels, 3);
+  for (size_t i = 0; i < out.data.size(); ++i) {
+    if (static_cast<int>(i % image.channels) < colour) out.data[i] = LinearToSrgb(out.data[i]);
+  }
+  return out;
+}
+
+Status ComputeRelativeRmse(const Image& ours, const Image& reference, const Image& mask,
+                           double* relative_rmse) {
+  int channels = 0;
+  size_t masked = 0;
+  SFT_RETURN_IF_ERROR(
+      CheckInputs(ours, reference, mask, ImageMetricsOptions(), &channels, &masked));
+  double error = 0.0, energy = 0.0;
+  for (int y = 0; y < ours.height; ++y) {
+    for (int x = 0; x < ours.width; ++x) {
+      if (!mask.empty() && !(mask.at(x, y) > 0.5f)) continue;
+      for (int c = 0; c < channels; ++c) {
+        const double r = reference.at(x, y, c);
+        const double d = static_cast<double>(ours.at(x, y, c)) - r;
+        error += d * d;
+        energy += r * r;
+      }
+    }
+  }
+  *relative_rmse =
+      energy > 0.0 ? std::sqrt(error / energy) : std::numeric_limits<double>::quiet_NaN();
+  return Status::Ok();
+}
+
+Status ComputeImageScores(const Image& ours, const Image& reference, const Image& mask,
+                          const ImageMetricsOptions& options, ImageScores* scores) {
+  SFT_RETURN_IF_ERROR(ComputePsnr(ours, reference, mask, options, &scores->psnr_linear));
+  SFT_RETURN_IF_ERROR(ComputeSsim(ours, reference, mask, options, &scores->ssim_linear));
+  SFT_RETURN_IF_ERROR(ComputeRelativeRmse(ours, reference, mask, &scores->relative_rmse));
+  ImageMetricsOptions display = options;
+  display.peak = 1.0;
+  const Image ours_display = DisplayImage(ours), reference_display = DisplayImage(reference);
+  SFT_RETURN_IF_ERROR(
+      ComputePsnr(ours_display, reference_display, mask, display, &scores->psnr_srgb));
+  return ComputeSsim(ours_display, reference_display, mask, display, &scores->ssim_srgb);
 }
 
 }  // namespace sft

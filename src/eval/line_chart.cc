@@ -51,6 +51,13 @@ std::string LineChartSvg(const LineChart& chart) {
     y_hi += 0.5;
     y_lo -= 0.5;
   }
+  const double margin = std::clamp(chart.margin, 0.0, 1.0);
+  const double x_pad = margin * (x_hi - x_lo), y_pad = margin * (y_hi - y_lo);
+  // The margin never takes a non-negative axis below zero (times, counts).
+  x_lo = x_lo >= 0.0 ? std::max(0.0, x_lo - x_pad) : x_lo - x_pad;
+  x_hi += x_pad;
+  y_lo = (y_lo >= 0.0 && !chart.log_y) ? std::max(0.0, y_lo - y_pad) : y_lo - y_pad;
+  y_hi += y_pad;
   auto px = [&](double x) { return left + (x - x_lo) / (x_hi - x_lo) * plot_w; };
   auto py = [&](double y) { return top + (1.0 - (ty(y) - y_lo) / (y_hi - y_lo)) * plot_h; };
   svg += "<rect x=\"" + Num(left) + "\" y=\"" + Num(top) + "\" width=\"" + Num(plot_w) +
@@ -71,19 +78,39 @@ std::string LineChartSvg(const LineChart& chart) {
          (chart.log_y ? " (log)" : "") + "</text>\n";
   for (size_t s = 0; s < chart.series.size(); ++s) {
     const LineSeries& series = chart.series[s];
-    const char* color = kColors[s % (sizeof(kColors) / sizeof(kColors[0]))];
-    std::string points;
+    const std::string color = !series.color.empty()
+                                  ? HtmlEscape(series.color)
+                                  : kColors[s % (sizeof(kColors) / sizeof(kColors[0]))];
+    const std::string fill = series.hollow_markers ? "none" : color;
+    std::string points, dots;
     for (size_t i = 0; i < std::min(series.x.size(), series.y.size()); ++i) {
       if (!usable(series.x[i], series.y[i])) continue;
       points += Num(px(series.x[i])) + "," + Num(py(series.y[i])) + " ";
+      if (series.marker_radius <= 0.0) continue;
+      dots += "<circle cx=\"" + Num(px(series.x[i])) + "\" cy=\"" + Num(py(series.y[i])) +
+              "\" r=\"" + Num(series.marker_radius) + "\" fill=\"" + fill + "\" stroke=\"" + color +
+              "\" stroke-width=\"" + (series.hollow_markers ? "2" : "1") + "\">";
+      if (i < series.tips.size()) dots += "<title>" + HtmlEscape(series.tips[i]) + "</title>";
+      dots += "</circle>\n";
     }
-    svg += "<polyline fill=\"none\" stroke=\"" + std::string(color) +
-           "\" stroke-width=\"1.5\" points=\"" + points + "\"/>\n";
+    if (series.line) {
+      svg += "<polyline fill=\"none\" stroke=\"" + color + "\" stroke-width=\"1.5\" points=\"" +
+             points + "\"/>\n";
+    }
+    svg += dots;
     const double ly = top + 14 * s + 8;
-    svg += "<line x1=\"" + Num(left + plot_w + 10) + "\" y1=\"" + Num(ly) + "\" x2=\"" +
-           Num(left + plot_w + 28) + "\" y2=\"" + Num(ly) + "\" stroke=\"" + color +
-           "\" stroke-width=\"2\"/><text x=\"" + Num(left + plot_w + 32) + "\" y=\"" + Num(ly + 4) +
-           "\">" + HtmlEscape(series.name) + "</text>\n";
+    if (series.line) {
+      svg += "<line x1=\"" + Num(left + plot_w + 10) + "\" y1=\"" + Num(ly) + "\" x2=\"" +
+             Num(left + plot_w + 28) + "\" y2=\"" + Num(ly) + "\" stroke=\"" + color +
+             "\" stroke-width=\"2\"/>";
+    }
+    if (series.marker_radius > 0.0) {
+      svg += "<circle cx=\"" + Num(left + plot_w + 19) + "\" cy=\"" + Num(ly) + "\" r=\"" +
+             Num(std::min(series.marker_radius, 5.0)) + "\" fill=\"" + fill + "\" stroke=\"" +
+             color + "\" stroke-width=\"" + (series.hollow_markers ? "2" : "1") + "\"/>";
+    }
+    svg += "<text x=\"" + Num(left + plot_w + 32) + "\" y=\"" + Num(ly + 4) + "\">" +
+           HtmlEscape(series.name) + "</text>\n";
   }
   return svg + "</svg>\n";
 }

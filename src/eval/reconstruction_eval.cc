@@ -1,5 +1,6 @@
 #include "src/eval/reconstruction_eval.h"
 
+#include <cmath>
 #include <filesystem>
 
 #include "src/core/file_util.h"
@@ -17,28 +18,46 @@ namespace {
 
 using json = nlohmann::json;
 
-// Per-view results of one measure and their means.
+// A number for JSON: null when not finite (a relative RMSE against a black reference).
+json Finite(double value) { return std::isfinite(value) ? json(value) : json(nullptr); }
+
+// Per-view scores of one pass and their means over views (the relative RMSE's over the views
+// where it is defined).
 struct Measure {
   json views = json::array();
-  double psnr_sum = 0.0, ssim_sum = 0.0;
-  int count = 0;
+  ImageScores sum;
+  double rel_rmse_sum = 0.0;
+  int count = 0, rel_rmse_count = 0;
 
   Status Add(int v, const Image& ours, const Image& reference, const Image& mask) {
-    double psnr = 0.0, ssim = 0.0;
-    const ImageMetricsOptions options;
-    SFT_RETURN_IF_ERROR(
-        ComputePsnr(ours, reference, mask, options, &psnr).Prefixed("view " + std::to_string(v)));
-    SFT_RETURN_IF_ERROR(
-        ComputeSsim(ours, reference, mask, options, &ssim).Prefixed("view " + std::to_string(v)));
-    views.push_back({{"view", v}, {"psnr", psnr}, {"ssim", ssim}});
-    psnr_sum += psnr;
-    ssim_sum += ssim;
+    ImageScores s;
+    SFT_RETURN_IF_ERROR(ComputeImageScores(ours, reference, mask, ImageMetricsOptions(), &s)
+                            .Prefixed("view " + std::to_string(v)));
+    views.push_back({{"view", v},
+                     {"psnr_srgb", s.psnr_srgb},
+                     {"ssim_srgb", s.ssim_srgb},
+                     {"psnr_linear", s.psnr_linear},
+                     {"ssim_linear", s.ssim_linear},
+                     {"rel_rmse", Finite(s.relative_rmse)}});
+    sum.psnr_srgb += s.psnr_srgb;
+    sum.ssim_srgb += s.ssim_srgb;
+    sum.psnr_linear += s.psnr_linear;
+    sum.ssim_linear += s.ssim_linear;
+    if (std::isfinite(s.relative_rmse)) {
+      rel_rmse_sum += s.relative_rmse;
+      ++rel_rmse_count;
+    }
     ++count;
     return Status::Ok();
   }
   json ToJson() const {
     if (count == 0) return nullptr;
-    return {{"psnr", psnr_sum / count}, {"ssim", ssim_sum / count}, {"views", views}};
+    return {{"psnr_srgb", sum.psnr_srgb / count},
+            {"ssim_srgb", sum.ssim_srgb / count},
+            {"psnr_linear", sum.psnr_linear / count},
+            {"ssim_linear", sum.ssim_linear / count},
+            {"rel_rmse", rel_rmse_count > 0 ? json(rel_rmse_sum / rel_rmse_count) : json(nullptr)},
+            {"views", views}};
   }
 };
 
@@ -73,6 +92,19 @@ Status TruePass(const Dataset& dataset, int v, const std::string& folder, const 
   RenderView(*scene, *truth, view, options, &image);
   *out = ToRgb(image);
   return Status::Ok();
+}
+
+// What each key of a measure means (written into the report so that the JSON explains itself).
+json MeasureDefinitions() {
+  return {{"psnr_srgb",
+           "PSNR (dB, peak 1) of the display images: linear values clipped to [0, 1], then "
+           "sRGB-encoded"},
+          {"ssim_srgb", "SSIM of the display images (dynamic range 1)"},
+          {"psnr_linear", "PSNR (dB, peak 1) of the linear values"},
+          {"ssim_linear", "SSIM of the linear values (dynamic range 1)"},
+          {"rel_rmse",
+           "sqrt(sum (ours - reference)^2 / sum reference^2) of the linear values; null when the "
+           "reference is black"}};
 }
 
 }  // namespace
@@ -156,10 +188,17 @@ Status EvaluateReconstruction(const std::string& dataset_dir, const std::string&
       SFT_RETURN_IF_ERROR(roughness.Add(v, ToRgb(ours), truth, mask));
     }
   }
-  *report = {
-      {"mode", "reconstruction"}, {"dataset", dataset_dir},     {"reconstruction", reconstruction},
-      {"spp", options.spp},       {"bounces", options.bounces}, {"psnr_peak", 1.0},
-      {"full", full.ToJson()},    {"albedo", albedo.ToJson()},  {"roughness", roughness.ToJson()}};
+  *report = {{"mode", "reconstruction"},
+             {"dataset", dataset_dir},
+             {"reconstruction", reconstruction},
+             {"spp", options.spp},
+             {"bounces", options.bounces},
+             {"views", selected},
+             {"psnr_peak", 1.0},
+             {"definitions", MeasureDefinitions()},
+             {"full", full.ToJson()},
+             {"albedo", albedo.ToJson()},
+             {"roughness", roughness.ToJson()}};
   return Status::Ok();
 }
 

@@ -6,8 +6,10 @@
 //              named like the view's image, premultiplied by coverage as Cycles' DiffCol pass),
 //              or else the albedo pass of `ground_truth.mesh` with `ground_truth.material`;
 //   roughness  the same with `ground_truth.roughness` or the material's roughness.
-// over each view's mask (all pixels when it has none). PSNR with peak 1 and SSIM
-// (src/eval/image_metrics.h), per view and their means over views.
+// over each view's mask (all pixels when it has none). For each pass, per view and as means over
+// views (src/eval/image_metrics.h): PSNR and SSIM of the display images (clipped to [0, 1] and
+// sRGB-encoded: what a viewer sees, meaningful on HDR data), PSNR and SSIM of the linear values
+// (peak 1), and the relative RMSE of the linear values.
 #ifndef SFT_EVAL_RECONSTRUCTION_EVAL_H_
 #define SFT_EVAL_RECONSTRUCTION_EVAL_H_
 
@@ -28,9 +30,10 @@ struct ReconstructionEvalOptions {
   bool Check(std::string* why) const;
 };
 
-// Fills *report with {"mode": "reconstruction", "full": {...}, "albedo": {...} | null,
-// "roughness": {...} | null, ...}; each measure {"psnr", "ssim", "views": [{"view", "psnr",
-// "ssim"}]}.
+// Fills *report with {"mode": "reconstruction", "views": [...], "full": {...}, "albedo": {...} |
+// null, "roughness": {...} | null, "definitions": {...}, ...}; each pass {"psnr_srgb",
+// "ssim_srgb", "psnr_linear", "ssim_linear", "rel_rmse", "views": [{"view", the same five}]}
+// (rel_rmse null where undefined).
 Status EvaluateReconstruction(const std::string& dataset_dir, const std::string& reconstruction,
                               const ReconstructionEvalOptions& options, nlohmann::json* report);
 

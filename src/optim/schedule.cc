@@ -78,6 +78,12 @@ int64_t Schedule::RemainingWork() const {
   return work;
 }
 
+int64_t Schedule::TotalWork(const std::vector<StageOptions>& stages) {
+  Schedule fresh;
+  fresh.stages_ = stages;
+  return fresh.RemainingWork();
+}
+
 Status Schedule::Start(const Dataset& dataset, const std::string& out,
                        const std::vector<StageOptions>& stages, const ScheduleStart& start,
                        const json& run_info, std::unique_ptr<Schedule>* schedule) {

@@ -106,6 +106,8 @@ class Schedule {
   // spp), for a progress line whose ETA holds across stages of different scales.
   int64_t RemainingWork() const;
   static int64_t StepWork(const StageOptions& stage);
+  // The work of a whole run of `stages` in the same units (RemainingWork of a fresh run).
+  static int64_t TotalWork(const std::vector<StageOptions>& stages);
 
  private:
   Schedule() = default;

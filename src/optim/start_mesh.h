@@ -14,6 +14,9 @@
 
 namespace sft {
 
+// The material a run starts from when none is given (grey albedo 0.5, roughness 0.5, constant).
+inline constexpr char kInitialMaterial[] = R"({"albedo": [0.5, 0.5, 0.5], "roughness": 0.5})";
+
 enum class StartKind { kGiven, kDatasetInitialMesh, kCarved };
 
 struct StartChoice {

@@ -80,8 +80,18 @@ TEST(ReconstructCliTest, ReconstructEvalResume) {
             0)
       << out;
   const nlohmann::json images = nlohmann::json::parse(out);
-  EXPECT_GT(images["full"]["psnr"].get<double>(), 20.0);
-  EXPECT_GT(images["albedo"]["psnr"].get<double>(), 15.0);
+  EXPECT_GT(images["full"]["psnr_linear"].get<double>(), 20.0);
+  EXPECT_GT(images["albedo"]["psnr_linear"].get<double>(), 15.0);
+  // The display (sRGB) measures and the relative RMSE come with every pass and view.
+  for (const char* pass : {"full", "albedo", "roughness"}) {
+    for (const char* key : {"psnr_srgb", "ssim_srgb", "ssim_linear", "rel_rmse"}) {
+      EXPECT_TRUE(images[pass][key].is_number()) << pass << " " << key;
+      EXPECT_TRUE(images[pass]["views"][0][key].is_number()) << pass << " " << key;
+    }
+  }
+  EXPECT_GT(images["full"]["psnr_srgb"].get<double>(), 15.0);
+  EXPECT_LT(images["full"]["rel_rmse"].get<double>(), 0.5);
+  EXPECT_EQ(images["views"].size(), 4u);
   ASSERT_EQ(RunSft("eval --reference " + tmp.Join("ds/gt/mesh.ply") + " --mesh " +
                        tmp.Join("r/mesh.ply") + " --samples 20000",
                    &out),

@@ -1,4 +1,5 @@
-// PSNR and SSIM over a mask (src/eval/image_metrics.h) on cases with known answers.
+// PSNR, SSIM and relative RMSE over a mask, on linear and display (sRGB) values
+// (src/eval/image_metrics.h), on cases with known answers.
 #include "src/eval/image_metrics.h"
 
 #include <gmock/gmock.h>
@@ -129,6 +130,43 @@ TEST(ImageMetricsTest, ShiftedImageHasLowerSsim) {
   EXPECT_LT(closer, 1.0);
 }
 
+// HDR pixels: a reference of 4 and a re-render of 3 differ by 1 in linear values (peak-1 PSNR
+// 0 dB, relative RMSE 1/4) but both show as white: the display PSNR is the cap, SSIM 1.
+TEST(ImageMetricsTest, HdrValuesClipOnTheDisplay) {
+  const Image reference(16, 12, 3, 4.0f), ours(16, 12, 3, 3.0f);
+  ImageScores s;
+  ASSERT_TRUE(ComputeImageScores(ours, reference, Image(), ImageMetricsOptions(), &s).ok());
+  EXPECT_NEAR(s.psnr_linear, 0.0, 1e-12);
+  EXPECT_NEAR(s.relative_rmse, 0.25, 1e-12);
+  EXPECT_EQ(s.psnr_srgb, ImageMetricsOptions().max_psnr);
+  EXPECT_NEAR(s.ssim_srgb, 1.0, 1e-9);
+}
+
+// Constant images with a known sRGB code value: linear 0.5 shows as 1.055·0.5^(1/2.4) − 0.055 =
+// 0.7353570, 0.25 as 0.5370987; PSNR = −20·log10(0.1982582) = 14.05537 dB. The linear PSNR is
+// −20·log10(0.25) = 12.04120 dB, the relative RMSE 0.25 / 0.5 = 0.5 (0.5 is the reference here).
+// Below 0.0031308 the encoding is linear: 0.002 shows as 0.02584 (31.75415 dB against black).
+TEST(ImageMetricsTest, DisplayPsnrOfConstantImagesIsKnown) {
+  const Image reference(10, 10, 3, 0.5f), ours(10, 10, 3, 0.25f);
+  ImageScores s;
+  ASSERT_TRUE(ComputeImageScores(ours, reference, Image(), ImageMetricsOptions(), &s).ok());
+  EXPECT_NEAR(s.psnr_srgb, 14.055374519, 1e-4);
+  EXPECT_NEAR(s.psnr_linear, 12.041199827, 1e-6);
+  EXPECT_NEAR(s.relative_rmse, 0.5, 1e-7);
+  const Image display = DisplayImage(reference);
+  EXPECT_NEAR(display.at(3, 4, 1), 0.735356983, 1e-6);
+  const Image dark(10, 10, 3, 0.002f), black(10, 10, 3, 0.0f);
+  ASSERT_TRUE(ComputeImageScores(dark, black, Image(), ImageMetricsOptions(), &s).ok());
+  EXPECT_NEAR(s.psnr_srgb, 31.754149814, 1e-4);
+  EXPECT_TRUE(std::isnan(s.relative_rmse));  // a black reference: undefined.
+  // Alpha is not encoded; negative values show as black.
+  Image rgba(2, 1, 4, -1.0f);
+  rgba.at(0, 0, 3) = 0.5f;
+  const Image shown = DisplayImage(rgba);
+  EXPECT_EQ(shown.at(0, 0, 0), 0.0f);
+  EXPECT_EQ(shown.at(0, 0, 3), 0.5f);
+}
+
 TEST(ImageMetricsTest, BadInputsAreErrors) {
   const Image a = Pattern(16, 16);
   ImageMetricsOptions options;
@@ -145,6 +183,11 @@ TEST(ImageMetricsTest, BadInputsAreErrors) {
   Image nan_image = a;
   nan_image.at(3, 4, 1) = std::nanf("");
   EXPECT_THAT(ComputePsnr(nan_image, a, Image(), options, &value).message(),
+              HasSubstr("non-finite"));
+  EXPECT_THAT(ComputeRelativeRmse(a, Pattern(16, 15), Image(), &value).message(),
+              HasSubstr("sizes differ"));
+  ImageScores scores;
+  EXPECT_THAT(ComputeImageScores(nan_image, a, Image(), options, &scores).message(),
               HasSubstr("non-finite"));
   options.peak = 0.0;
   EXPECT_THAT(ComputePsnr(a, a, Image(), options, &value).message(), HasSubstr("peak"));

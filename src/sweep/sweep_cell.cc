@@ -1,0 +1,196 @@
+#include "src/sweep/sweep_cell.h"
+
+#include <chrono>
+#include <set>
+
+#include "src/core/file_util.h"
+#include "src/eval/mesh_metrics.h"
+#include "src/eval/reconstruction_eval.h"
+#include "src/geometry/material.h"
+#include "src/io/scene_setup.h"
+#include "src/optim/schedule_config.h"
+
+namespace sft {
+namespace {
+
+using json = nlohmann::json;
+
+double NowSeconds() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+// The base configuration with the grid's outer iterations (or the budget's 10000).
+Status BaseConfig(const SweepGrid& grid, ScheduleConfig* config) {
+  SFT_RETURN_IF_ERROR(MergeScheduleConfig(grid.config, "config", config));
+  if (grid.outer_iterations > 0) {
+    return MergeScheduleConfig({{"outer_iterations", grid.outer_iterations}}, "grid", config);
+  }
+  if (grid.time_budget > 0.0 && !config->flat.contains("outer_iterations")) {
+    return MergeScheduleConfig({{"outer_iterations", 10000}}, "grid", config);
+  }
+  return Status::Ok();
+}
+
+// The stages as JSON with "fit every view" written one way (an empty list).
+json NormalizedStages(const std::vector<StageOptions>& stages, int num_views) {
+  json list = json::array();
+  for (const StageOptions& stage : stages) {
+    json j = StageJson(stage);
+    const std::set<int> views(stage.fit.views.begin(), stage.fit.views.end());
+    if (static_cast<int>(views.size()) == num_views && *views.begin() == 0 &&
+        *views.rbegin() == num_views - 1) {
+      j["views"] = json::array();
+    }
+    list.push_back(j);
+  }
+  return list;
+}
+
+json MeasureLine(const json& pass) {
+  if (!pass.is_object()) return nullptr;
+  json out = json::object();
+  for (const char* key : {"psnr_srgb", "ssim_srgb", "psnr_linear", "ssim_linear", "rel_rmse"}) {
+    out[key] = pass.value(key, json());
+  }
+  return out;
+}
+
+// Scores the reconstruction in `dir`: images of the fitted views (dir/eval.json) and, with a
+// reference, Chamfer and F1 of dir/mesh.ply.
+Status ScoreCell(const SweepContext& context, const std::string& dir, const std::vector<int>& views,
+                 json* line) {
+  const SweepGrid& grid = *context.grid;
+  ReconstructionEvalOptions options;
+  options.spp = grid.eval.spp;
+  options.bounces = grid.eval.bounces;
+  options.views = views;
+  json images;
+  SFT_RETURN_IF_ERROR(EvaluateReconstruction(grid.dataset, dir, options, &images));
+  SFT_RETURN_IF_ERROR(WriteTextFile(JoinPath(dir, "eval.json"), images.dump(1) + "\n"));
+  for (const char* pass : {"full", "albedo", "roughness"}) {
+    (*line)[pass] = MeasureLine(images[pass]);
+  }
+  (*line)["chamfer"] = nullptr;
+  (*line)["f1"] = nullptr;
+  if (grid.reference.empty()) return Status::Ok();
+  TriMesh mesh;
+  const std::string mesh_path = JoinPath(dir, "mesh.ply");
+  SFT_RETURN_IF_ERROR(ReadMesh(mesh_path, &mesh));
+  MeshMetricsOptions mesh_options;
+  mesh_options.tolerance = grid.eval.f1_tolerance;
+  mesh_options.samples = grid.eval.mesh_samples;
+  MeshMetrics m;
+  SFT_RETURN_IF_ERROR(
+      ComputeMeshMetrics(context.reference, mesh, mesh_options, &m, grid.reference, mesh_path));
+  (*line)["chamfer"] = m.chamfer;
+  (*line)["f1"] = m.f1;
+  (*line)["f1_tolerance"] = m.tolerance;
+  return Status::Ok();
+}
+
+// Runs the schedule of `stages` in `dir`; *seconds is its wall time, *ended_by why it stopped.
+Status Reconstruct(const SweepContext& context, const std::vector<StageOptions>& stages,
+                   const std::string& dir, const CellCallbacks& callbacks, json* line,
+                   bool* interrupted) {
+  const json run_info = {{"dataset", context.grid->dataset},
+                         {"start", context.start.Describe()},
+                         {"init", context.start.path},
+                         {"sweep_cell", (*line)["id"]}};
+  std::unique_ptr<Schedule> schedule;
+  SFT_RETURN_IF_ERROR(
+      Schedule::Start(context.dataset, dir, stages, context.start_state, run_info, &schedule));
+  const double budget = context.grid->time_budget;
+  bool budget_spent = false;
+  ScheduleCallbacks hooks;
+  hooks.on_iteration = [&](const IterationRecord& record) {
+    if (callbacks.on_iteration &&
+        !callbacks.on_iteration(record.seconds, schedule->CurrentStage())) {
+      *interrupted = true;
+      return false;
+    }
+    if (budget > 0.0 && record.seconds >= budget) {
+      budget_spent = true;
+      return false;
+    }
+    return true;
+  };
+  SFT_RETURN_IF_ERROR(schedule->Run(hooks));
+  if (*interrupted) return Status::Ok();
+  const ScheduleProgress& p = schedule->progress();
+  (*line)["seconds"] = p.seconds;
+  (*line)["ended_by"] = budget_spent ? "time_budget" : "iterations";
+  (*line)["outer_iterations"] = p.outer_done;
+  (*line)["iterations"] = schedule->records().size();
+  return Status::Ok();
+}
+
+}  // namespace
+
+Status LoadSweepContext(const SweepGrid& grid, SweepContext* context) {
+  context->grid = &grid;
+  if (!grid.reference.empty()) SFT_RETURN_IF_ERROR(ReadMesh(grid.reference, &context->reference));
+  SFT_RETURN_IF_ERROR(ReadDataset(grid.dataset, &context->dataset));
+  SFT_RETURN_IF_ERROR(CheckViewsHaveLights(context->dataset));
+  SFT_RETURN_IF_ERROR(ChooseStart(context->dataset, grid.init, &context->start));
+  ScheduleConfig config;
+  SFT_RETURN_IF_ERROR(BaseConfig(grid, &config));
+  std::vector<StageOptions> stages;
+  SFT_RETURN_IF_ERROR(
+      ResolveStages(config, context->start.kind == StartKind::kCarved, &stages).Prefixed("config"));
+  context->default_stages =
+      NormalizedStages(stages, static_cast<int>(context->dataset.views.size()));
+  SFT_RETURN_IF_ERROR(LoadStartMesh(context->dataset, context->start, InitialMeshOptions(),
+                                    &context->start_state.mesh));
+  return LoadMaterial(grid.material.empty() ? kInitialMaterial : grid.material,
+                      context->start_state.mesh, &context->start_state.material);
+}
+
+Status CellStages(const SweepContext& context, const SweepCell& cell,
+                  std::vector<StageOptions>* stages) {
+  ScheduleConfig config;
+  SFT_RETURN_IF_ERROR(BaseConfig(*context.grid, &config));
+  SFT_RETURN_IF_ERROR(MergeScheduleConfig(cell.config, "axes", &config));
+  if (cell.views > 0) {
+    std::vector<int> views;
+    SFT_RETURN_IF_ERROR(
+        EvenlySpacedViews(cell.views, static_cast<int>(context.dataset.views.size()), &views));
+    SFT_RETURN_IF_ERROR(MergeScheduleConfig({{"views", views}}, "axes", &config));
+  }
+  return ResolveStages(config, context.start.kind == StartKind::kCarved, stages);
+}
+
+bool IsDefaultStages(const SweepContext& context, const std::vector<StageOptions>& stages) {
+  return NormalizedStages(stages, static_cast<int>(context.dataset.views.size())) ==
+         context.default_stages;
+}
+
+Status RunCell(const SweepContext& context, const SweepCell& cell, const std::string& dir,
+               const CellCallbacks& callbacks, json* line, bool* interrupted) {
+  *interrupted = false;
+  *line = {{"id", cell.id}, {"index", cell.index}, {"settings", cell.settings}};
+  auto fail = [&](const Status& status) {
+    (*line)["status"] = "error";
+    (*line)["error"] = status.message();
+    return Status::Ok();
+  };
+  std::vector<StageOptions> stages;
+  Status status = CellStages(context, cell, &stages);
+  if (!status.ok()) return fail(status);
+  (*line)["default"] = IsDefaultStages(context, stages);
+  status = Reconstruct(context, stages, dir, callbacks, line, interrupted);
+  if (*interrupted) return Status::Ok();
+  if (!status.ok()) return fail(status);
+  std::vector<int> views;
+  status =
+      SelectViews(stages.back().fit.views, static_cast<int>(context.dataset.views.size()), &views);
+  if (!status.ok()) return fail(status);
+  (*line)["views"] = views.size();
+  const double start = NowSeconds();
+  status = ScoreCell(context, dir, views, line);
+  if (!status.ok()) return fail(status.Prefixed("scoring"));
+  (*line)["eval_seconds"] = NowSeconds() - start;
+  (*line)["status"] = "ok";
+  return Status::Ok();
+}
+
+}  // namespace sft

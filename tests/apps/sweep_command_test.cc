@@ -1,0 +1,205 @@
+// `sft sweep` end to end on a tiny synthesized dataset: cells run and scored, an error cell
+// recorded, the default configuration marked, the report written; a sweep interrupted (SIGINT)
+// and then killed (SIGKILL) continues without redoing a finished cell; bad grids and folders
+// are one-line errors that write nothing.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "tests/testing/synth_dataset.h"
+#include "tests/testing/temp_dir.h"
+
+namespace sft {
+namespace {
+
+using json = nlohmann::json;
+using testing::CountLines;
+using ::testing::HasSubstr;
+using testing::RunSft;
+using ::testing::StartsWith;
+namespace fs = std::filesystem;
+
+std::vector<std::string> ReadLines(const std::string& path) {
+  std::istringstream in(testing::ReadTestFile(path));
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  return lines;
+}
+
+// Starts the sweep in the background, waits (at most 120 s) until sweep.jsonl has `lines` lines,
+// sends `signal` and prints the sweep's exit status last.
+std::string StopAfter(const std::string& sweep, const std::string& jsonl, int lines,
+                      const std::string& signal) {
+  const std::string script = sweep + " & pid=$!; for i in $(seq 2400); do [ -f " + jsonl +
+                             " ] && [ $(wc -l < " + jsonl + ") -ge " + std::to_string(lines) +
+                             " ] && break; sleep 0.05; done; kill -" + signal +
+                             " $pid; wait $pid; echo \"exit=$?\"";
+  std::string out;
+  testing::RunCommand("bash -c '" + script + "'", &out);
+  return out;
+}
+
+class SweepCommandTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    ASSERT_EQ(testing::SynthIcosphere(tmp_.Join("ds"),
+                                      "--cameras 4 --zooms 1 --res 16 --spp 16 --bounces 1"),
+              "");
+    std::string out;
+    ASSERT_EQ(RunSft("perturb --mesh " + tmp_.Join("ds/gt/mesh.ply") + " --out " +
+                         tmp_.Join("init.ply") + " --amplitude 0.02 --seed 2",
+                     &out),
+              0)
+        << out;
+  }
+  testing::TempDir tmp_;
+};
+
+// Six cells: three real ones of 1 s each (a time budget) and three that the configuration
+// rejects ("auto" bounces). Run 1 is interrupted after the first finished cell, run 2 killed
+// after the second; run 3 finishes. Every finished cell's line stays as it was, and every cell
+// is recorded once.
+TEST_F(SweepCommandTest, InterruptedAndKilledSweepsContinue) {
+  testing::WriteTestFile(tmp_.Join("grid.json"), R"({
+    "dataset": "ds", "init": "init.ply", "reference": "ds/gt/mesh.ply",
+    "time_budget": 1, "config": {"steps": 2, "phases": "geometry"},
+    "eval": {"spp": 4, "bounces": 1, "mesh_samples": 2000},
+    "axes": {"spp": [4, 8, 16], "bounces": [2, "auto"]}})");
+  const std::string jsonl = tmp_.Join("out/sweep.jsonl");
+  const std::string sweep = testing::SftBinary() + " sweep --quiet --grid " +
+                            tmp_.Join("grid.json") + " --out " + tmp_.Join("out");
+  std::string out = StopAfter(sweep, jsonl, 1, "INT");
+  EXPECT_THAT(out, HasSubstr("exit=130")) << out;
+  EXPECT_THAT(out, HasSubstr("run the same command again"));
+  const std::vector<std::string> first = ReadLines(jsonl);
+  ASSERT_GE(first.size(), 1u);
+  ASSERT_LT(first.size(), 6u);
+
+  out = StopAfter(sweep, jsonl, static_cast<int>(first.size()) + 1, "KILL");
+  EXPECT_THAT(out, HasSubstr("exit=137")) << out;
+  const std::vector<std::string> second = ReadLines(jsonl);
+  ASSERT_GT(second.size(), first.size());
+  ASSERT_LT(second.size(), 6u);
+  EXPECT_TRUE(std::equal(first.begin(), first.end(), second.begin()));
+
+  ASSERT_EQ(testing::RunCommand(sweep, &out), 0) << out;
+  EXPECT_THAT(out, HasSubstr("6 cells (" + std::to_string(6 - second.size()) + " run now, " +
+                             std::to_string(second.size()) + " before; 3 errors)"));
+  const std::vector<std::string> third = ReadLines(jsonl);
+  ASSERT_EQ(third.size(), 6u);
+  EXPECT_TRUE(std::equal(second.begin(), second.end(), third.begin()));
+  std::map<std::string, json> cells;
+  for (const std::string& text : third) {
+    const json line = json::parse(text);
+    EXPECT_TRUE(cells.emplace(line["id"].get<std::string>(), line).second) << text;
+  }
+  ASSERT_EQ(cells.size(), 6u);
+  // Cells 0-2: bounces 2 and spp 4, 8, 16, each ended by the budget and scored.
+  const json& ok = cells.at("00_bounces2_spp4");
+  EXPECT_EQ(ok["status"], "ok");
+  EXPECT_EQ(ok["ended_by"], "time_budget");
+  EXPECT_GE(ok["seconds"].get<double>(), 1.0);
+  EXPECT_GT(ok["f1"].get<double>(), 0.0);
+  EXPECT_GT(ok["full"]["psnr_srgb"].get<double>(), 10.0);
+  EXPECT_TRUE(ok["albedo"]["ssim_srgb"].is_number());
+  EXPECT_EQ(ok["views"], 4);
+  EXPECT_FALSE(ok["default"].get<bool>());
+  // spp 16 and bounces 2 are the configuration's own values: the default cell.
+  EXPECT_TRUE(cells.at("02_bounces2_spp16")["default"].get<bool>());
+  const json& error = cells.at("04_bouncesauto_spp8");
+  EXPECT_EQ(error["status"], "error");
+  EXPECT_THAT(error["error"].get<std::string>(), HasSubstr("bounces: expected an integer"));
+  EXPECT_TRUE(fs::exists(tmp_.Join("out/cells/02_bounces2_spp16/eval.json")));
+  EXPECT_TRUE(fs::exists(tmp_.Join("out/cells/02_bounces2_spp16/mesh.ply")));
+  const std::string report = testing::ReadTestFile(tmp_.Join("out/report.html"));
+  EXPECT_THAT(report, HasSubstr("Pareto front"));
+  EXPECT_THAT(report, HasSubstr("default: 02_bounces2_spp16"));
+
+  // A finished sweep run again does nothing; another grid in the same folder is refused.
+  ASSERT_EQ(testing::RunCommand(sweep, &out), 0) << out;
+  EXPECT_THAT(out, HasSubstr("0 run now, 6 before"));
+  EXPECT_EQ(ReadLines(jsonl), third);
+  EXPECT_NE(testing::RunCommand(sweep + " --time-budget 2", &out), 0);
+  EXPECT_THAT(out, HasSubstr("holds a sweep of another grid"));
+  EXPECT_THAT(out, HasSubstr("\"time_budget\""));
+}
+
+// Views counts become evenly spaced view indices; more views than the dataset has is the cell's
+// error. Outer iterations instead of a budget end the cells.
+TEST_F(SweepCommandTest, ViewsAxisAndOuterIterations) {
+  testing::WriteTestFile(tmp_.Join("grid.json"), R"({
+    "dataset": "ds", "init": "init.ply", "outer_iterations": 1,
+    "config": {"steps": 1, "spp": 2, "phases": "texture"},
+    "eval": {"spp": 2, "bounces": 1},
+    "axes": {"views": [2, 9]}})");
+  std::string out;
+  ASSERT_EQ(
+      RunSft("sweep --quiet --grid " + tmp_.Join("grid.json") + " --out " + tmp_.Join("o"), &out),
+      0)
+      << out;
+  const std::vector<std::string> lines = ReadLines(tmp_.Join("o/sweep.jsonl"));
+  ASSERT_EQ(lines.size(), 2u);
+  const json two = json::parse(lines[0]), nine = json::parse(lines[1]);
+  EXPECT_EQ(two["status"], "ok");
+  EXPECT_EQ(two["ended_by"], "iterations");
+  EXPECT_EQ(two["outer_iterations"], 1);
+  EXPECT_EQ(two["views"], 2);
+  EXPECT_TRUE(two["f1"].is_null());  // no reference mesh.
+  // Views 0 and 2 of 4 were fitted and scored.
+  EXPECT_EQ(two["id"], "00_views2");
+  const json state = json::parse(testing::ReadTestFile(tmp_.Join("o/cells/00_views2/state.json")));
+  EXPECT_EQ(state["stages"][0]["views"], json::parse("[0, 2]"));
+  const json eval = json::parse(testing::ReadTestFile(tmp_.Join("o/cells/00_views2/eval.json")));
+  EXPECT_EQ(eval["views"], json::parse("[0, 2]"));
+  EXPECT_EQ(nine["status"], "error");
+  EXPECT_THAT(nine["error"].get<std::string>(), HasSubstr("9 views asked, the dataset has 4"));
+}
+
+TEST_F(SweepCommandTest, BadInputsAreOneLineAndWriteNothing) {
+  testing::WriteTestFile(tmp_.Join("bad.json"), R"({"dataset": "ds", "axes": {"spp": []}})");
+  testing::WriteTestFile(tmp_.Join("good.json"), R"({"dataset": "ds", "init": "init.ply"})");
+  fs::create_directories(tmp_.Join("full"));
+  testing::WriteTestFile(tmp_.Join("full/x.txt"), "something else");
+  const struct {
+    std::string args;
+    std::string expected;
+  } cases[] = {
+      {"sweep --grid " + tmp_.Join("bad.json") + " --out " + tmp_.Join("o"), "axes.spp"},
+      {"sweep --grid " + tmp_.Join("missing.json") + " --out " + tmp_.Join("o"), "missing.json"},
+      {"sweep --out " + tmp_.Join("o"), "--grid"},
+      {"sweep --preset ablations --out " + tmp_.Join("o"), "dataset: missing"},
+      {"sweep --preset nope --out " + tmp_.Join("o"), "--preset"},
+      {"sweep --grid " + tmp_.Join("good.json"), "--out"},
+      {"sweep --grid " + tmp_.Join("good.json") + " --time-budget -1 --out " + tmp_.Join("o"),
+       "--time-budget"},
+      {"sweep --grid " + tmp_.Join("good.json") + " --reference " + tmp_.Join("nope.ply") +
+           " --out " + tmp_.Join("o"),
+       "nope.ply"},
+      {"sweep --grid " + tmp_.Join("good.json") + " --out " + tmp_.Join("ds/sub"), "--out"},
+      {"sweep --grid " + tmp_.Join("good.json") + " --out " + tmp_.Join("full"), "holds no sweep"},
+  };
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.args);
+    std::string out;
+    EXPECT_EQ(RunSft(c.args, &out), 1);
+    EXPECT_EQ(CountLines(out), 1) << out;
+    EXPECT_THAT(out, StartsWith("sft sweep: error: "));
+    EXPECT_THAT(out, HasSubstr(c.expected));
+  }
+  EXPECT_FALSE(fs::exists(tmp_.Join("o")));
+  EXPECT_FALSE(fs::exists(tmp_.Join("ds/sub")));
+  // --print-cells lists the preset's 24 cells and writes nothing.
+  std::string out;
+  ASSERT_EQ(
+      RunSft("sweep --preset ablations --dataset " + tmp_.Join("ds") + " --print-cells", &out), 0)
+      << out;
+  EXPECT_EQ(CountLines(out), 24);
+  EXPECT_THAT(out, HasSubstr("00_local_geometry_views8 "));
+}
+
+}  // namespace
+}  // namespace sft
