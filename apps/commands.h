@@ -49,6 +49,9 @@ CommandRunner SetupPerturbCommand(CLI::App* app);
 CommandRunner SetupEvalCommand(CLI::App* app);
 CommandRunner SetupCompareCommand(CLI::App* app);
 CommandRunner SetupImportCommand(CLI::App* app);
+// Adds `sft import nerf`, `idr` and `middlebury` under `import`; its runner returns -1 when none of
+// them was the one parsed.
+CommandRunner AddCalibratedImportCommands(CLI::App* import);
 CommandRunner SetupAlignProbeCommand(CLI::App* app);
 CommandRunner SetupInitCommand(CLI::App* app);
 CommandRunner SetupExportCommand(CLI::App* app);

@@ -1,6 +1,7 @@
 // sft import: brings captures into the sft-dataset/1 format. `sft import colmap` converts a COLMAP
 // sparse model and its images (src/io/colmap_import.h); `sft import video` selects frames of a
-// video and runs COLMAP on them first (src/io/video_import.h). Decisions in docs/import.md.
+// video and runs COLMAP on them first (src/io/video_import.h); `nerf`, `idr` and `middlebury` are
+// in import_calibrated_command.cc. Decisions in docs/import.md.
 #include <cstdio>
 #include <memory>
 
@@ -152,10 +153,12 @@ CommandRunner SetupImportCommand(CLI::App* app) {
       "video", "Select frames of a video, run COLMAP (CPU) on them and import the result");
   auto video_opts = std::make_shared<VideoImportOptions>();
   SetupImportVideo(video, video_opts.get());
-  return [opts, colmap, video_opts, video]() {
+  CommandRunner calibrated = AddCalibratedImportCommands(app);
+  return [opts, colmap, video_opts, video, calibrated]() {
     if (colmap->parsed()) return RunImportColmap(*opts);
     if (video->parsed()) return RunImportVideo(*video_opts);
-    return 2;
+    const int code = calibrated();
+    return code >= 0 ? code : 2;
   };
 }
 

@@ -192,7 +192,9 @@ Status RunRender(const RenderCommandOptions& opts) {
       opts.out, {{opts.dataset}, {opts.mesh, MaterialFile(opts.material), opts.lights}}, "--out"));
   Dataset dataset;
   SFT_RETURN_IF_ERROR(ReadDataset(opts.dataset, &dataset));
-  SFT_RETURN_IF_ERROR(CheckViewsHaveLights(dataset));
+  // Only the colour pass is lit; albedo, roughness, normal and depth are first-hit passes that
+  // need no light, so they also render datasets with unknown lighting (empty `lights`).
+  if (render.pass == RenderPass::kColor) SFT_RETURN_IF_ERROR(CheckViewsHaveLights(dataset));
   if (!opts.lights.empty()) {
     std::vector<double> scales;
     SFT_RETURN_IF_ERROR(ReadLightScales(opts.lights, dataset, &scales));

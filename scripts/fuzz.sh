@@ -26,7 +26,8 @@ while [[ $# -gt 0 ]]; do
 done
 all=(colmap_text_fuzzer colmap_binary_fuzzer point_cloud_ply_fuzzer mesh_obj_fuzzer
      mesh_ply_fuzzer mesh_off_fuzzer material_json_fuzzer mesh_colors_fuzzer scene_json_fuzzer
-     exr_fuzzer png_fuzzer)
+     exr_fuzzer png_fuzzer nerf_transforms_fuzzer middlebury_par_fuzzer npy_fuzzer
+     npz_fuzzer)
 if [[ ${#targets[@]} -eq 0 ]]; then targets=("${all[@]}"); fi
 [[ "$build_dir" = /* ]] || build_dir="$root/$build_dir"
 
@@ -54,6 +55,11 @@ seeds_for() {
     scene_json_fuzzer) echo data/cycles/*/scene.json ;;
     exr_fuzzer) echo data/cycles/bunny_point_ggx_gi/gt/roughness/001.exr \
                      data/cycles/sphere_env_studio/gt/albedo/006.exr ;;
+    nerf_transforms_fuzzer) echo fuzz/seeds/nerf_transforms ;;
+    middlebury_par_fuzzer) echo fuzz/seeds/middlebury_par ;;
+    # Binary seeds are generated (scripts/npz_fuzz_seeds.py), not checked in.
+    npy_fuzzer) echo "$build_dir/fuzz-seeds/npy" ;;
+    npz_fuzzer) echo "$build_dir/fuzz-seeds/npz" ;;
     png_fuzzer) echo data/cycles/sphere_env_studio/masks/006.png \
                      data/cycles/bunny_point_diffuse/masks/000.png ;;
     *) echo "unknown fuzz target $1" >&2; return 1 ;;
@@ -61,6 +67,7 @@ seeds_for() {
 }
 
 mkdir -p "$build_dir/fuzz-artifacts" "$build_dir/fuzz-logs"
+python3 scripts/npz_fuzz_seeds.py "$build_dir/fuzz-seeds"
 failed=0
 for t in "${targets[@]}"; do
   bin="$build_dir/fuzz/$t"

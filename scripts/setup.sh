@@ -21,8 +21,8 @@ PACKAGES=(
   colmap libopenvdb-dev libcgal-dev
   # clang and its runtime (libFuzzer, sanitizers) for the fuzz targets
   clang libclang-rt-14-dev
-  # CLI, JSON
-  libcli11-dev nlohmann-json3-dev
+  # CLI, JSON, zip archives (NumPy .npz camera files of sft import idr)
+  libcli11-dev nlohmann-json3-dev libzip-dev
   # glTF 2.0 writer (sft export)
   libtinygltf-dev
   # tests and benchmarks

@@ -16,59 +16,13 @@
 #include "src/io/colmap_model.h"
 #include "src/io/dataset.h"
 #include "src/io/image_io.h"
+#include "src/io/import_files.h"
 #include "src/io/point_cloud_ply.h"
 #include "src/io/probe_alignment.h"
 
 namespace sft {
 namespace {
 namespace fs = std::filesystem;
-
-// Decodes an image with OpenCV as stored (no EXIF rotation: COLMAP's cameras describe the pixels
-// as stored). Error names the file.
-Status DecodeImage(const std::string& path, int flags, cv::Mat* mat) {
-  if (!FileExists(path)) return Status::Error(path + ": file not found");
-  try {
-    *mat = cv::imread(path, flags);
-  } catch (const cv::Exception& e) {
-    return Status::Error(path + ": cannot decode image (" + e.msg + ")");
-  }
-  if (mat->empty()) return Status::Error(path + ": cannot decode image");
-  return Status::Ok();
-}
-
-Status WritePngMat(const std::string& path, const cv::Mat& mat) {
-  return WriteAtomically(path, [&mat](const std::string& tmp) {
-    try {
-      if (cv::imwrite(tmp, mat)) return Status::Ok();
-    } catch (const cv::Exception& e) {
-      return Status::Error(tmp + ": cannot write PNG (" + e.msg + ")");
-    }
-    return Status::Error(tmp + ": cannot write PNG");
-  });
-}
-
-Status CopyFile(const std::string& from, const std::string& to) {
-  return WriteAtomically(to, [&from](const std::string& tmp) {
-    std::error_code ec;
-    fs::copy_file(from, tmp, fs::copy_options::overwrite_existing, ec);
-    if (ec) return Status::Error(from + ": cannot copy (" + ec.message() + ")");
-    return Status::Ok();
-  });
-}
-
-std::string FormatName(const std::string& ext) {
-  if (ext == "jpg" || ext == "jpeg") return "JPEG";
-  if (ext == "tif" || ext == "tiff") return "TIFF";
-  if (ext == "webp") return "WebP";
-  std::string upper = ext;
-  for (char& c : upper) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
-  return upper;
-}
-
-std::string WithoutExtension(const std::string& path) {
-  const fs::path p(path);
-  return (p.parent_path() / p.stem()).generic_string();
-}
 
 // Camera "c<ID>" for every COLMAP camera that a registered image uses.
 Status ConvertCameras(const ColmapModel& model, Dataset* dataset,
@@ -105,50 +59,22 @@ Status ConvertCameras(const ColmapModel& model, Dataset* dataset,
 // Copies or converts one image into `root`/`out_name`; `*encoding` describes the source.
 Status ImportImage(const std::string& source, const Camera& camera, const std::string& root,
                    const std::string& out_name, std::string* encoding) {
-  const std::string ext = FileExtension(source);
   cv::Mat mat;
-  SFT_RETURN_IF_ERROR(DecodeImage(source, cv::IMREAD_UNCHANGED, &mat));
+  SFT_RETURN_IF_ERROR(ReadImageAsStored(source, cv::IMREAD_UNCHANGED, &mat));
   if (mat.cols != camera.width || mat.rows != camera.height) {
     return Status::Error(source + ": image is " + std::to_string(mat.cols) + "x" +
                          std::to_string(mat.rows) + " but its camera " + camera.id + " is " +
                          std::to_string(camera.width) + "x" + std::to_string(camera.height));
   }
-  const int depth = mat.depth();
-  const std::string bits = depth == CV_16U ? "16-bit" : "8-bit";
-  if (ext == "exr") {
-    *encoding = "linear EXR";
-    return CopyFile(source, JoinPath(root, out_name));
-  }
-  if (depth != CV_8U && depth != CV_16U) {
-    return Status::Error(source + ": only 8- and 16-bit images (or EXR) can be imported");
-  }
-  if (ext == "png") {
-    *encoding = "sRGB " + bits + " PNG";
-    return CopyFile(source, JoinPath(root, out_name));
-  }
-  *encoding = "sRGB " + bits + " " + FormatName(ext) + " converted to PNG";
-  return WritePngMat(JoinPath(root, out_name), mat);
+  return StoreImportedImage(source, mat, root, out_name, encoding);
 }
 
-// Reads the mask of image `name`: MASKS/NAME.png, else MASKS/STEM.png; writes it to
-// `root`/`out_name` as 8-bit 0/255 and returns its bits.
+// Reads the mask of image `name` (FindMaskFile); writes it to `root`/`out_name` as 8-bit 0/255
+// and returns its bits.
 Status ImportMask(const std::string& masks, const std::string& name, const Camera& camera,
                   const std::string& root, const std::string& out_name, MaskBits* bits) {
-  std::string path = JoinPath(masks, name + ".png");
-  if (!FileExists(path)) path = JoinPath(masks, WithoutExtension(name) + ".png");
-  if (!FileExists(path)) {
-    return Status::Error(JoinPath(masks, name + ".png") + ": mask of image " + name +
-                         " not found (nor " + path + ")");
-  }
-  cv::Mat mat;
-  SFT_RETURN_IF_ERROR(DecodeImage(path, cv::IMREAD_GRAYSCALE, &mat));
-  if (mat.cols != camera.width || mat.rows != camera.height) {
-    return Status::Error(path + ": mask is " + std::to_string(mat.cols) + "x" +
-                         std::to_string(mat.rows) + " but image " + name + " is " +
-                         std::to_string(camera.width) + "x" + std::to_string(camera.height));
-  }
   cv::Mat binary;
-  cv::threshold(mat, binary, 127, 255, cv::THRESH_BINARY);  // > 127 = object (docs/dataset.md).
+  SFT_RETURN_IF_ERROR(ReadMaskFile(masks, name, camera.width, camera.height, &binary));
   bits->width = binary.cols;
   bits->height = binary.rows;
   bits->inside.assign(binary.datastart, binary.dataend);
@@ -166,7 +92,7 @@ Status LoadProbeImage(const std::string& path, Image* rgb) {
     return Status::Ok();
   }
   cv::Mat mat;
-  SFT_RETURN_IF_ERROR(DecodeImage(path, cv::IMREAD_ANYDEPTH | cv::IMREAD_COLOR, &mat));
+  SFT_RETURN_IF_ERROR(ReadImageAsStored(path, cv::IMREAD_ANYDEPTH | cv::IMREAD_COLOR, &mat));
   const int depth = mat.depth();
   if (depth != CV_8U && depth != CV_16U && depth != CV_32F) {
     return Status::Error(path + ": unsupported probe pixel type");
@@ -455,24 +381,9 @@ Status ImportColmap(const ColmapImportOptions& opts, ColmapImportReport* report)
   if (opts.import_dense) FindDense(opts.model, &dense_mesh, &dense_points);
   const RunInputs inputs{{opts.model, opts.images, opts.HasMaskFolder() ? opts.masks : ""},
                          {opts.probe, dense_mesh, dense_points}};
-  SFT_RETURN_IF_ERROR(CheckOutputDirectory(opts.out, inputs, "--out"));
-  const std::string partial = opts.out + ".partial";
-  SFT_RETURN_IF_ERROR(CheckOutputDirectory(partial, inputs, "--out (OUT.partial)"));
-  if (fs::exists(opts.out, ec) && !fs::is_empty(opts.out, ec) && !opts.overwrite) {
-    return Status::Error(opts.out + ": output exists and is not empty (use --overwrite)");
-  }
-  fs::remove_all(partial, ec);
-  SFT_RETURN_IF_ERROR(MakeDirectories(partial));
-  Status status = ImportInto(opts, partial, report);
-  if (status.ok()) {
-    if (fs::exists(opts.out, ec)) fs::remove_all(opts.out, ec);
-    fs::rename(partial, opts.out, ec);
-    if (ec) {
-      status = Status::Error(opts.out + ": cannot move the finished dataset in place (" +
-                             ec.message() + ")");
-    }
-  }
-  if (!status.ok()) fs::remove_all(partial, ec);
+  const Status status = BuildDatasetFolder(
+      opts.out, inputs, opts.overwrite,
+      [&](const std::string& partial) { return ImportInto(opts, partial, report); });
   report->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return status;
 }

@@ -24,6 +24,12 @@ TempDir::~TempDir() {
 }
 
 std::string DataDir() { return SFT_DATA_DIR; }
+
+std::string SharedDataDir() {
+  const std::string dir = std::string(SFT_DATA_DIR) + "/../../shared/data";
+  std::error_code ec;
+  return std::filesystem::is_directory(dir, ec) ? dir : "";
+}
 std::string SftBinary() { return SFT_BINARY; }
 
 void WriteTestFile(const std::string& path, const std::string& contents) {

@@ -24,6 +24,9 @@ class TempDir {
 
 // The source tree's data/ directory (fixtures, Cycles reference datasets).
 std::string DataDir();
+// The project's shared data folder (../shared/data beside the repository: real captures and
+// other data that may not be copied into it), or "" when it is absent; tests that need it skip.
+std::string SharedDataDir();
 // Absolute path of the built `sft` executable (for CLI tests).
 std::string SftBinary();
 // The whole file at `path` as is (binary); "" when it cannot be read.
