@@ -73,6 +73,51 @@ json AtlasJson(const UvAtlasReport& r, const BakeReport& b, int texture_size) {
           {"dilation_rings", b.dilation_rings}};
 }
 
+// The atlas, the bake and the textured formats (OBJ and/or glTF); adds the atlas's numbers to
+// *summary and the written files to *files. `dataset` may be null.
+Status WriteTexturedFormats(const ExportOptions& options, const TriMesh& mesh,
+                            const std::vector<Eigen::Vector3d>& world,
+                            const std::vector<Eigen::Vector3i>& faces,
+                            const std::vector<Eigen::Vector3d>& positions, const Material& material,
+                            const Dataset* dataset, bool obj, bool gltf, json* summary,
+                            json* files) {
+  UvAtlasOptions atlas_options = options.atlas;
+  std::string texture_from = "--texture-size";
+  atlas_options.texture_size = options.texture_size;
+  if (options.texture_size == 0) {
+    Eigen::Vector3d lo, hi;
+    MeshBounds(mesh, &lo, &hi);
+    atlas_options.texture_size =
+        dataset != nullptr ? TextureSizeFromFootprint(*dataset, 0.5 * (lo + hi), SurfaceArea(mesh))
+                           : kDefaultTextureSize;
+    texture_from = dataset != nullptr ? "pixel footprint" : "default";
+  }
+  UvAtlas atlas;
+  UvAtlasReport atlas_report;
+  SFT_RETURN_IF_ERROR(BuildUvAtlas(world, faces, atlas_options, &atlas, &atlas_report)
+                          .Prefixed(JoinPath(options.reconstruction, "mesh.ply")));
+  BakedMaterial baked;
+  BakeReport bake_report;
+  SFT_RETURN_IF_ERROR(BakeMaterial(atlas, material, &baked, &bake_report)
+                          .Prefixed(JoinPath(options.reconstruction, "material.json")));
+  (*summary)["atlas"] = AtlasJson(atlas_report, bake_report, atlas.texture_size);
+  (*summary)["atlas"]["texture_size_from"] = texture_from;
+  if (obj) {
+    SFT_RETURN_IF_ERROR(WriteObjExport(options.out, positions, faces, atlas, baked, material));
+    files->insert(files->end(), {kObjFile, kMtlFile, kAlbedoPngFile, kRoughnessPngFile});
+  }
+  if (gltf) {
+    std::vector<Eigen::Vector3d> y_up(positions.size());
+    for (size_t v = 0; v < positions.size(); ++v) {
+      y_up[v] = Eigen::Vector3d(positions[v].x(), positions[v].z(), -positions[v].y());
+    }
+    SFT_RETURN_IF_ERROR(
+        WriteGlbExport(JoinPath(options.out, kGlbFile), y_up, faces, atlas, baked, material));
+    files->push_back(kGlbFile);
+  }
+  return Status::Ok();
+}
+
 }  // namespace
 
 bool ExportOptions::Check(std::string* why) const {
@@ -155,40 +200,9 @@ Status ExportReconstruction(const ExportOptions& options, json* summary) {
   SFT_RETURN_IF_ERROR(MakeDirectories(options.out));
 
   if (obj || gltf) {
-    UvAtlasOptions atlas_options = options.atlas;
-    std::string texture_from = "--texture-size";
-    atlas_options.texture_size = options.texture_size;
-    if (options.texture_size == 0) {
-      Eigen::Vector3d lo, hi;
-      MeshBounds(mesh, &lo, &hi);
-      atlas_options.texture_size =
-          have_dataset ? TextureSizeFromFootprint(dataset, 0.5 * (lo + hi), SurfaceArea(mesh))
-                       : kDefaultTextureSize;
-      texture_from = have_dataset ? "pixel footprint" : "default";
-    }
-    UvAtlas atlas;
-    UvAtlasReport atlas_report;
-    SFT_RETURN_IF_ERROR(BuildUvAtlas(world, faces, atlas_options, &atlas, &atlas_report)
-                            .Prefixed(JoinPath(options.reconstruction, "mesh.ply")));
-    BakedMaterial baked;
-    BakeReport bake_report;
-    SFT_RETURN_IF_ERROR(BakeMaterial(atlas, material, &baked, &bake_report)
-                            .Prefixed(JoinPath(options.reconstruction, "material.json")));
-    (*summary)["atlas"] = AtlasJson(atlas_report, bake_report, atlas.texture_size);
-    (*summary)["atlas"]["texture_size_from"] = texture_from;
-    if (obj) {
-      SFT_RETURN_IF_ERROR(WriteObjExport(options.out, positions, faces, atlas, baked, material));
-      files.insert(files.end(), {kObjFile, kMtlFile, kAlbedoPngFile, kRoughnessPngFile});
-    }
-    if (gltf) {
-      std::vector<Eigen::Vector3d> y_up(positions.size());
-      for (size_t v = 0; v < positions.size(); ++v) {
-        y_up[v] = Eigen::Vector3d(positions[v].x(), positions[v].z(), -positions[v].y());
-      }
-      SFT_RETURN_IF_ERROR(
-          WriteGlbExport(JoinPath(options.out, kGlbFile), y_up, faces, atlas, baked, material));
-      files.push_back(kGlbFile);
-    }
+    SFT_RETURN_IF_ERROR(WriteTexturedFormats(options, mesh, world, faces, positions, material,
+                                             have_dataset ? &dataset : nullptr, obj, gltf, summary,
+                                             &files));
   }
   if (ply) {
     SFT_RETURN_IF_ERROR(

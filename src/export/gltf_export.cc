@@ -75,20 +75,11 @@ tinygltf::Material MakeMaterial(int base_color, int metallic_roughness, const Ma
   return material;
 }
 
-}  // namespace
-
-Status WriteGlbExport(const std::string& path, const std::vector<Eigen::Vector3d>& positions,
-                      const std::vector<Eigen::Vector3i>& faces, const UvAtlas& atlas,
-                      const BakedMaterial& baked, const Material& material) {
-  std::string albedo_png, roughness_png;
-  SFT_RETURN_IF_ERROR(EncodePng(baked.albedo, /*srgb=*/true, &albedo_png).Prefixed(path));
-  // glTF's metallicRoughness texture: G = roughness, B = metallic (0); R is unused (0).
-  Image metal_rough(baked.roughness.width, baked.roughness.height, 3, 0.0f);
-  for (int y = 0; y < metal_rough.height; ++y) {
-    for (int x = 0; x < metal_rough.width; ++x) metal_rough.at(x, y, 1) = baked.roughness.at(x, y);
-  }
-  SFT_RETURN_IF_ERROR(EncodePng(metal_rough, /*srgb=*/false, &roughness_png).Prefixed(path));
-
+// Seam-split positions, texture coordinates and indices as buffer views and accessors; returns
+// the triangle primitive over them (material 0).
+tinygltf::Primitive AddGeometry(const std::vector<Eigen::Vector3d>& positions,
+                                const std::vector<Eigen::Vector3i>& faces, const UvAtlas& atlas,
+                                tinygltf::Model* model) {
   const SeamSplitMesh split = SplitAtSeams(faces, atlas);
   std::vector<float> xyz, uv;
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = -lo;
@@ -105,26 +96,50 @@ Status WriteGlbExport(const std::string& path, const std::vector<Eigen::Vector3d
     for (int k = 0; k < 3; ++k) indices.push_back(static_cast<uint32_t>(f[k]));
   }
 
+  const size_t n = split.source_vertex.size();
+  const int position_view =
+      AddBufferView(xyz.data(), xyz.size() * sizeof(float), TINYGLTF_TARGET_ARRAY_BUFFER, model);
+  const int uv_view =
+      AddBufferView(uv.data(), uv.size() * sizeof(float), TINYGLTF_TARGET_ARRAY_BUFFER, model);
+  const int index_view = AddBufferView(indices.data(), indices.size() * sizeof(uint32_t),
+                                       TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER, model);
+  const int position_accessor =
+      AddAccessor(position_view, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, n, model);
+  model->accessors[position_accessor].minValues = {lo.x(), lo.y(), lo.z()};
+  model->accessors[position_accessor].maxValues = {hi.x(), hi.y(), hi.z()};
+  const int uv_accessor =
+      AddAccessor(uv_view, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC2, n, model);
+  const int index_accessor = AddAccessor(index_view, TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT,
+                                         TINYGLTF_TYPE_SCALAR, indices.size(), model);
+
+  tinygltf::Primitive primitive;
+  primitive.attributes["POSITION"] = position_accessor;
+  primitive.attributes["TEXCOORD_0"] = uv_accessor;
+  primitive.indices = index_accessor;
+  primitive.material = 0;
+  primitive.mode = TINYGLTF_MODE_TRIANGLES;
+  return primitive;
+}
+
+}  // namespace
+
+Status WriteGlbExport(const std::string& path, const std::vector<Eigen::Vector3d>& positions,
+                      const std::vector<Eigen::Vector3i>& faces, const UvAtlas& atlas,
+                      const BakedMaterial& baked, const Material& material) {
+  std::string albedo_png, roughness_png;
+  SFT_RETURN_IF_ERROR(EncodePng(baked.albedo, /*srgb=*/true, &albedo_png).Prefixed(path));
+  // glTF's metallicRoughness texture: G = roughness, B = metallic (0); R is unused (0).
+  Image metal_rough(baked.roughness.width, baked.roughness.height, 3, 0.0f);
+  for (int y = 0; y < metal_rough.height; ++y) {
+    for (int x = 0; x < metal_rough.width; ++x) metal_rough.at(x, y, 1) = baked.roughness.at(x, y);
+  }
+  SFT_RETURN_IF_ERROR(EncodePng(metal_rough, /*srgb=*/false, &roughness_png).Prefixed(path));
+
   tinygltf::Model model;
   model.asset.version = "2.0";
   model.asset.generator = "sft export";
   model.buffers.resize(1);
-  const size_t n = split.source_vertex.size();
-  const int position_view =
-      AddBufferView(xyz.data(), xyz.size() * sizeof(float), TINYGLTF_TARGET_ARRAY_BUFFER, &model);
-  const int uv_view =
-      AddBufferView(uv.data(), uv.size() * sizeof(float), TINYGLTF_TARGET_ARRAY_BUFFER, &model);
-  const int index_view = AddBufferView(indices.data(), indices.size() * sizeof(uint32_t),
-                                       TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER, &model);
-  const int position_accessor =
-      AddAccessor(position_view, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, n, &model);
-  model.accessors[position_accessor].minValues = {lo.x(), lo.y(), lo.z()};
-  model.accessors[position_accessor].maxValues = {hi.x(), hi.y(), hi.z()};
-  const int uv_accessor =
-      AddAccessor(uv_view, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC2, n, &model);
-  const int index_accessor = AddAccessor(index_view, TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT,
-                                         TINYGLTF_TYPE_SCALAR, indices.size(), &model);
-
+  tinygltf::Primitive primitive = AddGeometry(positions, faces, atlas, &model);
   tinygltf::Sampler sampler;
   sampler.magFilter = TINYGLTF_TEXTURE_FILTER_LINEAR;
   sampler.minFilter = TINYGLTF_TEXTURE_FILTER_LINEAR_MIPMAP_LINEAR;
@@ -136,12 +151,6 @@ Status WriteGlbExport(const std::string& path, const std::vector<Eigen::Vector3d
   model.materials.push_back(MakeMaterial(base_color, metallic_roughness, material));
   model.extensionsUsed.push_back("KHR_materials_specular");
 
-  tinygltf::Primitive primitive;
-  primitive.attributes["POSITION"] = position_accessor;
-  primitive.attributes["TEXCOORD_0"] = uv_accessor;
-  primitive.indices = index_accessor;
-  primitive.material = 0;
-  primitive.mode = TINYGLTF_MODE_TRIANGLES;
   tinygltf::Mesh mesh;
   mesh.name = "sft_model";
   mesh.primitives.push_back(primitive);
