@@ -171,6 +171,10 @@ Status RunSweep(const SweepGrid& grid, const SweepRunOptions& options, SweepSumm
   Progress progress("sweep", std::max<int64_t>(1, total), options.progress);
   for (const SweepCell& cell : cells) {
     if (done.count(cell.id)) continue;
+    if (options.interrupted && options.interrupted()) {  // e.g. during the last cell's scoring.
+      summary->interrupted = true;
+      break;
+    }
     progress.SetDetail(cell.id);
     const std::string dir = JoinPath(JoinPath(options.out, "cells"), cell.id);
     std::error_code error;

@@ -1,7 +1,7 @@
 // `sft sweep` end to end on a tiny synthesized dataset: cells run and scored, an error cell
 // recorded, the default configuration marked, the report written; a sweep interrupted (SIGINT)
 // and then killed (SIGKILL) continues without redoing a finished cell; bad grids and folders
-// are one-line errors that write nothing.
+// are one-line errors that write nothing (grid errors in detail: tests/sweep/sweep_grid_test.cc).
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -59,14 +59,14 @@ class SweepCommandTest : public ::testing::Test {
   testing::TempDir tmp_;
 };
 
-// Six cells: three real ones of 1 s each (a time budget) and three that the configuration
+// Six cells: three real ones of 0.5 s each (a time budget) and three that the configuration
 // rejects ("auto" bounces). Run 1 is interrupted after the first finished cell, run 2 killed
 // after the second; run 3 finishes. Every finished cell's line stays as it was, and every cell
 // is recorded once.
 TEST_F(SweepCommandTest, InterruptedAndKilledSweepsContinue) {
   testing::WriteTestFile(tmp_.Join("grid.json"), R"({
     "dataset": "ds", "init": "init.ply", "reference": "ds/gt/mesh.ply",
-    "time_budget": 1, "config": {"steps": 2, "phases": "geometry"},
+    "time_budget": 0.5, "config": {"steps": 2, "phases": "geometry"},
     "eval": {"spp": 4, "bounces": 1, "mesh_samples": 2000},
     "axes": {"spp": [4, 8, 16], "bounces": [2, "auto"]}})");
   const std::string jsonl = tmp_.Join("out/sweep.jsonl");
@@ -102,7 +102,7 @@ TEST_F(SweepCommandTest, InterruptedAndKilledSweepsContinue) {
   const json& ok = cells.at("00_bounces2_spp4");
   EXPECT_EQ(ok["status"], "ok");
   EXPECT_EQ(ok["ended_by"], "time_budget");
-  EXPECT_GE(ok["seconds"].get<double>(), 1.0);
+  EXPECT_GE(ok["seconds"].get<double>(), 0.5);
   EXPECT_GT(ok["f1"].get<double>(), 0.0);
   EXPECT_GT(ok["full"]["psnr_srgb"].get<double>(), 10.0);
   EXPECT_TRUE(ok["albedo"]["ssim_srgb"].is_number());
@@ -169,10 +169,8 @@ TEST_F(SweepCommandTest, BadInputsAreOneLineAndWriteNothing) {
     std::string expected;
   } cases[] = {
       {"sweep --grid " + tmp_.Join("bad.json") + " --out " + tmp_.Join("o"), "axes.spp"},
-      {"sweep --grid " + tmp_.Join("missing.json") + " --out " + tmp_.Join("o"), "missing.json"},
       {"sweep --out " + tmp_.Join("o"), "--grid"},
       {"sweep --preset ablations --out " + tmp_.Join("o"), "dataset: missing"},
-      {"sweep --preset nope --out " + tmp_.Join("o"), "--preset"},
       {"sweep --grid " + tmp_.Join("good.json"), "--out"},
       {"sweep --grid " + tmp_.Join("good.json") + " --time-budget -1 --out " + tmp_.Join("o"),
        "--time-budget"},
