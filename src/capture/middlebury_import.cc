@@ -59,7 +59,7 @@ Status ImportMiddlebury(const MiddleburyImportOptions& opts, MiddleburyImportRep
   source.provenance = {{"par", opts.par},
                        {"entries", report->entries},
                        {"entries_without_image", report->missing_images}};
-  source.inputs = {{opts.images}, {opts.par}};
+  source.inputs = {{folder.empty() ? "." : folder}, {opts.par}};
   return ImportCalibratedViews(views, source, opts.import, &report->import);
 }
 

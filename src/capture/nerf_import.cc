@@ -71,7 +71,7 @@ Status ImportNerf(const NerfImportOptions& opts, NerfImportReport* report) {
   CalibratedSource source;
   source.format = "nerf";
   source.provenance = {{"transforms", opts.transforms}, {"frames", report->frames}};
-  source.inputs = {{}, {opts.transforms}};
+  source.inputs = {{folder}, {opts.transforms}};
   return ImportCalibratedViews(views, source, opts.import, &report->import);
 }
 
