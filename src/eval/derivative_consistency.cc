@@ -2,7 +2,6 @@
 
 #include <cmath>
 
-#include "src/io/scene_setup.h"
 #include "src/render/scene.h"
 
 namespace sft {
@@ -48,30 +47,19 @@ double NoiseToSignal(const std::vector<std::vector<double>>& images) {
 Status MeasureDerivativeConsistency(const Dataset& dataset, const TriMesh& mesh,
                                     const Material& material, const GradcheckOptions& options,
                                     int seeds, ConsistencyResult* result) {
-  std::string why;
-  if (!options.Check(&why)) return Status::Error(why);
   if (seeds < 2 || seeds > 64) return Status::Error("consistency seeds: must be in [2, 64]");
-  DerivativeRequest request = options.derivatives;
-  request.params = ParameterSelection::Only(options.kind);
-  request.jacobian_rows = true;
-  request.adjoint_weights = nullptr;
-  if (!request.Check(&why)) return Status::Error(why);
-  DatasetViews views;
-  SFT_RETURN_IF_ERROR(MakeDatasetViews(dataset, &views));
-  std::vector<int> selected;
-  SFT_RETURN_IF_ERROR(SelectViews(options.views, static_cast<int>(views.views.size()), &selected));
+  GradcheckSetup setup;
+  SFT_RETURN_IF_ERROR(PrepareGradcheck(dataset, options, &setup));
   const RenderScene scene(mesh);
   const int num_lights = static_cast<int>(dataset.lights.size());
   const ParameterLayout layout = MakeParameterLayout(scene, material, num_lights);
   const std::vector<double> delta =
       GradcheckDirection(scene, layout, options.kind, options.direction_seed);
-  const int block =
-      options.block > 0 ? options.block : (options.kind == ParameterKind::kVertex ? 8 : 1);
   *result = ConsistencyResult();
   result->seeds = seeds;
-  result->block = block;
-  for (int v : selected) {
-    const ViewSetup& view = views.views[v];
+  result->block = setup.block;
+  for (int v : setup.selected) {
+    const ViewSetup& view = setup.views.views[v];
     std::vector<std::vector<double>> pixels, blocks;
     for (int s = 0; s < seeds; ++s) {
       RenderOptions render = options.render;
@@ -80,10 +68,11 @@ Status MeasureDerivativeConsistency(const Dataset& dataset, const TriMesh& mesh,
       Image image;
       DerivativeOutput out;
       RenderStats stats;
-      RenderViewWithDerivatives(scene, material, view, render, request, num_lights, &image, &out,
-                                &stats);
+      RenderViewWithDerivatives(scene, material, view, render, setup.request, num_lights, &image,
+                                &out, &stats);
       pixels.push_back(DirectionalDerivativeImage(out.rows, delta));
-      blocks.push_back(BlockSums(pixels.back(), view.camera.width, view.camera.height, block));
+      blocks.push_back(
+          BlockSums(pixels.back(), view.camera.width, view.camera.height, setup.block));
     }
     ConsistencyViewResult r;
     r.view = v;
@@ -91,7 +80,7 @@ Status MeasureDerivativeConsistency(const Dataset& dataset, const TriMesh& mesh,
     r.block_correlation = MeanPairCorrelation(blocks);
     r.noise_to_signal = NoiseToSignal(pixels);
     result->views.push_back(r);
-    const double n = static_cast<double>(selected.size());
+    const double n = static_cast<double>(setup.selected.size());
     result->pixel_correlation += r.pixel_correlation / n;
     result->block_correlation += r.block_correlation / n;
     result->noise_to_signal += r.noise_to_signal / n;

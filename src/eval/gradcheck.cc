@@ -245,24 +245,35 @@ bool GradcheckOptions::Check(std::string* why) const {
   return true;
 }
 
-Status RunGradcheck(const Dataset& dataset, const TriMesh& mesh, const Material& material,
-                    const GradcheckOptions& options, GradcheckResult* result) {
+Status PrepareGradcheck(const Dataset& dataset, const GradcheckOptions& options,
+                        GradcheckSetup* setup) {
   std::string why;
   if (!options.Check(&why)) return Status::Error(why);
-  DerivativeRequest request = options.derivatives;
-  request.params = ParameterSelection::Only(options.kind);
-  request.jacobian_rows = true;
-  request.adjoint_weights = nullptr;
-  if (!request.Check(&why)) return Status::Error(why);
-  DatasetViews views;
-  SFT_RETURN_IF_ERROR(MakeDatasetViews(dataset, &views));
-  std::vector<int> selected;
-  SFT_RETURN_IF_ERROR(SelectViews(options.views, static_cast<int>(views.views.size()), &selected));
+  setup->request = options.derivatives;
+  setup->request.params = ParameterSelection::Only(options.kind);
+  setup->request.jacobian_rows = true;
+  setup->request.adjoint_weights = nullptr;
+  if (!setup->request.Check(&why)) return Status::Error(why);
+  SFT_RETURN_IF_ERROR(MakeDatasetViews(dataset, &setup->views));
+  SFT_RETURN_IF_ERROR(
+      SelectViews(options.views, static_cast<int>(setup->views.views.size()), &setup->selected));
+  setup->block =
+      options.block > 0 ? options.block : (options.kind == ParameterKind::kVertex ? 8 : 1);
+  return Status::Ok();
+}
+
+Status RunGradcheck(const Dataset& dataset, const TriMesh& mesh, const Material& material,
+                    const GradcheckOptions& options, GradcheckResult* result) {
+  GradcheckSetup setup;
+  SFT_RETURN_IF_ERROR(PrepareGradcheck(dataset, options, &setup));
+  DerivativeRequest& request = setup.request;
+  const DatasetViews& views = setup.views;
+  const std::vector<int>& selected = setup.selected;
+  const int block = setup.block;
   const RenderScene scene(mesh);
   const ParameterLayout layout =
       MakeParameterLayout(scene, material, static_cast<int>(dataset.lights.size()));
   const bool vertices = options.kind == ParameterKind::kVertex;
-  const int block = options.block > 0 ? options.block : (vertices ? 8 : 1);
 
   std::vector<double> delta =
       GradcheckDirection(scene, layout, options.kind, options.direction_seed);

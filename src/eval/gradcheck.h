@@ -51,6 +51,7 @@
 #include "src/geometry/material.h"
 #include "src/geometry/mesh.h"
 #include "src/io/dataset.h"
+#include "src/io/scene_setup.h"
 #include "src/render/derivatives.h"
 #include "src/render/render.h"
 #include "src/render/scene.h"
@@ -120,6 +121,20 @@ struct GradcheckResult {
 
 Status RunGradcheck(const Dataset& dataset, const TriMesh& mesh, const Material& material,
                     const GradcheckOptions& options, GradcheckResult* result);
+
+// What a check and a consistency measurement (derivative_consistency.h) both start from: the
+// derivative request of the options' kind (Jacobian rows, no adjoint weights), the dataset's
+// per-view setups, the selected views and the block side (0 in the options = 8 for vertices,
+// 1 otherwise).
+struct GradcheckSetup {
+  DerivativeRequest request;
+  DatasetViews views;
+  std::vector<int> selected;
+  int block = 1;
+};
+// Checks `options` and fills `setup`; errors name the option.
+Status PrepareGradcheck(const Dataset& dataset, const GradcheckOptions& options,
+                        GradcheckSetup* setup);
 
 // The direction δ of a check of `kind` (file comment): the smooth displacement field for
 // vertices, uniform in [−1, 1] per parameter of the kind otherwise; zero elsewhere.
