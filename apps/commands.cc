@@ -56,6 +56,9 @@ void AddEdgeBudgetOptions(CLI::App* app, DerivativeRequest* request) {
   app->add_option("--texel-edge-ratio", request->texel_edge_ratio,
                   "Texel-boundary samples per pixel sample, [0, 16]; 0 = off")
       ->capture_default_str();
+  app->add_flag("--no-normal-sliding{false}", request->normal_sliding,
+                "Smooth shading: leave out the sliding (barycentric) term of the shading "
+                "normal's derivative (biased, lower variance)");
 }
 
 std::string MaterialFile(const std::string& material) {

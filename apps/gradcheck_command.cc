@@ -13,6 +13,7 @@
 #include "src/geometry/material.h"
 #include "src/geometry/mesh.h"
 #include "src/io/dataset.h"
+#include "src/io/scene_setup.h"
 
 namespace sft {
 namespace {
@@ -20,14 +21,15 @@ namespace {
 // The command-line values of `sft gradcheck`; validated by GradcheckOptions::Check and the
 // loaders.
 struct GradcheckCommandOptions {
-  std::string dataset;          // dataset directory: cameras, lights, views.
-  std::string mesh;             // mesh (OBJ, PLY, OFF).
-  std::string material;         // material JSON file or inline JSON; "" = default material.
-  std::string param;            // vertices | albedo | roughness | specular | light.
-  std::string effects = "all";  // enabled effects (Effects::Parse).
-  std::string json;             // optional JSON report path.
-  GradcheckOptions check;       // spp, bounces, views, step, block, tolerance, seeds.
-  int consistency_seeds = 0;    // > 0: measure seed-to-seed consistency instead, [2, 64].
+  std::string dataset;           // dataset directory: cameras, lights, views.
+  std::string mesh;              // mesh (OBJ, PLY, OFF).
+  std::string material;          // material JSON file or inline JSON; "" = default material.
+  std::string param;             // vertices | albedo | roughness | specular | light.
+  std::string effects = "all";   // enabled effects (Effects::Parse).
+  std::string shading = "auto";  // "auto" (the dataset's, DatasetShading), "flat" or "smooth".
+  std::string json;              // optional JSON report path.
+  GradcheckOptions check;        // spp, bounces, views, step, block, tolerance, seeds.
+  int consistency_seeds = 0;     // > 0: measure seed-to-seed consistency instead, [2, 64].
 };
 
 // --consistency-seeds: the derivative image at K seeds against itself
@@ -91,6 +93,10 @@ int RunGradcheckCommand(const GradcheckCommandOptions& opts) {
   Dataset dataset;
   status = ReadDataset(opts.dataset, &dataset);
   if (!status.ok()) return PrintError("gradcheck", status);
+  if (!ResolveShading(opts.shading, dataset, &check.render.shading)) {
+    return PrintError("gradcheck", Status::Error("--shading: expected auto, flat or smooth, got '" +
+                                                 opts.shading + "'"));
+  }
   TriMesh mesh;
   status = ReadMesh(opts.mesh, &mesh);
   if (!status.ok()) return PrintError("gradcheck", status);
@@ -111,6 +117,7 @@ int RunGradcheckCommand(const GradcheckCommandOptions& opts) {
   report["spp"] = check.render.spp;
   report["bounces"] = check.render.bounces;
   report["effects"] = check.render.effects.ToString();
+  report["shading"] = ShadingName(check.render.shading);
   report["step"] = result.step;
   report["block"] = result.block;
   nlohmann::json per_view = nlohmann::json::array();
@@ -190,6 +197,9 @@ CommandRunner SetupGradcheckCommand(CLI::App* app) {
       ->capture_default_str();
   app->add_option("--bounces", opts->check.render.bounces,
                   "Path segments: 1 = direct light only, 2 = one indirect bounce")
+      ->capture_default_str();
+  app->add_option("--shading", opts->shading,
+                  "auto (the dataset's ground_truth.shading, else smooth), flat or smooth")
       ->capture_default_str();
   app->add_option("--effects", opts->effects, "Enabled effects (see sft render --help)")
       ->capture_default_str();

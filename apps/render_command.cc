@@ -28,17 +28,18 @@ namespace {
 
 // The command-line values of `sft render`; validated by FinishRenderOptions and the loaders.
 struct RenderCommandOptions {
-  std::string dataset;          // dataset directory (sft-dataset/1).
-  std::string mesh;             // mesh to render (OBJ, PLY, OFF).
-  std::string material;         // material JSON file or inline JSON; "" = default material.
-  std::string out;              // output directory (images/, render.json, report.html).
-  std::string lights;           // light scales (lights.json of sft reconstruct); "" = none.
-  std::string pass = "color";   // color | albedo | roughness | normal | depth.
-  std::string effects = "all";  // enabled effects (Effects::Parse).
-  std::vector<int> views;       // view indices; empty = all.
-  RenderOptions render;         // spp, bounces, seed, threads.
-  bool quiet = false;           // no progress line.
-  bool no_report = false;       // skip the comparison with the dataset images and report.html.
+  std::string dataset;           // dataset directory (sft-dataset/1).
+  std::string mesh;              // mesh to render (OBJ, PLY, OFF).
+  std::string material;          // material JSON file or inline JSON; "" = default material.
+  std::string out;               // output directory (images/, render.json, report.html).
+  std::string lights;            // light scales (lights.json of sft reconstruct); "" = none.
+  std::string pass = "color";    // color | albedo | roughness | normal | depth.
+  std::string effects = "all";   // enabled effects (Effects::Parse).
+  std::string shading = "auto";  // "auto" (the dataset's, DatasetShading), "flat" or "smooth".
+  std::vector<int> views;        // view indices; empty = all.
+  RenderOptions render;          // spp, bounces, seed, threads.
+  bool quiet = false;            // no progress line.
+  bool no_report = false;        // skip the comparison with the dataset images and report.html.
 };
 
 constexpr char kReportFiles[] = "report_files";  // the report's PNGs, under OUT/.
@@ -192,6 +193,9 @@ Status RunRender(const RenderCommandOptions& opts) {
       opts.out, {{opts.dataset}, {opts.mesh, MaterialFile(opts.material), opts.lights}}, "--out"));
   Dataset dataset;
   SFT_RETURN_IF_ERROR(ReadDataset(opts.dataset, &dataset));
+  if (!ResolveShading(opts.shading, dataset, &render.shading)) {
+    return Status::Error("--shading: expected auto, flat or smooth, got '" + opts.shading + "'");
+  }
   // Only the colour pass is lit; albedo, roughness, normal and depth are first-hit passes that
   // need no light, so they also render datasets with unknown lighting (empty `lights`).
   if (render.pass == RenderPass::kColor) SFT_RETURN_IF_ERROR(CheckViewsHaveLights(dataset));
@@ -224,6 +228,7 @@ Status RunRender(const RenderCommandOptions& opts) {
   report["spp"] = render.spp;
   report["bounces"] = render.bounces;
   report["effects"] = render.effects.ToString();
+  report["shading"] = ShadingName(render.shading);
   report["pass"] = opts.pass;
   report["seed"] = render.seed;
   const bool colour_pass = render.pass == RenderPass::kColor;
@@ -350,6 +355,9 @@ CommandRunner SetupRenderCommand(CLI::App* app) {
                   "Path segments: 1 = direct light only, 2 = one indirect bounce")
       ->capture_default_str();
   app->add_option("--pass", opts->pass, "color | albedo | roughness | normal | depth")
+      ->capture_default_str();
+  app->add_option("--shading", opts->shading,
+                  "auto (the dataset's ground_truth.shading, else smooth), flat or smooth")
       ->capture_default_str();
   app->add_option("--effects", opts->effects,
                   "Enabled effects: comma list of direct,shadows,bounces,specular,environment, "

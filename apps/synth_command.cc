@@ -52,11 +52,13 @@ struct SynthOptions {
   bool environment_background = false;  // camera rays that miss see the probe.
   RenderOptions render;                 // spp, bounces, seed, threads of the target renders.
   std::string effects = "all";          // enabled effects (Effects::Parse).
-  bool overwrite = false;               // replace an existing, non-empty output directory.
-  bool quiet = false;                   // no progress line.
-  bool ground = false;                  // add a textured ground plane (rendered, not in gt/).
-  GroundOptions ground_options;         // the plane's size and texture (src/io/synth_scene.h).
-  std::string path = "sphere";          // camera path: "sphere" (Fibonacci) or "orbit".
+  // "smooth" (interpolated vertex normals: the object a mesh stands for) or "flat" (facets).
+  std::string shading = "smooth";
+  bool overwrite = false;        // replace an existing, non-empty output directory.
+  bool quiet = false;            // no progress line.
+  bool ground = false;           // add a textured ground plane (rendered, not in gt/).
+  GroundOptions ground_options;  // the plane's size and texture (src/io/synth_scene.h).
+  std::string path = "sphere";   // camera path: "sphere" (Fibonacci) or "orbit".
   std::vector<double> elevation = {15.0, 40.0};  // orbit elevation range, degrees, [-89, 89].
 
   // Errors name the command-line flag and the value; NaN fails every range test. --spp,
@@ -273,9 +275,13 @@ Status FinishDataset(const SynthOptions& opts, const RenderOptions& render, cons
   SFT_RETURN_IF_ERROR(WriteMesh(JoinPath(partial, "gt/mesh.ply"), mesh));
   SFT_RETURN_IF_ERROR(SaveMaterial(JoinPath(partial, "gt/material.json"), material));
   dataset->gt_mesh = "gt/mesh.ply";
-  dataset->ground_truth = {{"mesh", "gt/mesh.ply"},     {"material", "gt/material.json"},
-                           {"renderer", "sft"},         {"samples", render.spp},
-                           {"bounces", render.bounces}, {"seed", render.seed},
+  dataset->ground_truth = {{"mesh", "gt/mesh.ply"},
+                           {"material", "gt/material.json"},
+                           {"renderer", "sft"},
+                           {"samples", render.spp},
+                           {"bounces", render.bounces},
+                           {"seed", render.seed},
+                           {"shading", ShadingName(render.shading)},
                            {"source_mesh", opts.mesh}};
   SFT_RETURN_IF_ERROR(WriteSceneJson(*dataset, partial));
   std::error_code ec;
@@ -293,6 +299,9 @@ Status RunSynth(const SynthOptions& opts) {
   if (!opts.Check(&why)) return Status::Error(why);
   RenderOptions render = opts.render;
   if (!Effects::Parse(opts.effects, &render.effects, &why)) return Status::Error("--" + why);
+  if (!ShadingFromName(opts.shading, &render.shading)) {
+    return Status::Error("--shading: expected flat or smooth, got '" + opts.shading + "'");
+  }
   if (!render.Check(&why)) return Status::Error("--" + why);
   SFT_RETURN_IF_ERROR(CheckSynthOutput(opts));
 
@@ -365,6 +374,10 @@ CommandRunner SetupSynthCommand(CLI::App* app) {
                   "Path segments: 1 = direct light only, 2 = one indirect bounce")
       ->capture_default_str();
   app->add_option("--effects", opts->effects, "Enabled effects (see sft render --help)")
+      ->capture_default_str();
+  app->add_option("--shading", opts->shading,
+                  "smooth (interpolated vertex normals) or flat (face normals); recorded as "
+                  "ground_truth.shading, which sft reconstruct follows")
       ->capture_default_str();
   app->add_option("--seed", opts->render.seed, "Sample seed")->capture_default_str();
   app->add_option("--threads", opts->render.threads, "Worker threads (0 = all cores)")

@@ -162,6 +162,7 @@ Status EvaluateReconstruction(const std::string& dataset_dir, const std::string&
   render.spp = options.spp;
   render.bounces = options.bounces;
   render.seed = options.seed;
+  render.shading = DatasetShading(dataset);  // as the fit renders it with "shading": "auto".
   RenderOptions albedo_pass = render;
   albedo_pass.pass = RenderPass::kAlbedo;
   RenderOptions roughness_pass = render;

@@ -481,6 +481,13 @@ class SceneParser {
       SFT_RETURN_IF_ERROR(String(*mesh, "ground_truth.mesh", false, &dataset->gt_mesh));
       SFT_RETURN_IF_ERROR(ContainedPath("ground_truth.mesh", dataset->gt_mesh));
     }
+    if (const json* shading = Find(*value, "shading"); shading != nullptr && !shading->is_null()) {
+      SFT_RETURN_IF_ERROR(String(*shading, "ground_truth.shading", false, &dataset->gt_shading));
+      if (dataset->gt_shading != "flat" && dataset->gt_shading != "smooth") {
+        return Error("ground_truth.shading",
+                     "expected \"flat\" or \"smooth\", got \"" + dataset->gt_shading + "\"");
+      }
+    }
     return Status::Ok();
   }
 

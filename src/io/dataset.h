@@ -99,7 +99,10 @@ struct Dataset {
   std::vector<LightSpec> lights;
   std::vector<ViewSpec> views;
   Background background = Background::kBlack;
-  std::string gt_mesh;          // `ground_truth.mesh` (relative), empty when absent.
+  std::string gt_mesh;  // `ground_truth.mesh` (relative), empty when absent.
+  // `ground_truth.shading`: how the images were rendered, "flat" or "smooth" (render.h's
+  // Shading); empty when absent (real photographs: smooth surfaces).
+  std::string gt_shading;
   nlohmann::json ground_truth;  // the whole `ground_truth` object as read (null when absent).
   // Optional keys written by importers (docs/dataset.md, docs/import.md); empty when absent.
   std::string sparse_points;           // "sparse_points": PLY point cloud (xyz, rgb), world frame.

@@ -92,4 +92,16 @@ Status SelectViews(const std::vector<int>& requested, int num_views, std::vector
   return Status::Ok();
 }
 
+Shading DatasetShading(const Dataset& dataset) {
+  return dataset.gt_shading == "flat" ? Shading::kFlat : Shading::kSmooth;
+}
+
+bool ResolveShading(const std::string& name, const Dataset& dataset, Shading* shading) {
+  if (name == "auto") {
+    *shading = DatasetShading(dataset);
+    return true;
+  }
+  return ShadingFromName(name, shading);
+}
+
 }  // namespace sft

@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "src/core/status.h"
@@ -40,6 +41,12 @@ Status MakeDatasetViews(const Dataset& dataset, DatasetViews* out);
 // The view indices to work on: `requested` when non-empty (each checked against [0, num_views);
 // the error names the offending index), else all views.
 Status SelectViews(const std::vector<int>& requested, int num_views, std::vector<int>* selected);
+
+// The shading a dataset's images call for: ground_truth.shading when the dataset records it (a
+// synthetic dataset says how it was rendered), else smooth (photographs of real surfaces).
+Shading DatasetShading(const Dataset& dataset);
+// A "shading" option's value: "auto" (DatasetShading), "flat" or "smooth". False for others.
+bool ResolveShading(const std::string& name, const Dataset& dataset, Shading* shading);
 
 }  // namespace sft
 

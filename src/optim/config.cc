@@ -91,6 +91,14 @@ const std::map<std::string, Key>& Keys() {
                         return Effects::Parse(s, &o->cache.render.effects, &why) ? "" : why;
                       },
                       [](const O& o) { return o.cache.render.effects.ToString(); })},
+      {"shading", Choice(
+                      [](const std::string& s, O* o) -> std::string {
+                        if (s != "auto" && s != "flat" && s != "smooth")
+                          return "expected auto, flat or smooth";
+                        o->shading = s;
+                        return "";
+                      },
+                      [](const O& o) { return o.shading; })},
       {"pyramid_levels", Int([](O* o) -> int& { return o->cache.pyramid_levels; }, 1, 12)},
       {"level_weight", Real([](O* o) -> double& { return o->cache.level_weight; }, 1e-6, 64)},
       {"image_weight", Real([](O* o) -> double& { return o->cache.image_weight; }, 0, 1e6)},
@@ -213,6 +221,7 @@ const std::map<std::string, Key>& Keys() {
                      },
                      [](const O& o) { return std::string(PhaseScheduleName(o.phases)); })},
       {"outer_iterations", Int([](O* o) -> int& { return o->outer_iterations; }, 1, 10000)},
+      {"normal_sliding", Bool([](O* o) -> bool& { return o->cache.edges.normal_sliding; })},
       {"fit_specular", Bool([](O* o) -> bool& { return o->fit_specular; })},
       {"fit_lights", Bool([](O* o) -> bool& { return o->fit_lights; })},
       {"seed",

@@ -71,6 +71,10 @@ bool ReconstructOptions::Check(std::string* why) const {
     *why = "outer_iterations: must be in [1, 10000]";
     return false;
   }
+  if (shading != "auto" && shading != "flat" && shading != "smooth") {
+    *why = "shading: expected auto, flat or smooth, got '" + shading + "'";
+    return false;
+  }
   return true;
 }
 
@@ -110,6 +114,7 @@ Status Reconstruction::Create(const Dataset& dataset, const TriMesh& mesh, const
   std::unique_ptr<Reconstruction> r(new Reconstruction());
   r->dataset_ = &dataset;
   r->options_ = options;
+  ResolveShading(options.shading, dataset, &r->options_.cache.render.shading);
   r->mesh_ = mesh;
   r->material_ = material;
   std::vector<Eigen::Vector3d> positions;
@@ -129,7 +134,7 @@ Status Reconstruction::Create(const Dataset& dataset, const TriMesh& mesh, const
     }
   }
   SFT_RETURN_IF_ERROR(RenderCache::Create(dataset, &r->views_, views, r->faces_, material,
-                                          &r->params_, options.cache, &r->cache_));
+                                          &r->params_, r->options_.cache, &r->cache_));
   r->start_time_ = NowSeconds();
   *out = std::move(r);
   return Status::Ok();

@@ -35,6 +35,10 @@ struct ReconstructOptions {
   bool fit_lights = false;    // the texture phase also fits the light intensity scales.
   uint64_t seed = 1;          // base seed of the renders.
   std::vector<int> views;     // dataset views to fit; empty = all.
+  // Shading of the fit's renders: "auto" (the dataset's, DatasetShading in src/io/scene_setup.h:
+  // its ground_truth.shading, else smooth), "flat" or "smooth". Create resolves it into
+  // cache.render.shading.
+  std::string shading = "auto";
 
   ReconstructOptions();
   bool Check(std::string* why) const;

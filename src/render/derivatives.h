@@ -13,9 +13,11 @@
 //   albedo, roughness, specular: every BSDF factor of every path vertex, all effects; exact (no
 //     visibility depends on them);
 //   light scales: every contribution of that light;
-//   vertices, interior terms (geometry_derivatives.h): through every path vertex's face normal
-//     (BSDF, cosines) and, for point lights, its position (light direction and 1/d²), chained
-//     through the hit points of earlier bounces; all effects;
+//   vertices, interior terms (geometry_derivatives.h): through every path vertex's shading
+//     normal (BSDF, cosines) — the face normal, or under smooth shading the interpolated vertex
+//     normals with their two-ring and the hit's sliding barycentrics (internal/shading_normal.h)
+//     — and, for point lights, its position (light direction and 1/d²), chained through the hit
+//     points of earlier bounces; all effects;
 //   vertices, boundary terms (edge sampling, src/render/internal/*_edges.cc): see the table.
 //
 // Vertex derivative terms present per Effects setting (✓ present, — not needed):
@@ -24,21 +26,24 @@
 //   + shadows      ✓         ✓                 ✓ seen directly   ✓ seen directly     —
 //   + bounces      ✓         ✓                 ✓ via bounce (C)  ✓ via bounce (B)    ✓ silhouettes,
 //                                                                                      creases
+//                                                                                      (flat)
 //   + environment  ✓         ✓ (vs background) ✓ seen directly   —                   ✓ occlusion
 //                                                                                      (with
 //                                                                                      shadows)
 //   + specular     ✓         ✓                 as above          as above            as above
 // Secondary edges (internal/secondary_edges.cc; secondary_edge_samples per path vertex):
 // (A) mesh edges seen from a path vertex — silhouettes against the environment (when it is lit
-// with shadows) or against farther surfaces, and creases, when a further bounce is traced;
+// with shadows) or against farther surfaces, and creases under flat shading, when a further
+// bounce is traced;
 // (B) point-light shadow boundaries on the surface a bounce reaches; (C) texel boundaries on the
 // surface a bounce reaches. Their sampling is unbiased: (A) and (C) draw (edge, point) pairs —
 // (A) from a mixture of the edges around the vertex's face and all edges ∝ length, (C) ∝ length
 // × material jump — uniform in the angle they subtend, and keep one by resampling with the
 // BSDF·cosine towards it; (B) resamples a per-view pool of cast shadow points with the
 // BSDF·cosine times the curve's angular speed.
-// Primary edges cover silhouettes, boundary and non-manifold edges and, because shading is flat,
-// creases between non-coplanar faces. Texel boundaries are where piecewise-constant albedo or
+// Primary edges cover silhouettes, boundary and non-manifold edges and, under flat shading,
+// creases between non-coplanar faces (smooth shading is continuous across them: Shading in
+// render.h). Texel boundaries are where piecewise-constant albedo or
 // roughness (mesh colors) jumps: grid lines inside faces and edges between coplanar faces, moving
 // with the vertices. Their jump in the full path radiance (direct and indirect light, shadowed or
 // not) is included where the camera sees them directly, and through a bounce by secondary edges
@@ -143,6 +148,13 @@ struct DerivativeRequest {
   // along the lines the term converges fast (measurements: docs/design-notes.md, "Texel
   // boundaries").
   double texel_edge_ratio = 0.125;
+  // Smooth shading only: include the sliding term of the shading normal (the hit's barycentrics
+  // change as its face moves under the ray; internal/shading_normal.h). It is part of the exact
+  // derivative (without it the finite-difference tests of smooth shading miss by 13–61%), but its
+  // per-sample values scale with the normal field's change across a face over the face's height
+  // and with 1/cos of the incidence, so on fine, curved meshes it carries most of the variance
+  // (docs/design-notes.md, "Smooth shading"). false: left out (biased, quieter).
+  bool normal_sliding = true;
 
   // True when valid; else *why names the field.
   bool Check(std::string* why) const;

@@ -17,6 +17,7 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <memory>
 #include <optional>
 
 #include "src/core/rng.h"
@@ -26,6 +27,7 @@
 #include "src/render/internal/integrator.h"
 #include "src/render/internal/path_derivatives.h"
 #include "src/render/internal/secondary_edges.h"
+#include "src/render/internal/vertex_normal_jacobian.h"
 
 namespace sft {
 namespace {
@@ -201,6 +203,11 @@ void RenderImpl(const RenderScene& scene, const Material& material, const ViewSe
   RenderStats edge_stats;  // of the edge terms' set-up and samples outside the tiles.
   const std::optional<render_internal::SecondaryEdges> secondary = MaybeSecondaryEdges(
       scene, material, view, options, request, environment, max_segments, &edge_stats);
+  std::shared_ptr<const render_internal::VertexNormalJacobian> normal_jacobian;
+  if (request != nullptr && (request->jacobian_rows || request->adjoint_weights != nullptr) &&
+      request->params.vertices && options.shading == Shading::kSmooth) {
+    normal_jacobian = render_internal::VertexNormalJacobian::Of(scene);
+  }
   const Context ctx{scene,
                     material,
                     options.sampling_material != nullptr ? *options.sampling_material : material,
@@ -211,7 +218,8 @@ void RenderImpl(const RenderScene& scene, const Material& material, const ViewSe
                     options.effects.specular ? 1.0 : 0.0,
                     request,
                     layout,
-                    secondary ? &*secondary : nullptr};
+                    secondary ? &*secondary : nullptr,
+                    normal_jacobian.get()};
   const int width = view.camera.width;
   const int height = view.camera.height;
   *image = Image(width, height, 4);

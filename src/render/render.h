@@ -42,6 +42,17 @@ struct Effects {
 enum class RenderPass { kColor, kAlbedo, kRoughness, kNormal, kDepth };
 bool RenderPassFromName(const std::string& name, RenderPass* pass);
 
+// How a hit is shaded. kFlat: with its face's geometric normal, so every edge between
+// non-coplanar faces is a shading discontinuity (a crease) that edge sampling must cover.
+// kSmooth: with the interpolated angle-weighted vertex normals (RenderScene::SmoothNormal, as
+// Blender computes them and Cycles interpolates them), continuous across edges, so only
+// silhouettes, shadow boundaries and texel boundaries are discontinuities. Geometry (ray
+// offsets, edge planes, hit-point motion) always uses the geometric normal.
+enum class Shading { kFlat, kSmooth };
+// "flat" | "smooth"; false for any other name.
+bool ShadingFromName(const std::string& name, Shading* shading);
+const char* ShadingName(Shading shading);
+
 struct RenderOptions {
   int spp = 64;     // samples per pixel, >= 1.
   int bounces = 2;  // path segments as in the report: 1 = direct light only, 2 = one
@@ -50,6 +61,7 @@ struct RenderOptions {
   uint64_t seed = 0;  // base seed; the image is a deterministic function of it.
   int threads = 0;    // worker threads; 0 = all cores.
   RenderPass pass = RenderPass::kColor;
+  Shading shading = Shading::kFlat;  // normals shading uses (see Shading).
   // Not owned. When set, path sampling (lobe choices, directions, pdfs, MIS weights) uses this
   // material while path values use the rendered one ("detached sampling"): renders of nearby
   // materials then follow identical paths, as finite differences and linearizations need. Must

@@ -67,6 +67,18 @@ bool RenderPassFromName(const std::string& name, RenderPass* pass) {
   return true;
 }
 
+bool ShadingFromName(const std::string& name, Shading* shading) {
+  if (name == "flat")
+    *shading = Shading::kFlat;
+  else if (name == "smooth")
+    *shading = Shading::kSmooth;
+  else
+    return false;
+  return true;
+}
+
+const char* ShadingName(Shading shading) { return shading == Shading::kSmooth ? "smooth" : "flat"; }
+
 bool RenderOptions::Check(std::string* why) const {
   if (spp < 1 || spp > (1 << 20)) {
     *why = "spp: must be in [1, 1048576], got " + std::to_string(spp);

@@ -10,6 +10,8 @@
 #include <mutex>
 #include <tuple>
 
+#include "src/render/vertex_normals.h"
+
 namespace sft {
 
 RTCDevice EmbreeDevice() {
@@ -233,6 +235,14 @@ void RenderScene::UpdateDerived() {
     }
     face_scales_[f] = scale;
   }
+  AngleWeightedNormalSums(positions_, faces_, welded_, &vertex_normals_);
+  for (size_t v = 0; v < positions_.size(); ++v) {
+    const Eigen::Vector3d& sum = vertex_normals_[welded_[v]];
+    const double len = sum.norm();
+    // welded_[v] ≤ v: the representative is normalized before its copies read it.
+    vertex_normals_[v] =
+        len > 0 && std::isfinite(len) ? Eigen::Vector3d(sum / len) : Eigen::Vector3d::Zero();
+  }
 }
 
 void RenderScene::Bounds(Eigen::Vector3d* lo, Eigen::Vector3d* hi) const {
@@ -349,6 +359,15 @@ bool RenderScene::Occluded(const Eigen::Vector3d& origin, const Eigen::Vector3d&
 Eigen::Vector3d RenderScene::Point(int face, double u, double v) const {
   const Eigen::Vector3i& f = faces_[face];
   return (1.0 - u - v) * positions_[f[0]] + u * positions_[f[1]] + v * positions_[f[2]];
+}
+
+Eigen::Vector3d RenderScene::SmoothNormal(int face, double u, double v) const {
+  const Eigen::Vector3i& f = faces_[face];
+  const Eigen::Vector3d m =
+      (1.0 - u - v) * vertex_normals_[f[0]] + u * vertex_normals_[f[1]] + v * vertex_normals_[f[2]];
+  const double len = m.norm();
+  if (face_normals_[face].isZero()) return Eigen::Vector3d::Zero();
+  return len > 0 && std::isfinite(len) ? Eigen::Vector3d(m / len) : face_normals_[face];
 }
 
 }  // namespace sft

@@ -87,6 +87,14 @@ class RenderScene {
   // Unit geometric normal n = normalize((p1 − p0) × (p2 − p0)) (counter-clockwise = front);
   // zero for a degenerate face.
   Eigen::Vector3d FaceNormal(int face) const { return face_normals_[face]; }
+  // The unit angle-weighted normal of vertex v's welded vertex (vertex_normals.h): faces are
+  // taken counter-clockwise = front, so a mesh with mixed winding gets cancelling terms. Zero
+  // when the sum vanishes (no non-degenerate face, or cancelling ones).
+  const Eigen::Vector3d& VertexNormal(int v) const { return vertex_normals_[v]; }
+  // The smooth shading normal at barycentrics (1 − u − v, u, v) of `face`: normalize(Σ b_j·N_j)
+  // over its corners' vertex normals, as Cycles interpolates them. Falls back to the face's
+  // geometric normal where that sum vanishes; zero for a degenerate face (never shaded).
+  Eigen::Vector3d SmoothNormal(int face, double u, double v) const;
 
   const std::vector<Eigen::Vector3d>& positions() const { return positions_; }
   const std::vector<Eigen::Vector3i>& faces() const { return faces_; }
@@ -124,6 +132,7 @@ class RenderScene {
   std::vector<Eigen::Vector3d> positions_;
   std::vector<Eigen::Vector3i> faces_;
   std::vector<Eigen::Vector3d> face_normals_;
+  std::vector<Eigen::Vector3d> vertex_normals_;  // per original vertex (its welded one's).
   std::vector<double> face_scales_;
   std::vector<char> referenced_;
   Eigen::Vector3d lo_ = Eigen::Vector3d::Zero(), hi_ = Eigen::Vector3d::Zero();

@@ -61,6 +61,7 @@ TEST_P(CyclesAgreementTest, MatchesReference) {
   options.spp = param.spp;
   options.bounces = gt["max_bounces_cycles"].get<int>() + 1;
   options.seed = 1;
+  options.shading = DatasetShading(dataset);  // ground_truth.shading, as Blender shaded it.
   double worst_mean = 0.0, worst_block = 0.0;
   for (size_t v = 0; v < views.views.size(); ++v) {
     Image ours, reference, mask;
@@ -85,6 +86,7 @@ TEST_P(CyclesAgreementTest, MatchesReference) {
 INSTANTIATE_TEST_SUITE_P(Cycles, CyclesAgreementTest,
                          ::testing::Values(CyclesCase{"bunny_point_diffuse", 64, 0.02},
                                            CyclesCase{"bunny_point_ggx_gi", 512, 0.03},
+                                           CyclesCase{"bunny_point_ggx_gi_smooth", 512, 0.03},
                                            CyclesCase{"sphere_env_studio", 256, 0.03},
                                            CyclesCase{"spot_textured_point", 64, 0.03}),
                          [](const ::testing::TestParamInfo<CyclesCase>& info) {

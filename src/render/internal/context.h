@@ -18,6 +18,7 @@ namespace render_internal {
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
 struct SecondaryEdges;
+class VertexNormalJacobian;
 
 struct Context {
   const RenderScene& scene;
@@ -33,6 +34,8 @@ struct Context {
   const ParameterLayout* layout;
   // Candidates of secondary edge samples; null when they are off.
   const SecondaryEdges* secondary;
+  // Smooth shading with vertex derivatives: the vertex normals' Jacobian; null otherwise.
+  const VertexNormalJacobian* normal_jacobian;
 };
 
 // Texel indices of a hit, and the BSDF parameters there.

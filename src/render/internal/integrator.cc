@@ -17,17 +17,23 @@ constexpr double kSharedSideMinCosine = 1.0 - 1e-9;
 // The shading frame of a path vertex at ray hit `hit` of the ray along `dir`.
 struct ShadingPoint {
   Eigen::Vector3d p;
-  Eigen::Vector3d n;  // unit face normal flipped to the side of wo (two-sided shading).
+  // The unit shading normal (the face's, or the interpolated smooth one) flipped to the side of
+  // wo that the face's geometric normal faces (two-sided shading).
+  Eigen::Vector3d n;
   Eigen::Vector3d wo;
-  double sign = 1.0;  // n = sign·(face normal).
+  double sign = 1.0;  // n = sign·(unflipped shading normal).
 };
 
-// False for a degenerate triangle (no defined surface).
+// False for a degenerate triangle (no defined surface). The side is the geometric one: where an
+// interpolated normal turns away from wo (near silhouettes) the BSDF sees wo below its
+// hemisphere and reflects nothing.
 bool Shade(const Context& ctx, const Eigen::Vector3d& dir, const RayHit& hit, ShadingPoint* sp) {
   sp->p = ctx.scene.Point(hit.face, hit.u, hit.v);
-  sp->n = ctx.scene.FaceNormal(hit.face);
+  const Eigen::Vector3d face_normal = ctx.scene.FaceNormal(hit.face);
+  sp->n = ctx.options.shading == Shading::kSmooth ? ctx.scene.SmoothNormal(hit.face, hit.u, hit.v)
+                                                  : face_normal;
   sp->wo = -dir;
-  sp->sign = sp->n.dot(sp->wo) < 0.0 ? -1.0 : 1.0;
+  sp->sign = face_normal.dot(sp->wo) < 0.0 ? -1.0 : 1.0;
   sp->n *= sp->sign;
   return !sp->n.isZero();
 }
@@ -353,8 +359,10 @@ Eigen::Vector3d TraceAuxiliary(const Context& ctx, const Eigen::Vector3d& dir, c
     case RenderPass::kRoughness:
       return Eigen::Vector3d::Constant(params.roughness);
     case RenderPass::kNormal: {
-      Eigen::Vector3d n = ctx.scene.FaceNormal(hit.face);
-      if (n.dot(dir) > 0.0) n = -n;
+      Eigen::Vector3d n = ctx.options.shading == Shading::kSmooth
+                              ? ctx.scene.SmoothNormal(hit.face, hit.u, hit.v)
+                              : ctx.scene.FaceNormal(hit.face);
+      if (ctx.scene.FaceNormal(hit.face).dot(dir) > 0.0) n = -n;
       return n;
     }
     case RenderPass::kDepth: {

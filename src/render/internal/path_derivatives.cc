@@ -6,11 +6,16 @@ namespace render_internal {
 void PathDerivatives::SetVertex(int face, const Eigen::Vector3d& barycentrics,
                                 const Eigen::Vector3d& dir, double sign, bool track_point) {
   if (!vertices_) return;
-  const Eigen::Vector3i& corners = ctx_.scene.faces()[face];
-  const auto& p = ctx_.scene.positions();
-  corners_ = corners;
-  normal_ = NormalChain(p[corners[0]], p[corners[1]], p[corners[2]], sign);
-  if (track_point) point_.Advance(count_ == 0, dir, normal_.unit_normal(), barycentrics, corners);
+  if (ctx_.normal_jacobian != nullptr) {
+    normal_.SetSmooth(ctx_.scene, *ctx_.normal_jacobian, face, barycentrics, sign,
+                      ctx_.request->normal_sliding);
+    track_point = true;
+  } else {
+    normal_.SetFlat(ctx_.scene, face, sign);
+  }
+  if (track_point) {
+    point_.Advance(count_ == 0, dir, normal_.face_normal(), barycentrics, ctx_.scene.faces()[face]);
+  }
 }
 
 void PathDerivatives::AddContribution(const Eigen::Vector3d& prefix, const SurfaceMaterial& surface,
@@ -39,7 +44,9 @@ void PathDerivatives::AddContribution(const Eigen::Vector3d& prefix, const Surfa
   const Eigen::Vector3d base = prefix.cwiseProduct(light.q);
   const Eigen::Vector3d base_f = base.cwiseProduct(f);
   const Eigen::Matrix3d d_n = base_f * light.dc_dn.transpose() + light.c * base * dg_dn.transpose();
-  AddFace(corners_, normal_.Map(d_n));
+  scratch_.clear();
+  normal_.Map(d_n, point_, &scratch_);
+  AddVertices(scratch_, Eigen::Vector3d::Ones());
   if (light.follows_point && point_.valid) {
     const Eigen::Matrix3d d_x =
         base_f * light.dc_dx.transpose() + light.c * base * (dg_dwi.transpose() * light.dwi_dx);
@@ -49,8 +56,7 @@ void PathDerivatives::AddContribution(const Eigen::Vector3d& prefix, const Surfa
     }
   }
   for (int j = 0; j < count_; ++j) {
-    const Eigen::Vector3d w = excluded_[j].cwiseProduct(f_q);
-    AddFace(scatters_[j].corners, w.asDiagonal() * scatters_[j].ds_dcorners);
+    AddVertices(scatters_[j].ds_dvertices, excluded_[j].cwiseProduct(f_q));
   }
 }
 
@@ -92,8 +98,8 @@ void PathDerivatives::AddScatter(const Eigen::Vector3d& prefix, const SurfaceMat
     EvalGlossyWithGradient(surface.params, n, wo, wi, &dg_dn, &dg_dwi);
     const Eigen::Matrix3d ds_dn =
         (f * wi.transpose() + n.dot(wi) * Eigen::Vector3d::Ones() * dg_dn.transpose()) / pdf;
-    scatter.corners = corners_;
-    scatter.ds_dcorners = normal_.Map(ds_dn);
+    scatter.ds_dvertices.clear();
+    normal_.Map(ds_dn, point_, &scatter.ds_dvertices);
   }
   ++count_;
 }

@@ -17,6 +17,7 @@
 #include "src/render/derivatives.h"
 #include "src/render/geometry_derivatives.h"
 #include "src/render/internal/context.h"
+#include "src/render/internal/shading_normal.h"
 
 namespace sft {
 namespace render_internal {
@@ -134,9 +135,9 @@ struct LightTerm {
 // possibly zero factor is needed.
 //
 // Vertex coordinates enter (directions detached, so wo and sampled wi stay fixed) through the
-// normal n_k of every vertex's face — s_k, f_i and c depend on it — and, for point lights,
-// through the position x_i (wi = (L − x_i)/d, c), which moves with the faces hit before
-// (PointJacobian). Texel lookups are piecewise constant and contribute nothing.
+// shading normal n_k of every vertex (ShadingNormalChain) — s_k, f_i and c depend on it — and, for
+// point lights, through the position x_i (wi = (L − x_i)/d, c), which moves with the faces hit
+// before (PointJacobian). Texel lookups are piecewise constant and contribute nothing.
 class PathDerivatives {
  public:
   explicit PathDerivatives(const Context& ctx)
@@ -170,7 +171,9 @@ class PathDerivatives {
   }
 
   // The path reached a new vertex on face `face` (hit barycentrics `barycentrics`, ray direction
-  // `dir`), shaded with normal sign·n̂. `track_point`: keep x's Jacobian (point lights exist).
+  // `dir`), shaded with sign times its flat or smooth normal (ctx.options.shading).
+  // `track_point`: keep x's Jacobian (point lights or edge terms need it; smooth shading always
+  // does).
   void SetVertex(int face, const Eigen::Vector3d& barycentrics, const Eigen::Vector3d& dir,
                  double sign, bool track_point);
 
@@ -197,16 +200,17 @@ class PathDerivatives {
   struct Scatter {
     SurfaceMaterial surface;
     BsdfDerivatives d_s;
-    Eigen::Vector3i corners;
-    Eigen::Matrix<double, 3, 9> ds_dcorners;  // ∂s/∂(corner coordinates), rows = channels.
+    VertexGradients ds_dvertices;  // ∂s/∂(vertex coordinates), rows = channels.
   };
 
   void Emit(int param, const Eigen::Vector3d& d) {
     if (d[0] != 0.0 || d[1] != 0.0 || d[2] != 0.0) Add(param, d);
   }
-  void AddFace(const Eigen::Vector3i& corners, const Eigen::Matrix<double, 3, 9>& g) {
-    for (int j = 0; j < 3; ++j) {
-      for (int k = 0; k < 3; ++k) Emit(3 * corners[j] + k, g.col(3 * j + k));
+  // Emits weight ⊙ g for every (vertex, g) of `gradients` (weight: per channel).
+  void AddVertices(const VertexGradients& gradients, const Eigen::Vector3d& weight) {
+    for (const auto& [vertex, g] : gradients) {
+      const Eigen::Matrix3d wg = weight.asDiagonal() * g;
+      for (int k = 0; k < 3; ++k) Emit(3 * vertex + k, wg.col(k));
     }
   }
 
@@ -224,10 +228,10 @@ class PathDerivatives {
   int count_ = 0;
   Scatter scatters_[kMaxScatters];
   std::array<Eigen::Vector3d, kMaxScatters> excluded_;
-  // The current vertex's face and normal chain, and its position's Jacobian.
-  Eigen::Vector3i corners_ = Eigen::Vector3i::Zero();
-  NormalChain normal_;
+  // The current vertex's normal chain and its position's Jacobian.
+  ShadingNormalChain normal_;
   PointJacobian point_;
+  VertexGradients scratch_;  // the current contribution's normal terms.
 };
 
 }  // namespace render_internal

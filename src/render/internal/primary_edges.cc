@@ -1,6 +1,7 @@
 // Primary edges: the projection of every mesh edge where the image is discontinuous —
 // silhouettes (adjacent faces facing opposite ways from the camera), boundary and non-manifold
-// edges, and creases (flat shading: any edge whose faces are not coplanar). See edge_sampling.h.
+// edges, and creases (flat shading only: any edge whose faces are not coplanar; smooth shading is
+// continuous across them). See edge_sampling.h.
 #include <algorithm>
 #include <cmath>
 
@@ -122,11 +123,13 @@ std::vector<EdgeCandidate> PrimaryEdgeCandidates(const EdgeView& view) {
   const auto& positions = scene.positions();
   const auto& edges = scene.edges();
   std::vector<EdgeCandidate> candidates;
+  // Smooth shading is continuous across creases: only silhouettes (and boundaries) jump.
+  const bool flat = view.ctx.options.shading == Shading::kFlat;
   for (size_t e = 0; e < edges.size(); ++e) {
     const MeshEdge& edge = edges[e];
     const Eigen::Vector3d& a = positions[edge.v0];
     const Eigen::Vector3d& b = positions[edge.v1];
-    if (a == b || !IsDiscontinuityEdge(scene, edge, view.center, /*creases=*/true)) continue;
+    if (a == b || !IsDiscontinuityEdge(scene, edge, view.center, /*creases=*/flat)) continue;
     double s0, s1, length;
     if (!view.ClippedImageLength(a, b, &s0, &s1, &length) || !std::isfinite(length)) continue;
     candidates.push_back({static_cast<int>(e), s0, s1,

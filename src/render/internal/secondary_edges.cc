@@ -206,13 +206,15 @@ void SampleMeshEdge(const SecondaryVertex& v, double u_index, double u_point, Sa
                     PathDerivatives* path, RenderStats* stats) {
   const MeshEdgeTable& table = *v.ctx.secondary->mesh_edges;
   if (table.empty()) return;
+  // Creases jump only under flat shading (smooth normals are continuous across them).
+  const bool flat = v.ctx.options.shading == Shading::kFlat;
   auto edge_ends = [&](int c, Eigen::Vector3d* a, Eigen::Vector3d* b) {
     const MeshEdgeTable::Record& r = table.record(c);
     if (r.f0 == v.face || r.f1 == v.face) return false;
     *a = r.a.cast<double>();
     *b = r.b.cast<double>();
     if (!(std::max(v.n.dot(*a - v.x), v.n.dot(*b - v.x)) > 0.0)) return false;
-    return table.IsDiscontinuity(c, v.x, /*creases=*/v.indirect);
+    return table.IsDiscontinuity(c, v.x, /*creases=*/v.indirect && flat);
   };
   const SegmentCandidates candidates = DrawSegmentCandidates(
       NearEdgeMixture(table, v.face, v.x, v.n), kSecondaryCandidates, v.x, u_index, u_point,

@@ -293,7 +293,8 @@ std::vector<TexelCandidate> TexelCandidates(const EdgeView& view) {
   for (const TexelSegment& segment : *TexelSegments(scene, material, glossy)) {
     // A coplanar edge seen edge-on from the camera is a primary edge there.
     if (segment.edge >= 0 &&
-        IsDiscontinuityEdge(scene, scene.edges()[segment.edge], view.center, /*creases=*/true)) {
+        IsDiscontinuityEdge(scene, scene.edges()[segment.edge], view.center,
+                            /*creases=*/view.ctx.options.shading == Shading::kFlat)) {
       continue;
     }
     Eigen::Vector3d y0, y1;
