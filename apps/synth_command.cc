@@ -52,8 +52,8 @@ struct SynthOptions {
   bool environment_background = false;  // camera rays that miss see the probe.
   RenderOptions render;                 // spp, bounces, seed, threads of the target renders.
   std::string effects = "all";          // enabled effects (Effects::Parse).
-  // "smooth" (interpolated vertex normals: the object a mesh stands for) or "flat" (facets).
-  std::string shading = "smooth";
+  // "flat" (face normals) or "smooth" (interpolated vertex normals); docs/cli.md, "Shading".
+  std::string shading = "flat";
   bool overwrite = false;        // replace an existing, non-empty output directory.
   bool quiet = false;            // no progress line.
   bool ground = false;           // add a textured ground plane (rendered, not in gt/).
@@ -376,7 +376,7 @@ CommandRunner SetupSynthCommand(CLI::App* app) {
   app->add_option("--effects", opts->effects, "Enabled effects (see sft render --help)")
       ->capture_default_str();
   app->add_option("--shading", opts->shading,
-                  "smooth (interpolated vertex normals) or flat (face normals); recorded as "
+                  "flat (face normals) or smooth (interpolated vertex normals); recorded as "
                   "ground_truth.shading, which sft reconstruct follows")
       ->capture_default_str();
   app->add_option("--seed", opts->render.seed, "Sample seed")->capture_default_str();
