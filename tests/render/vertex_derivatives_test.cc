@@ -584,8 +584,12 @@ TEST(VertexDerivativesTest, GlossyPlane) {
 // ---------------------------------------------------------------------------------------------
 // (c) Hard cases: every Jacobian entry and gradient component finite, no crash.
 
+void ExpectFiniteOutputs(const RenderScene& scene, const Material& material, const ViewSetup& view,
+                         const RenderOptions& options, const DerivativeRequest& request,
+                         const std::string& name);
+
 // Renders rows and an adjoint gradient of vertex derivatives (all effects, a point light and an
-// environment, two bounces) and checks that everything is finite.
+// environment, two bounces), flat and smooth shaded, and checks that everything is finite.
 void ExpectFiniteDerivatives(const Geometry& g, const ViewSetup& base_view, double roughness,
                              const char* name) {
   const Material material = ConstantMaterial(static_cast<int>(g.faces.size()),
@@ -602,10 +606,22 @@ void ExpectFiniteDerivatives(const Geometry& g, const ViewSetup& base_view, doub
   request.params = ParameterSelection::Only(ParameterKind::kVertex);
   request.jacobian_rows = true;
   request.adjoint_weights = &weights;
-  RenderOptions options;
-  options.spp = 4;
-  options.bounces = 2;
   const RenderScene scene(g.positions, g.faces);
+  for (const Shading shading : {Shading::kFlat, Shading::kSmooth}) {
+    RenderOptions options;
+    options.spp = 4;
+    options.bounces = 2;
+    options.shading = shading;
+    ExpectFiniteOutputs(scene, material, view, options, request,
+                        std::string(name) + " (" + ShadingName(shading) + ")");
+  }
+}
+
+// One render of ExpectFiniteDerivatives: image, gradient and every row entry finite.
+void ExpectFiniteOutputs(const RenderScene& scene, const Material& material, const ViewSetup& view,
+                         const RenderOptions& options, const DerivativeRequest& request,
+                         const std::string& name) {
+  const int res = view.camera.width;
   Image image;
   DerivativeOutput out;
   RenderViewWithDerivatives(scene, material, view, options, request, 1, &image, &out);
