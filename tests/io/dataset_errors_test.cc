@@ -288,6 +288,29 @@ TEST(DatasetErrors, BadGroundTruth) {
   EXPECT_THAT(ReadError(scene), HasSubstr("ground_truth: expected an object"));
   scene["ground_truth"] = {{"mesh", 5}};
   EXPECT_THAT(ReadError(scene), HasSubstr("ground_truth.mesh: expected a string"));
+  scene["ground_truth"] = {{"shading", "phong"}};
+  EXPECT_THAT(ReadError(scene),
+              AllOf(HasSubstr("ground_truth.shading: expected \"flat\" or \"smooth\""),
+                    HasSubstr("phong")));
+  scene["ground_truth"] = {{"shading", 1}};
+  EXPECT_THAT(ReadError(scene), HasSubstr("ground_truth.shading: expected a string"));
+}
+
+// ground_truth.shading picks the shading of "auto"; without it a dataset is shaded smooth.
+TEST(DatasetErrors, ShadingFollowsGroundTruth) {
+  json scene = MinimalScene();
+  Dataset dataset;
+  ASSERT_TRUE(ParseSceneJson(scene.dump(), "d", &dataset).ok());
+  EXPECT_EQ(DatasetShading(dataset), Shading::kSmooth);
+  scene["ground_truth"] = {{"shading", "flat"}};
+  ASSERT_TRUE(ParseSceneJson(scene.dump(), "d", &dataset).ok());
+  EXPECT_EQ(DatasetShading(dataset), Shading::kFlat);
+  Shading shading = Shading::kFlat;
+  EXPECT_TRUE(ResolveShading("smooth", dataset, &shading));
+  EXPECT_EQ(shading, Shading::kSmooth);
+  EXPECT_TRUE(ResolveShading("auto", dataset, &shading));
+  EXPECT_EQ(shading, Shading::kFlat);
+  EXPECT_FALSE(ResolveShading("gouraud", dataset, &shading));
 }
 
 }  // namespace
