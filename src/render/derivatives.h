@@ -150,10 +150,10 @@ struct DerivativeRequest {
   double texel_edge_ratio = 0.125;
   // Smooth shading only: include the sliding term of the shading normal (the hit's barycentrics
   // change as its face moves under the ray; internal/shading_normal.h). It is part of the exact
-  // derivative (without it the finite-difference tests of smooth shading miss by 13–61%), but its
-  // per-sample values scale with the normal field's change across a face over the face's height
-  // and with 1/cos of the incidence, so on fine, curved meshes it carries most of the variance
-  // (docs/design-notes.md, "Smooth shading"). false: left out (biased, quieter).
+  // derivative, but its per-sample values scale with the normal field's change across a face
+  // over the face's height and with 1/cos of the incidence, so on fine, curved meshes it carries
+  // most of the variance (docs/design-notes.md, "Smooth shading"). false: left out (biased,
+  // quieter).
   bool normal_sliding = true;
 
   // True when valid; else *why names the field.

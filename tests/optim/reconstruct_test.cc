@@ -463,10 +463,14 @@ TEST(ReconstructConfigTest, KeysRoundTripAndUnknownKeysAreErrors) {
                                       {"laplacian", "cotangent"},
                                       {"linear_solver", "dense_qr"},
                                       {"views", {0, 2}},
-                                      {"fit_lights", true}},
+                                      {"fit_lights", true},
+                                      {"shading", "smooth"},
+                                      {"normal_sliding", false}},
                                      "cfg.json", &options)
                   .ok());
   EXPECT_EQ(options.solver.kind, SolverKind::kDogleg);
+  EXPECT_EQ(options.shading, "smooth");
+  EXPECT_FALSE(options.cache.edges.normal_sliding);
   EXPECT_EQ(options.solver.steps, 7);
   EXPECT_TRUE(options.regularizers.cotangent);
   const nlohmann::json all = ReconstructConfigJson(options);
@@ -483,6 +487,8 @@ TEST(ReconstructConfigTest, KeysRoundTripAndUnknownKeysAreErrors) {
   EXPECT_FALSE(status.ok());
   status = ApplyReconstructConfig({{"solver", "newton"}}, "cfg.json", &options);
   EXPECT_THAT(status.message(), ::testing::HasSubstr("solver"));
+  status = ApplyReconstructConfig({{"shading", "phong"}}, "cfg.json", &options);
+  EXPECT_THAT(status.message(), ::testing::HasSubstr("shading: expected auto, flat or smooth"));
 }
 
 TEST(FillUnsampledTexelsTest, CopiesInFaceNeighbours) {

@@ -4,10 +4,10 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
-#include <mutex>
 
 #include "src/render/internal/edge_sampling.h"
 #include "src/render/internal/sampling.h"
+#include "src/render/internal/scene_state_cache.h"
 
 namespace sft {
 namespace render_internal {
@@ -104,19 +104,7 @@ void MeshEdgeTable::BuildNearLists(const RenderScene& scene) {
 }
 
 std::shared_ptr<const MeshEdgeTable> MeshEdgeTable::Of(const RenderScene& scene) {
-  // The last build, shared by every view of a pass and both passes of an evaluation.
-  static std::mutex mutex;
-  static uint64_t cached_state = 0;
-  static std::shared_ptr<const MeshEdgeTable> cached;
-  {
-    std::lock_guard<std::mutex> lock(mutex);
-    if (cached != nullptr && cached_state == scene.state_id()) return cached;
-  }
-  auto built = std::make_shared<const MeshEdgeTable>(scene);
-  std::lock_guard<std::mutex> lock(mutex);
-  cached_state = scene.state_id();
-  cached = built;
-  return built;
+  return LastBuildFor<MeshEdgeTable>(scene);
 }
 
 }  // namespace render_internal

@@ -46,7 +46,7 @@ void PathDerivatives::AddContribution(const Eigen::Vector3d& prefix, const Surfa
   const Eigen::Matrix3d d_n = base_f * light.dc_dn.transpose() + light.c * base * dg_dn.transpose();
   scratch_.clear();
   normal_.Map(d_n, point_, &scratch_);
-  AddVertices(scratch_, Eigen::Vector3d::Ones());
+  AddVertices(scratch_);
   if (light.follows_point && point_.valid) {
     const Eigen::Matrix3d d_x =
         base_f * light.dc_dx.transpose() + light.c * base * (dg_dwi.transpose() * light.dwi_dx);

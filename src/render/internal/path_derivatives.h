@@ -206,6 +206,12 @@ class PathDerivatives {
   void Emit(int param, const Eigen::Vector3d& d) {
     if (d[0] != 0.0 || d[1] != 0.0 || d[2] != 0.0) Add(param, d);
   }
+  // Emits g for every (vertex, g) of `gradients`.
+  void AddVertices(const VertexGradients& gradients) {
+    for (const auto& [vertex, g] : gradients) {
+      for (int k = 0; k < 3; ++k) Emit(3 * vertex + k, g.col(k));
+    }
+  }
   // Emits weight ⊙ g for every (vertex, g) of `gradients` (weight: per channel).
   void AddVertices(const VertexGradients& gradients, const Eigen::Vector3d& weight) {
     for (const auto& [vertex, g] : gradients) {

@@ -4,9 +4,9 @@
 
 #include <algorithm>
 #include <cmath>
-#include <mutex>
 #include <tuple>
 
+#include "src/render/internal/scene_state_cache.h"
 #include "src/render/vertex_normals.h"
 
 namespace sft {
@@ -81,19 +81,7 @@ VertexNormalJacobian::VertexNormalJacobian(const RenderScene& scene) {
 }
 
 std::shared_ptr<const VertexNormalJacobian> VertexNormalJacobian::Of(const RenderScene& scene) {
-  // The last build, shared by every view of a pass and both passes of an evaluation.
-  static std::mutex mutex;
-  static uint64_t cached_state = 0;
-  static std::shared_ptr<const VertexNormalJacobian> cached;
-  {
-    std::lock_guard<std::mutex> lock(mutex);
-    if (cached != nullptr && cached_state == scene.state_id()) return cached;
-  }
-  auto built = std::make_shared<const VertexNormalJacobian>(scene);
-  std::lock_guard<std::mutex> lock(mutex);
-  cached_state = scene.state_id();
-  cached = built;
-  return built;
+  return LastBuildFor<VertexNormalJacobian>(scene);
 }
 
 }  // namespace render_internal
