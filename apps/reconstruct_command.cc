@@ -35,7 +35,7 @@ struct ReconstructCommandOptions {
   std::string resume;    // an earlier run's output directory to continue.
   std::string config;    // config JSON file.
   std::string material;  // initial material (JSON file or inline); "" = constant guess.
-  std::string phases, solver;
+  std::string phases, solver, effects;
   int outer = 0, steps = 0, spp = 0, bounces = 0, threads = 0;
   int64_t seed = 0;
   std::vector<int> views;
@@ -52,7 +52,8 @@ Status FlagKeys(const ReconstructCommandOptions& cli, ScheduleConfig* config) {
   const nlohmann::json all = {
       {"phases", cli.phases},   {"solver", cli.solver}, {"outer_iterations", cli.outer},
       {"steps", cli.steps},     {"spp", cli.spp},       {"bounces", cli.bounces},
-      {"threads", cli.threads}, {"seed", cli.seed},     {"views", cli.views}};
+      {"threads", cli.threads}, {"seed", cli.seed},     {"views", cli.views},
+      {"effects", cli.effects}};
   for (const auto& [key, value] : all.items()) {
     if (cli.given.count(key) == 0) continue;
     const Status status = MergeScheduleConfig({{key, value}}, "flag", config);
@@ -234,6 +235,10 @@ CommandRunner SetupReconstructCommand(CLI::App* app) {
       "steps");
   key_flag(app->add_option("--spp", opts->spp, "Samples per pixel of the fit's renders"), "spp");
   key_flag(app->add_option("--bounces", opts->bounces, "Path segments"), "bounces");
+  key_flag(app->add_option("--effects", opts->effects,
+                           "auto (the effect planner chooses; default) or a fixed list: "
+                           "direct,shadows,bounces,specular,environment | all"),
+           "effects");
   key_flag(app->add_option("--threads", opts->threads, "Render threads (0 = all cores)"),
            "threads");
   key_flag(app->add_option("--seed", opts->seed, "Base seed"), "seed");

@@ -58,6 +58,49 @@ Status AddStages(const nlohmann::json& stages, HtmlReport* html) {
   return html->AddImageRow(row);
 }
 
+// The effect planner's plan per outer iteration: one column per switch, "on", "off" or the bounce
+// count, with the measured changes in units of their thresholds (nothing when the effects were
+// fixed).
+void AddEffectPlans(const nlohmann::json& outer, HtmlReport* html) {
+  std::vector<std::string> header = {"outer", "stage", "planner s"};
+  std::vector<std::vector<std::string>> rows;
+  for (const auto& r : outer) {
+    if (!r.contains("effects") || !r["effects"].contains("decisions")) continue;
+    const nlohmann::json& plan = r["effects"];
+    if (rows.empty()) {
+      for (const auto& d : plan["decisions"]) header.push_back(d.value("name", "?"));
+    }
+    std::vector<std::string> row = {std::to_string(r.value("outer", 0)), r.value("stage", ""),
+                                    FormatNumber(plan.value("seconds", 0.0))};
+    for (const auto& d : plan["decisions"]) {
+      std::string cell = d.value("name", "") == "bounces"
+                             ? std::to_string(d.value("bounces", 1)) + " seg"
+                             : (d.value("on", false) ? "on" : "off");
+      if (d.value("reason", "") == "measured") {
+        // The change in units of the threshold, for the images and the step.
+        for (const char* key : {"image", "step"}) {
+          if (!d.contains(key) || !(d[key].value("threshold", 0.0) > 0.0)) continue;
+          cell += std::string(" ") + key + " " +
+                  FormatNumber(d[key].value("change", 0.0) / d[key].value("threshold", 1.0)) +
+                  "×, " + FormatNumber(100.0 * d[key].value("share", 0.0)) + "%";
+        }
+      } else {
+        cell += " (" + d.value("reason", "") + ")";
+      }
+      row.push_back(cell);
+    }
+    rows.push_back(row);
+  }
+  if (rows.empty()) return;
+  html->AddHeading("Effects chosen by the planner");
+  html->AddParagraph(
+      "Per outer iteration: each switch on or off, with its measured change of the images and "
+      "of the vertex gradient (step) in units of the noise threshold (noise_factor × the "
+      "seed-to-seed noise / √outer iterations) and as a share of the values' RMS; a switch stays "
+      "on when either is exceeded (1× or planner_max_share), or why it was not measured.");
+  html->AddTable(header, rows);
+}
+
 }  // namespace
 
 Status WriteReconstructReport(const std::string& out, const Dataset& dataset,
@@ -100,6 +143,7 @@ Status WriteReconstructReport(const std::string& out, const Dataset& dataset,
   html.AddSvg(LineChartSvg(psnr));
   AddReferenceCharts(outer_records, &html);
   SFT_RETURN_IF_ERROR(AddStages(stage_records, &html));
+  AddEffectPlans(outer_records, &html);
   html.AddHeading("Views at the final state");
   const std::vector<Image> renders = reconstruction->RenderViews(/*seed=*/0x5f7eed);
   const RenderCache& cache = reconstruction->cache();

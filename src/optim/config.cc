@@ -87,10 +87,40 @@ const std::map<std::string, Key>& Keys() {
       {"threads", Int([](O* o) -> int& { return o->cache.render.threads; }, 0, 1024)},
       {"effects", Choice(
                       [](const std::string& s, O* o) -> std::string {
+                        // "auto": every effect is a candidate and the planner chooses.
+                        o->planner.enabled = s == "auto";
+                        if (o->planner.enabled) {
+                          o->cache.render.effects = Effects();
+                          return "";
+                        }
                         std::string why;
                         return Effects::Parse(s, &o->cache.render.effects, &why) ? "" : why;
                       },
-                      [](const O& o) { return o.cache.render.effects.ToString(); })},
+                      [](const O& o) {
+                        return o.planner.enabled ? std::string("auto")
+                                                 : o.cache.render.effects.ToString();
+                      })},
+      {"pin",
+       {[](const json& v, O* o) -> std::string {
+          if (!v.is_object()) return "expected an object of effect names and true/false";
+          o->planner.pins.clear();
+          for (const auto& [name, on] : v.items()) {
+            if (!on.is_boolean()) return name + ": expected true or false";
+            o->planner.pins[name] = on.get<bool>();
+          }
+          std::string why;
+          if (o->planner.Check(&why)) return "";
+          return why.rfind("pin: ", 0) == 0 ? why.substr(5) : why;
+        },
+        [](const O& o) {
+          json pins = json::object();
+          for (const auto& [name, on] : o.planner.pins) pins[name] = on;
+          return pins;
+        }}},
+      {"planner_views", Int([](O* o) -> int& { return o->planner.views; }, 1, 1000)},
+      {"planner_noise_factor",
+       Real([](O* o) -> double& { return o->planner.noise_factor; }, 0, 100)},
+      {"planner_max_share", Real([](O* o) -> double& { return o->planner.max_share; }, 0, 1)},
       {"shading", Choice(
                       [](const std::string& s, O* o) -> std::string {
                         if (s != "auto" && s != "flat" && s != "smooth")

@@ -64,7 +64,8 @@ ReconstructOptions::ReconstructOptions() {
 }
 
 bool ReconstructOptions::Check(std::string* why) const {
-  if (!cache.Check(why) || !problem.Check(why) || !solver.Check(why) || !regularizers.Check(why)) {
+  if (!cache.Check(why) || !problem.Check(why) || !solver.Check(why) || !regularizers.Check(why) ||
+      !planner.Check(why)) {
     return false;
   }
   if (outer_iterations < 1 || outer_iterations > 10000) {
@@ -138,6 +139,25 @@ Status Reconstruction::Create(const Dataset& dataset, const TriMesh& mesh, const
   r->start_time_ = NowSeconds();
   *out = std::move(r);
   return Status::Ok();
+}
+
+Status Reconstruction::PlanEffects(int outer, EffectPlanReport* report) {
+  PlannerContext context;
+  context.ceiling = EffectPlan::From(options_.cache.render, options_.cache.edges);
+  context.geometry_phase = options_.phases != PhaseSchedule::kTexture;
+  context.fit_specular = options_.fit_specular;
+  context.outer_iterations = options_.outer_iterations;
+  for (const LightSpec& light : dataset_->lights) {
+    if (light.type == LightType::kEnvironment) {
+      context.has_environment = true;
+    } else {
+      context.has_point_lights = true;
+    }
+  }
+  context.specular_nonzero = CurrentMaterial().specular > 0.0;
+  // Seeds apart from the fit's (options_.seed * 7919 + 2 * outer + phase).
+  context.seed = options_.seed * 104729ull + 1000003ull * (static_cast<uint64_t>(outer) + 1);
+  return sft::PlanEffects(options_.planner, context, cache_.get(), report);
 }
 
 Status Reconstruction::RunOuter(int outer,

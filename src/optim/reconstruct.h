@@ -14,6 +14,7 @@
 #include "src/geometry/mesh.h"
 #include "src/io/dataset.h"
 #include "src/io/scene_setup.h"
+#include "src/optim/effect_planner.h"
 #include "src/optim/regularizers.h"
 #include "src/optim/render_cache.h"
 #include "src/optim/solvers.h"
@@ -25,10 +26,13 @@ bool PhaseScheduleFromName(const std::string& name, PhaseSchedule* schedule);
 const char* PhaseScheduleName(PhaseSchedule schedule);
 
 struct ReconstructOptions {
-  RenderCacheOptions cache;         // render (spp, bounces, effects, threads), pyramid, mask.
-  ProblemOptions problem;           // supersets and bounds.
-  SolverOptions solver;             // which solver and its options.
-  RegularizerOptions regularizers;  // Laplacian and texel smoothness weights.
+  RenderCacheOptions cache;  // render (spp, bounces, effects, threads), pyramid, mask.
+  // "effects": "auto": the planner chooses, before every outer iteration, which of cache's
+  // effects and edge budgets (the ceiling) the fit uses. Disabled = they are used as configured.
+  EffectPlannerOptions planner;
+  ProblemOptions problem;                            // supersets and bounds.
+  SolverOptions solver;                              // which solver and its options.
+  RegularizerOptions regularizers;                   // Laplacian and texel smoothness weights.
   PhaseSchedule phases = PhaseSchedule::kAlternate;  // texture, geometry or both alternating.
   int outer_iterations = 4;   // outer iterations (fresh seeds each), [1, 10000].
   bool fit_specular = false;  // the texture phase also fits the specular weight.
@@ -70,6 +74,10 @@ class Reconstruction {
   static Status Create(const Dataset& dataset, const TriMesh& mesh, const Material& material,
                        const std::vector<double>& light_scales, const ReconstructOptions& options,
                        std::unique_ptr<Reconstruction>* out);
+
+  // Runs the effect planner for outer iteration `outer` (its renders use the chosen plan from
+  // now on). The ceiling is the configured effects and budgets.
+  Status PlanEffects(int outer, EffectPlanReport* report);
 
   // Runs outer iteration `outer` (its phases). `on_iteration` is called after every solver
   // iteration; returning false stops the run (the state so far is kept).

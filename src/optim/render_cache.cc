@@ -169,7 +169,7 @@ Status RenderCache::Create(const Dataset& dataset, const DatasetViews* views,
 }
 
 void RenderCache::PrepareForEvaluation(bool evaluate_jacobians, bool new_evaluation_point) {
-  if (new_evaluation_point || (evaluate_jacobians && !has_rows_)) Render(/*rows=*/true);
+  if (stale_ || new_evaluation_point || (evaluate_jacobians && !has_rows_)) Render(/*rows=*/true);
 }
 
 void RenderCache::UpdateScene() {
@@ -210,6 +210,7 @@ Image RenderCache::RenderPassImage(int v, RenderPass pass) {
 
 void RenderCache::Render(bool rows) {
   UpdateScene();
+  stale_ = false;
   finite_ = true;
   non_finite_ = 0;
   RenderOptions render = options_.render;
@@ -241,6 +242,23 @@ void RenderCache::Render(bool rows) {
     ++renders_;
   }
   has_rows_ = rows && active_.Any();
+}
+
+void RenderCache::RenderSome(const std::vector<int>& views) {
+  UpdateScene();
+  RenderOptions render = options_.render;
+  render.seed = seed_;
+  for (int v : views) {
+    const auto start = std::chrono::steady_clock::now();
+    Image image;
+    RenderStats stats;
+    RenderView(*scene_, material_, ScaledView(v), render, &image, &stats);
+    render_seconds_ += Seconds(start);
+    StoreRender(v, image, nullptr);
+    ++renders_;
+  }
+  has_rows_ = false;
+  stale_ = true;
 }
 
 void RenderCache::StoreRender(int v, const Image& image, const JacobianRows* rows) {
@@ -361,10 +379,16 @@ Image RenderCache::AdjointWeights(int v) const {
 }
 
 bool RenderCache::AddAdjointGradient(int v, const Image& weights, std::vector<double>* gradient) {
+  return AddAdjointGradientWith(v, weights, plan(), seed_, gradient);
+}
+
+bool RenderCache::AddAdjointGradientWith(int v, const Image& weights, const EffectPlan& plan,
+                                         uint64_t seed, std::vector<double>* gradient) {
   UpdateScene();
   RenderOptions render = options_.render;
-  render.seed = seed_;
   DerivativeRequest request = options_.edges;
+  plan.ApplyTo(&render, &request);
+  render.seed = seed;
   request.params = active_.ToSelection();
   request.adjoint_weights = &weights;
   const auto start = std::chrono::steady_clock::now();
@@ -384,6 +408,22 @@ bool RenderCache::AddAdjointGradient(int v, const Image& weights, std::vector<do
     (*gradient)[i] += g;
   }
   return finite;
+}
+
+bool RenderCache::RenderWith(int v, const EffectPlan& plan, uint64_t seed, Image* image) {
+  UpdateScene();
+  RenderOptions render = options_.render;
+  DerivativeRequest unused = options_.edges;
+  plan.ApplyTo(&render, &unused);
+  render.seed = seed;
+  const auto start = std::chrono::steady_clock::now();
+  Image rendered;
+  RenderStats stats;
+  RenderView(*scene_, material_, ScaledView(v), render, &rendered, &stats);
+  render_seconds_ += Seconds(start);
+  ++renders_;
+  *image = ToRgb(rendered);
+  return stats.NonFinite() == 0;
 }
 
 }  // namespace sft

@@ -22,6 +22,7 @@
 #include "src/core/status.h"
 #include "src/io/dataset.h"
 #include "src/io/scene_setup.h"
+#include "src/optim/effect_planner.h"
 #include "src/optim/parameters.h"
 #include "src/optim/pyramid.h"
 #include "src/render/render.h"
@@ -84,11 +85,32 @@ class RenderCache : public ceres::EvaluationCallback {
   Image RenderPassImage(int v, RenderPass pass);
   // Renders every view at the current parameters: rows of the `active` kinds when `rows`.
   void Render(bool rows);
+  // Renders and stores only `views` (no rows), e.g. for their AdjointWeights; the next evaluation
+  // renders every view anew.
+  void RenderSome(const std::vector<int>& views);
   // The seed of the renders from now on (a new outer iteration).
-  void SetSeed(uint64_t seed) { seed_ = seed; }
+  void SetSeed(uint64_t seed) {
+    stale_ = stale_ || seed != seed_;
+    seed_ = seed;
+  }
   uint64_t seed() const { return seed_; }
   void SetActive(const ActiveParameters& active) { active_ = active; }
   const ActiveParameters& active() const { return active_; }
+  // The effects and derivative budgets of the renders from now on (the effect planner's result).
+  // The stored render no longer matches them: the next evaluation renders anew.
+  void SetPlan(const EffectPlan& plan) {
+    plan.ApplyTo(&options_.render, &options_.edges);
+    stale_ = true;
+  }
+  EffectPlan plan() const { return EffectPlan::From(options_.render, options_.edges); }
+  const RenderCacheOptions& options() const { return options_; }
+
+  // For measurements at the fit's scale (the effect planner): view v's colour image (RGB, level
+  // 0) under `plan` with `seed`, not stored. False when the render is not finite.
+  bool RenderWith(int v, const EffectPlan& plan, uint64_t seed, Image* image);
+  // Like AddAdjointGradient, under `plan` with `seed`.
+  bool AddAdjointGradientWith(int v, const Image& weights, const EffectPlan& plan, uint64_t seed,
+                              std::vector<double>* gradient);
 
   int num_views() const { return static_cast<int>(levels_.size()); }
   int num_levels(int v) const { return static_cast<int>(levels_[v].size()); }
@@ -148,6 +170,7 @@ class RenderCache : public ceres::EvaluationCallback {
   uint64_t seed_ = 0;
   bool finite_ = true;
   bool has_rows_ = false;
+  bool stale_ = false;  // the stored render is not of the current seed or plan.
   int64_t non_finite_ = 0;
   int64_t renders_ = 0;
   double render_seconds_ = 0.0;

@@ -48,10 +48,6 @@ bool StageOptions::Check(std::string* why) const {
     *why = "texel_resolution: must be in [0, 64] or auto";
     return false;
   }
-  if (effect_plan != "fixed") {
-    *why = "effect_plan: only \"fixed\" is available";
-    return false;
-  }
   if (material_model != "mesh_colors") {
     *why = "material_model: only \"mesh_colors\" is available";
     return false;
@@ -279,9 +275,28 @@ Status Schedule::FinishStage() {
   return Status::Ok();
 }
 
+// The effect planner before an outer iteration (when the stage's effects are "auto"): console
+// lines for what changed, the report for metrics.json.
+Status Schedule::PlanEffects(const ScheduleCallbacks& callbacks, json* record) {
+  const StageOptions& stage = stages_[progress_.stage];
+  if (!stage.fit.planner.enabled) return Status::Ok();
+  EffectPlanReport report;
+  SFT_RETURN_IF_ERROR(reconstruction_->PlanEffects(progress_.outer_done, &report));
+  if (callbacks.on_event) {
+    for (const std::string& line : PlanChangeLines(report, last_plan_.get())) {
+      callbacks.on_event(stage.name + ": " + line);
+    }
+  }
+  *record = report.ToJson();
+  last_plan_ = std::make_unique<EffectPlanReport>(report);
+  return Status::Ok();
+}
+
 Status Schedule::RunStageOuter(const ScheduleCallbacks& callbacks, bool* stop) {
   const StageOptions& stage = stages_[progress_.stage];
   const int outer = progress_.outer_done;
+  json plan_record;
+  SFT_RETURN_IF_ERROR(PlanEffects(callbacks, &plan_record));
   SFT_RETURN_IF_ERROR(reconstruction_->RunOuter(outer, [&](const IterationRecord& record) {
     IterationRecord r = record;
     r.stage = stage.name;
@@ -299,6 +314,7 @@ Status Schedule::RunStageOuter(const ScheduleCallbacks& callbacks, bool* stop) {
   }
   json record;
   SFT_RETURN_IF_ERROR(OuterRecord(callbacks, outer, &record));
+  if (!plan_record.is_null()) record["effects"] = plan_record;
   outer_records_.push_back(record);
   const bool stage_done = progress_.stage_outer_done >= stage.fit.outer_iterations;
   // CountSelfIntersectingFaces is -1 when CGAL fails: no evidence of folds then.

@@ -38,8 +38,7 @@ struct StageOptions {
   // re-projected (after a topology change).
   int texel_resolution = 0;
   TopologyOptions topology;  // remeshing / resampling before the stage, and on folds.
-  // Slots for the next stages of the project; each accepts its one current value:
-  std::string effect_plan = "fixed";           // "fixed": the effects as configured.
+  // Slot for UV textures; accepts its one current value:
   std::string material_model = "mesh_colors";  // "mesh_colors": per-face texel grids.
 
   bool Check(std::string* why) const;
@@ -115,6 +114,7 @@ class Schedule {
   Status CreateReconstruction();
   Status RunStageOuter(const ScheduleCallbacks& callbacks, bool* stop);
   Status ChangeTopology(TopologyChange change, const ScheduleCallbacks& callbacks);
+  Status PlanEffects(const ScheduleCallbacks& callbacks, nlohmann::json* record);
   Status OuterRecord(const ScheduleCallbacks& callbacks, int outer, nlohmann::json* out);
   Status FinishStage();
   Status Checkpoint();
@@ -134,6 +134,8 @@ class Schedule {
   nlohmann::json outer_records_ = nlohmann::json::array();
   nlohmann::json topology_records_ = nlohmann::json::array();
   nlohmann::json stage_records_ = nlohmann::json::array();
+  // The effect planner's last report in this session (console lines name only changes).
+  std::unique_ptr<EffectPlanReport> last_plan_;
   size_t phases_seen_ = 0;      // phase records of reconstruction_ already collected.
   double session_start_ = 0.0;  // steady-clock seconds when this session's Run began.
   double seconds_at_start_ = 0.0;

@@ -108,8 +108,6 @@ const std::map<std::string, StageKey>& StageKeys() {
           return "";
         },
         [](const S& s) { return json(s.topology.max_faces); }}},
-      {"effect_plan", OneOf([](S* s) -> std::string& { return s->effect_plan; }, {"fixed"},
-                            " (the effect planner is not available yet)")},
       {"material_model", OneOf([](S* s) -> std::string& { return s->material_model; },
                                {"mesh_colors"}, " (UV textures are not available yet)")},
   };
@@ -136,6 +134,8 @@ Status ApplyStageConfig(const json& keys, const std::string& source, StageOption
       stage->name = value.get<std::string>();
       continue;
     }
+    // state.json of runs before the effect planner: its "effects" list already says "fixed".
+    if (name == "effect_plan" && value == "fixed") continue;
     const auto it = StageKeys().find(name);
     if (it != StageKeys().end()) {
       const std::string why = it->second.set(value, stage);

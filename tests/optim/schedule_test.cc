@@ -87,7 +87,10 @@ TEST(ScheduleConfigTest, ErrorsNameTheStageAndKey) {
   EXPECT_THAT(error(R"({"stages": []})"), HasSubstr("stages: expected a non-empty array"));
   EXPECT_THAT(error(R"({"schedule": "fast"})"), HasSubstr("schedule: expected auto"));
   EXPECT_THAT(error(R"({"name": "x"})"), HasSubstr("name: a stage key"));
-  EXPECT_THAT(error(R"({"effect_plan": "auto"})"), HasSubstr("effect_plan: expected fixed"));
+  EXPECT_THAT(error(R"({"effect_plan": "auto"})"), HasSubstr("effect_plan: unknown key"));
+  EXPECT_THAT(error(R"({"pin": {"shadowz": true}})"), HasSubstr("pin: unknown effect 'shadowz'"));
+  EXPECT_THAT(error(R"({"pin": {"shadows": 1}})"),
+              HasSubstr("pin: shadows: expected true or false"));
   EXPECT_THAT(error(R"({"texel_resolution": 65})"), HasSubstr("texel_resolution"));
 }
 
@@ -209,11 +212,20 @@ TEST_F(ScheduleRunTest, StagesRunInOrderWithCheckpoints) {
   // The weights add up to at most the ETA's total (a solve may stop early when it converges).
   EXPECT_LE(done, work);
   EXPECT_GT(done, work / 2);
-  // One line per stage start, and one per texel-resolution change (the second stage doubles it).
-  ASSERT_EQ(events.size(), 3u);
-  EXPECT_THAT(events[0], HasSubstr("stage 1/2 coarse"));
-  EXPECT_THAT(events[1], HasSubstr("stage 2/2 fine"));
-  EXPECT_THAT(events[2], HasSubstr("texels: mesh-colours resolution"));
+  // One line per stage start, one per texel-resolution change (the second stage doubles it),
+  // and the effect planner's (the default "effects": "auto"): the convex icosphere does not
+  // shadow itself, so the first plan drops shadows and later plans change nothing.
+  std::vector<std::string> planner_lines, other_lines;
+  for (const std::string& line : events) {
+    (line.find("effects: ") != std::string::npos ? planner_lines : other_lines).push_back(line);
+  }
+  ASSERT_EQ(other_lines.size(), 3u);
+  EXPECT_THAT(other_lines[0], HasSubstr("stage 1/2 coarse"));
+  EXPECT_THAT(other_lines[1], HasSubstr("stage 2/2 fine"));
+  EXPECT_THAT(other_lines[2], HasSubstr("texels: mesh-colours resolution"));
+  ASSERT_EQ(planner_lines.size(), 1u);
+  EXPECT_THAT(planner_lines[0],
+              HasSubstr("coarse: effects: shadows off (image change 0: noise threshold "));
   const auto& records = schedule->records();
   ASSERT_FALSE(records.empty());
   EXPECT_EQ(records.front().stage, "coarse");
@@ -233,6 +245,11 @@ TEST_F(ScheduleRunTest, StagesRunInOrderWithCheckpoints) {
   EXPECT_EQ(metrics["outer"].size(), 3u);
   EXPECT_EQ(metrics["outer"][0]["stage"], "coarse");
   EXPECT_EQ(metrics["outer"][0]["self_intersecting_faces"], 0);
+  for (const json& outer : metrics["outer"]) {
+    EXPECT_EQ(outer["effects"]["plan"], "direct 1seg | edges: primary texel");
+    EXPECT_EQ(outer["effects"]["decisions"].size(), 8u);
+    EXPECT_GT(outer["effects"]["seconds"].get<double>(), 0.0);
+  }
   EXPECT_EQ(metrics["stages"].size(), 2u);
 
   // Texel resolution in the checkpoint: the material file carries resolution 2.
