@@ -94,7 +94,9 @@ const std::map<std::string, Key>& Keys() {
                           return "";
                         }
                         std::string why;
-                        return Effects::Parse(s, &o->cache.render.effects, &why) ? "" : why;
+                        if (Effects::Parse(s, &o->cache.render.effects, &why)) return "";
+                        // Parse names the field itself ("effects: unknown effect ...").
+                        return why.rfind("effects: ", 0) == 0 ? why.substr(9) : why;
                       },
                       [](const O& o) {
                         return o.planner.enabled ? std::string("auto")

@@ -80,6 +80,11 @@ TEST(EffectPlanTest, ConfigKeys) {
   EXPECT_EQ(bad.message(),
             "cfg.json: pin: unknown effect 'bounce' (known: environment, specular, shadows, "
             "bounces, primary_edges, shadow_edges, texel_edges, secondary_edges)");
+  EXPECT_EQ(ApplyReconstructConfig(nlohmann::json::parse(R"({"effects": "direct,glow"})"),
+                                   "cfg.json", &options)
+                .message(),
+            "cfg.json: effects: unknown effect 'glow' (known: direct, shadows, bounces, "
+            "specular, environment, all, none)");
   EXPECT_THAT(ApplyReconstructConfig(nlohmann::json::parse(R"({"planner_noise_factor": -1})"),
                                      "cfg.json", &options)
                   .message(),
