@@ -34,21 +34,28 @@ using Sample = std::vector<double>;
 // The two-seed estimates of the file comment for a reference A and a variant B.
 struct Comparison {
   double change = 0.0;  // sqrt(max(0, mean[(A1 − B1)(A2 − B2)])).
+  // sqrt(2 × the standard error of that mean): smaller changes are not distinguishable from 0.
+  double floor = 0.0;
   double noise = 0.0;   // sqrt(mean[(A1 − A2)²] / 2).
   double signal = 0.0;  // sqrt(max(0, mean[A1 · A2])).
 };
 
 Comparison Compare(const Sample (&a)[2], const Sample (&b)[2]) {
-  double cross = 0.0, diff2 = 0.0, product = 0.0;
+  double cross = 0.0, cross2 = 0.0, diff2 = 0.0, product = 0.0;
   const size_t n = a[0].size();
   for (size_t i = 0; i < n; ++i) {
-    cross += (a[0][i] - b[0][i]) * (a[1][i] - b[1][i]);
+    const double p = (a[0][i] - b[0][i]) * (a[1][i] - b[1][i]);
+    cross += p;
+    cross2 += p * p;
     diff2 += (a[0][i] - a[1][i]) * (a[0][i] - a[1][i]);
     product += a[0][i] * a[1][i];
   }
   Comparison c;
   if (n == 0) return c;
-  c.change = std::sqrt(std::max(0.0, cross / n));
+  const double mean = cross / n;
+  const double standard_error = std::sqrt(std::max(0.0, cross2 / n - mean * mean) / n);
+  c.change = std::sqrt(std::max(0.0, mean));
+  c.floor = std::sqrt(2.0 * standard_error);
   c.noise = std::sqrt(diff2 / (2.0 * n));
   c.signal = std::sqrt(std::max(0.0, product / n));
   return c;
@@ -157,6 +164,7 @@ Status Measure(const EffectPlannerOptions& options, const PlannerContext& contex
     const Comparison c = Compare(a, b);
     m->measured = true;
     m->change = c.change;
+    m->floor = c.floor;
     m->noise = c.noise;
     m->noise_without = Compare(b, b).noise;
     m->signal = c.signal;
@@ -378,6 +386,7 @@ json EffectPlanReport::ToJson() const {
                     {"threshold", m->threshold},
                     {"share_limit", m->share_limit},
                     {"noise_without", m->noise_without},
+                    {"floor", m->floor},
                     {"share", m->signal > 0.0 ? m->change / m->signal : 0.0},
                     {"matters", m->Matters()}};
     }
@@ -464,9 +473,10 @@ std::vector<std::string> PlanChangeLines(const EffectPlanReport& report,
         char part[160];
         std::snprintf(part, sizeof(part),
                       "%s change %.3g: noise threshold %.3g, %.1f%% of the signal, added noise "
-                      "%.3g",
+                      "%.3g, floor %.3g",
                       key, m->change, m->threshold,
-                      m->signal > 0.0 ? 100.0 * m->change / m->signal : 0.0, m->AddedNoise());
+                      m->signal > 0.0 ? 100.0 * m->change / m->signal : 0.0, m->AddedNoise(),
+                      m->floor);
         parts += (parts.empty() ? "" : "; ") + std::string(part);
       }
       line += parts + ")";

@@ -28,11 +28,14 @@
 // (edge terms) is also dropped when it adds more variance than it removes bias from what the stage
 // averages: change² · K ≤ σ_A² − σ_B² (the expected squared error of the stage's average is
 // bias² + σ²/K). Measured on the bunny, dropping secondary edges so made the fit both faster and
-// more accurate. Image effects are judged on the
-// images first and, when those do not show that the effect matters, on the gradient. Decisions are
-// greedy: each effect is measured against the plan with the earlier drops applied, so that two
-// effects that are each negligible but not together are not both dropped. The bounce count goes
-// down from the configured one while the last bounce does not matter.
+// more accurate. Finally the change must be distinguishable from 0: change² above two standard
+// errors of its own estimate (the mean of n products), else a switch that changes nothing but
+// which random numbers a path uses shows a spurious change of a few percent of the signal. Image
+// effects are judged on the images first and, when those do not show that the effect matters, on
+// the gradient. Decisions are greedy: each effect is measured against the plan with the earlier
+// drops applied, so that two effects that are each negligible but not together are not both
+// dropped. The bounce count goes down from the configured one while the last bounce does not
+// matter.
 //
 // An effect whose parameters the stage fits is kept (specular when fit_specular: without the
 // lobe its weight has no derivative); an effect absent from the scene (no environment light, a
@@ -110,8 +113,10 @@ struct EffectMeasurement {
   int outer_iterations = 1;    // K.
   // Above the noise or too large a share to leave out, and larger than the noise the switch
   // itself adds (the file comment).
+  double floor = 0.0;  // changes up to this are not distinguishable from 0 (2 SE).
   bool Matters() const {
-    return measured && (change > threshold || change > share_limit) && change > AddedNoise();
+    return measured && change > floor && (change > threshold || change > share_limit) &&
+           change > AddedNoise();
   }
   // sqrt(max(0, σ² − σ_without²) / K): the noise the switch adds to the stage's average.
   double AddedNoise() const {

@@ -124,12 +124,17 @@ class EffectPlannerTest : public ::testing::Test {
   // Plans at the true mesh and material of dataset `name` with `config` keys.
   EffectPlanReport Plan(const std::string& name, const std::string& config,
                         EffectPlan* cache_plan = nullptr) {
+    return PlanAt(dir_->Join(name), dir_->Join(name + "/gt/material.json"), config, cache_plan);
+  }
+  // Plans at the true mesh of the dataset in `dir` with material `material` (file or JSON).
+  EffectPlanReport PlanAt(const std::string& dir, const std::string& material_spec,
+                          const std::string& config, EffectPlan* cache_plan = nullptr) {
     Dataset dataset;
-    EXPECT_TRUE(ReadDataset(dir_->Join(name), &dataset).ok());
+    EXPECT_TRUE(ReadDataset(dir, &dataset).ok());
     TriMesh mesh;
-    EXPECT_TRUE(ReadMesh(dir_->Join(name + "/gt/mesh.ply"), &mesh).ok());
+    EXPECT_TRUE(ReadMesh(dir + "/gt/mesh.ply", &mesh).ok());
     Material material;
-    EXPECT_TRUE(LoadMaterial(dir_->Join(name + "/gt/material.json"), mesh, &material).ok());
+    EXPECT_TRUE(LoadMaterial(material_spec, mesh, &material).ok());
     ReconstructOptions options;
     options.cache.render.threads = 2;
     EXPECT_TRUE(ApplyReconstructConfig(nlohmann::json::parse(config), "test", &options).ok());
@@ -177,6 +182,25 @@ TEST_F(EffectPlannerTest, ConvexDiffuseFlashLitObjectNeedsNeitherBouncesNorShado
   EXPECT_EQ(report.plan.Summary(), "direct 1seg | edges: primary");
   EXPECT_GT(report.seconds, 0.0);
   EXPECT_EQ(report.views, 2);
+}
+
+// Lit by a studio probe (Cycles dataset), a convex sphere: the environment is all of the image;
+// the sphere shadows no part of itself and bounces leave it, so both change nothing
+// distinguishable from 0 and are dropped.
+TEST_F(EffectPlannerTest, EnvironmentLitConvexSphereNeedsNoShadows) {
+  const EffectPlanReport report =
+      PlanAt(testing::DataDir() + "/cycles/sphere_env_studio",
+             R"({"albedo": [0.5, 0.5, 0.5], "roughness": 0.5})", R"({"spp": 8})");
+  const EffectDecision& environment = Find(report, "environment");
+  EXPECT_TRUE(environment.on);
+  EXPECT_GT(environment.image.change, 0.5 * environment.image.signal);
+  const EffectDecision& shadows = Find(report, "shadows");
+  EXPECT_EQ(shadows.reason, "measured");
+  EXPECT_FALSE(shadows.on);
+  EXPECT_EQ(shadows.image.change, 0.0);
+  EXPECT_LE(shadows.step.change, shadows.step.floor);
+  EXPECT_EQ(Find(report, "bounces").bounces, 1);
+  EXPECT_TRUE(Find(report, "primary_edges").on);
 }
 
 TEST_F(EffectPlannerTest, LightBouncingInsideACornerIsKept) {
