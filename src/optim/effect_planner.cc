@@ -160,7 +160,7 @@ Status Measure(const EffectPlannerOptions& options, const PlannerContext& contex
                const EffectPlan& plan, const EffectPlan& variant, bool image, bool step,
                Measurer* measurer, References* refs, References* variant_refs,
                EffectDecision* decision, bool* matters) {
-  auto fill = [&](const Sample(&a)[2], const Sample(&b)[2], EffectMeasurement* m) {
+  auto fill = [&](const Sample(&a)[2], const Sample(&b)[2], double scale, EffectMeasurement* m) {
     const Comparison c = Compare(a, b);
     m->measured = true;
     m->change = c.change;
@@ -169,7 +169,7 @@ Status Measure(const EffectPlannerOptions& options, const PlannerContext& contex
     m->noise_without = Compare(b, b).noise;
     m->signal = c.signal;
     m->threshold = Threshold(options, context, c.noise);
-    m->share_limit = options.max_share * c.signal;
+    m->share_limit = options.max_share * std::max(c.signal, scale);
     m->outer_iterations = std::max(1, context.outer_iterations);
   };
   variant_refs->Invalidate();
@@ -180,7 +180,7 @@ Status Measure(const EffectPlannerOptions& options, const PlannerContext& contex
     refs->have_image = true;
     SFT_RETURN_IF_ERROR(measurer->Images(variant, variant_refs->image));
     variant_refs->have_image = true;
-    fill(refs->image, variant_refs->image, &decision->image);
+    fill(refs->image, variant_refs->image, context.image_signal_scale, &decision->image);
   }
   *matters = decision->image.Matters();
   if (step && !*matters) {
@@ -188,7 +188,7 @@ Status Measure(const EffectPlannerOptions& options, const PlannerContext& contex
     refs->have_step = true;
     SFT_RETURN_IF_ERROR(measurer->Gradients(variant, variant_refs->step));
     variant_refs->have_step = true;
-    fill(refs->step, variant_refs->step, &decision->step);
+    fill(refs->step, variant_refs->step, context.step_signal_scale, &decision->step);
     *matters = decision->step.Matters();
   }
   return Status::Ok();
@@ -436,6 +436,8 @@ Status PlanEffects(const EffectPlannerOptions& options, const PlannerContext& co
       SFT_RETURN_IF_ERROR(DecideSwitch(name, image ? "image" : "step", options, context, &measurer,
                                        &refs, &plan, &decision));
     }
+    report->image_signal = std::max(report->image_signal, decision.image.signal);
+    report->step_signal = std::max(report->step_signal, decision.step.signal);
     report->decisions.push_back(decision);
   }
   cache->SetActive(saved_active);

@@ -12,14 +12,14 @@
 //
 // The rule: an effect is dropped when switching it off changes the images (or the gradient) by
 // less than noise_factor × the seed-to-seed standard deviation of what the stage's fit averages,
-// and by less than max_share of the values' own RMS. A stage of K outer iterations renders with K
-// independent seeds, so a bias below σ/√K (σ the per-value standard deviation at the fit's spp) is
-// hidden by noise the fit still has at its end. The share limit keeps what the noise rule alone
-// would drop at high per-value noise although it shifts the expected values substantially: the
-// gradient at 16 spp has a per-entry σ about its own RMS, while a term that carries a quarter of
-// the expected gradient steers every step (measured on the bunny: docs/design-notes.md, "The
-// effect planner"). All quantities are estimated without the noise inflating them: with two
-// seeds s1, s2,
+// and by less than max_share of the values' own RMS (the largest measured in the stage so far). A
+// stage of K outer iterations renders with K independent seeds, so a bias below σ/√K (σ the
+// per-value standard deviation at the fit's spp) is hidden by noise the fit still has at its end.
+// The share limit keeps what the noise rule alone would drop at high per-value noise although it
+// shifts the expected values substantially: the gradient at 16 spp has a per-entry σ about its own
+// RMS, while a term that carries a quarter of the expected gradient steers every step (measured on
+// the bunny: docs/design-notes.md, "The effect planner"). All quantities are estimated without the
+// noise inflating them: with two seeds s1, s2,
 //   change² = mean[(A(s1) − B(s1)) · (A(s2) − B(s2))]   (an unbiased estimate of the squared
 //                                                         mean change: the seeds are independent)
 //   σ²      = mean[(A(s1) − A(s2))²] / 2                 (the per-value variance of A)
@@ -108,7 +108,7 @@ struct EffectMeasurement {
   double noise = 0.0;          // seed-to-seed standard deviation σ of the same values.
   double threshold = 0.0;      // noise_factor × σ / √K.
   double signal = 0.0;         // RMS of the mean values themselves (the change's share: / signal).
-  double share_limit = 0.0;    // max_share × signal.
+  double share_limit = 0.0;    // max_share × max(signal, the stage's signal scale).
   double noise_without = 0.0;  // σ of the values without the switch.
   int outer_iterations = 1;    // K.
   // Above the noise or too large a share to leave out, and larger than the noise the switch
@@ -144,7 +144,10 @@ struct EffectPlanReport {
   EffectPlan plan;
   std::vector<EffectDecision> decisions;
   double seconds = 0.0;  // the planner's own wall time.
-  int views = 0;         // views measured.
+  // The largest signal measured, for the images and the gradient (PlannerContext's scales).
+  double image_signal = 0.0;
+  double step_signal = 0.0;
+  int views = 0;  // views measured.
 
   nlohmann::json ToJson() const;
 };
@@ -158,7 +161,13 @@ struct PlannerContext {
   bool has_point_lights = false;
   bool specular_nonzero = true;  // some specular weight of the material is > 0.
   int outer_iterations = 1;      // K: the stage's outer iterations (independent seeds), >= 1.
-  uint64_t seed = 0;             // base seed of the planner's renders (two seeds from it).
+  // The largest signal (RMS of the mean values) measured earlier in the stage on the same
+  // topology, for the images and the gradient; 0 = none. The share limit is taken of the larger
+  // of it and the current signal: near convergence the gradient shrinks towards its noise, and a
+  // share of what is left would bring back terms that do not move the fit.
+  double image_signal_scale = 0.0;
+  double step_signal_scale = 0.0;
+  uint64_t seed = 0;  // base seed of the planner's renders (two seeds from it).
 };
 
 // Measures and decides (see the file comment); leaves the cache's plan set to the result and its

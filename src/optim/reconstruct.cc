@@ -141,8 +141,11 @@ Status Reconstruction::Create(const Dataset& dataset, const TriMesh& mesh, const
   return Status::Ok();
 }
 
-Status Reconstruction::PlanEffects(int outer, EffectPlanReport* report) {
+Status Reconstruction::PlanEffects(int outer, EffectPlanReport* report, double image_signal_scale,
+                                   double step_signal_scale) {
   PlannerContext context;
+  context.image_signal_scale = image_signal_scale;
+  context.step_signal_scale = step_signal_scale;
   context.ceiling = EffectPlan::From(options_.cache.render, options_.cache.edges);
   context.geometry_phase = options_.phases != PhaseSchedule::kTexture;
   context.fit_specular = options_.fit_specular;

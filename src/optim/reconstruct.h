@@ -76,8 +76,10 @@ class Reconstruction {
                        std::unique_ptr<Reconstruction>* out);
 
   // Runs the effect planner for outer iteration `outer` (its renders use the chosen plan from
-  // now on). The ceiling is the configured effects and budgets.
-  Status PlanEffects(int outer, EffectPlanReport* report);
+  // now on). The ceiling is the configured effects and budgets; `image_signal_scale` and
+  // `step_signal_scale` are PlannerContext's (0 = none).
+  Status PlanEffects(int outer, EffectPlanReport* report, double image_signal_scale = 0.0,
+                     double step_signal_scale = 0.0);
 
   // Runs outer iteration `outer` (its phases). `on_iteration` is called after every solver
   // iteration; returning false stops the run (the state so far is kept).

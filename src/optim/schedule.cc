@@ -178,6 +178,7 @@ Status Schedule::ChangeTopology(TopologyChange change, const ScheduleCallbacks& 
   topology_records_.push_back(record);
   ++progress_.topology_changes;
   baseline_ = current_.mesh;
+  image_signal_scale_ = step_signal_scale_ = 0.0;
   SFT_RETURN_IF_ERROR(WriteMesh(JoinPath(out_, kBaselineMesh), baseline_));
   if (callbacks.on_event) {
     char line[256];
@@ -192,6 +193,7 @@ Status Schedule::ChangeTopology(TopologyChange change, const ScheduleCallbacks& 
 
 Status Schedule::PrepareStage(const ScheduleCallbacks& callbacks) {
   SyncCurrent();
+  image_signal_scale_ = step_signal_scale_ = 0.0;
   const StageOptions& stage = stages_[progress_.stage];
   if (callbacks.on_event) {
     char line[256];
@@ -281,7 +283,10 @@ Status Schedule::PlanEffects(const ScheduleCallbacks& callbacks, json* record) {
   const StageOptions& stage = stages_[progress_.stage];
   if (!stage.fit.planner.enabled) return Status::Ok();
   EffectPlanReport report;
-  SFT_RETURN_IF_ERROR(reconstruction_->PlanEffects(progress_.outer_done, &report));
+  SFT_RETURN_IF_ERROR(reconstruction_->PlanEffects(progress_.outer_done, &report,
+                                                   image_signal_scale_, step_signal_scale_));
+  image_signal_scale_ = std::max(image_signal_scale_, report.image_signal);
+  step_signal_scale_ = std::max(step_signal_scale_, report.step_signal);
   if (callbacks.on_event) {
     for (const std::string& line : PlanChangeLines(report, last_plan_.get())) {
       callbacks.on_event(stage.name + ": " + line);

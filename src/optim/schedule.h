@@ -136,6 +136,9 @@ class Schedule {
   nlohmann::json stage_records_ = nlohmann::json::array();
   // The effect planner's last report in this session (console lines name only changes).
   std::unique_ptr<EffectPlanReport> last_plan_;
+  // The largest signals the planner measured in this stage since its last topology change.
+  double image_signal_scale_ = 0.0;
+  double step_signal_scale_ = 0.0;
   size_t phases_seen_ = 0;      // phase records of reconstruction_ already collected.
   double session_start_ = 0.0;  // steady-clock seconds when this session's Run began.
   double seconds_at_start_ = 0.0;
