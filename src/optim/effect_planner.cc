@@ -36,18 +36,20 @@ struct Comparison {
   double change = 0.0;  // sqrt(max(0, mean[(A1 − B1)(A2 − B2)])).
   // sqrt(2 × the standard error of that mean): smaller changes are not distinguishable from 0.
   double floor = 0.0;
-  double noise = 0.0;   // sqrt(mean[(A1 − A2)²] / 2).
-  double signal = 0.0;  // sqrt(max(0, mean[A1 · A2])).
+  double noise = 0.0;          // sqrt(mean[(A1 − A2)²] / 2).
+  double noise_without = 0.0;  // sqrt(mean[(B1 − B2)²] / 2).
+  double signal = 0.0;         // sqrt(max(0, mean[A1 · A2])).
 };
 
 Comparison Compare(const Sample (&a)[2], const Sample (&b)[2]) {
-  double cross = 0.0, cross2 = 0.0, diff2 = 0.0, product = 0.0;
+  double cross = 0.0, cross2 = 0.0, diff2 = 0.0, diff2_without = 0.0, product = 0.0;
   const size_t n = a[0].size();
   for (size_t i = 0; i < n; ++i) {
     const double p = (a[0][i] - b[0][i]) * (a[1][i] - b[1][i]);
     cross += p;
     cross2 += p * p;
     diff2 += (a[0][i] - a[1][i]) * (a[0][i] - a[1][i]);
+    diff2_without += (b[0][i] - b[1][i]) * (b[0][i] - b[1][i]);
     product += a[0][i] * a[1][i];
   }
   Comparison c;
@@ -57,6 +59,7 @@ Comparison Compare(const Sample (&a)[2], const Sample (&b)[2]) {
   c.change = std::sqrt(std::max(0.0, mean));
   c.floor = std::sqrt(2.0 * standard_error);
   c.noise = std::sqrt(diff2 / (2.0 * n));
+  c.noise_without = std::sqrt(diff2_without / (2.0 * n));
   c.signal = std::sqrt(std::max(0.0, product / n));
   return c;
 }
@@ -166,7 +169,7 @@ Status Measure(const EffectPlannerOptions& options, const PlannerContext& contex
     m->change = c.change;
     m->floor = c.floor;
     m->noise = c.noise;
-    m->noise_without = Compare(b, b).noise;
+    m->noise_without = c.noise_without;
     m->signal = c.signal;
     m->threshold = Threshold(options, context, c.noise);
     m->share_limit = options.max_share * std::max(c.signal, scale);
@@ -205,7 +208,7 @@ bool DecideWithoutMeasuring(const std::string& name, const EffectPlannerOptions&
   } else {
     decision->reason = Unmeasured(name, *plan, context);
     if (decision->reason.empty()) return false;
-    decision->on = decision->reason == "fitted" || decision->reason == "no geometry phase";
+    decision->on = decision->reason == "fitted";
   }
   if (!decision->on && plan->IsOn(name)) {
     *plan = plan->Without(name);

@@ -17,8 +17,8 @@
 // per-value standard deviation at the fit's spp) is hidden by noise the fit still has at its end.
 // The share limit keeps what the noise rule alone would drop at high per-value noise although it
 // shifts the expected values substantially: the gradient at 16 spp has a per-entry σ about its own
-// RMS, while a term that carries a quarter of the expected gradient steers every step (measured on
-// the bunny: docs/design-notes.md, "The effect planner"). All quantities are estimated without the
+// RMS, while a term that carries a quarter of the expected gradient steers every step
+// (docs/design-notes.md, "The effect planner"). All quantities are estimated without the
 // noise inflating them: with two seeds s1, s2,
 //   change² = mean[(A(s1) − B(s1)) · (A(s2) − B(s2))]   (an unbiased estimate of the squared
 //                                                         mean change: the seeds are independent)
@@ -27,8 +27,7 @@
 // where A is the current plan and B the plan without the effect. A switch whose samples are noisy
 // (edge terms) is also dropped when it adds more variance than it removes bias from what the stage
 // averages: change² · K ≤ σ_A² − σ_B² (the expected squared error of the stage's average is
-// bias² + σ²/K). Measured on the bunny, dropping secondary edges so made the fit both faster and
-// more accurate. Finally the change must be distinguishable from 0: change² above two standard
+// bias² + σ²/K). Finally the change must be distinguishable from 0: change² above two standard
 // errors of its own estimate (the mean of n products), else a switch that changes nothing but
 // which random numbers a path uses shows a spurious change of a few percent of the signal. Image
 // effects are judged on the images first and, when those do not show that the effect matters, on

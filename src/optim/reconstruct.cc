@@ -157,7 +157,7 @@ Status Reconstruction::PlanEffects(int outer, EffectPlanReport* report, double i
       context.has_point_lights = true;
     }
   }
-  context.specular_nonzero = CurrentMaterial().specular > 0.0;
+  context.specular_nonzero = params_.values()[params_.layout().SpecularIndex()] > 0.0;
   // Seeds apart from the fit's (options_.seed * 7919 + 2 * outer + phase).
   context.seed = options_.seed * 104729ull + 1000003ull * (static_cast<uint64_t>(outer) + 1);
   return sft::PlanEffects(options_.planner, context, cache_.get(), report);

@@ -13,10 +13,11 @@
 // Relative paths are relative to the grid file's folder. Axis values of the reconstruct keys
 // (spp, image_scale, bounces, effects, solver, steps, phases) are passed to the reconstruction's
 // configuration as they are ("effects": "auto" runs the effect planner): a value it rejects
-// (such as "bounces": "auto") makes that cell an error recorded in sweep.jsonl, and the sweep goes on. `views` counts evenly
-// spaced view indices; a `variant` sets several keys under one name. Cells are the product of the
-// axes in the order of kSweepAxes, the first outermost. A structural error (unknown key, an axis
-// that is not a non-empty array, a duplicate value, a bad variant) is one line naming the field.
+// (such as "bounces": "auto") makes that cell an error recorded in sweep.jsonl, and the sweep goes
+// on. `views` counts evenly spaced view indices; a `variant` sets several keys under one name.
+// Cells are the product of the axes in the order of kSweepAxes, the first outermost. A structural
+// error (unknown key, an axis that is not a non-empty array, a duplicate value, a bad variant) is
+// one line naming the field.
 #ifndef SFT_SWEEP_SWEEP_GRID_H_
 #define SFT_SWEEP_SWEEP_GRID_H_
 
