@@ -220,6 +220,12 @@ const std::map<std::string, Key>& Keys() {
        Real([](O* o) -> double& { return o->solver.adam.learning_rate_vertices; }, 1e-12, 10)},
       {"adam_lr_material",
        Real([](O* o) -> double& { return o->solver.adam.learning_rate_material; }, 1e-12, 10)},
+      {"adam_large_steps",
+       Real([](O* o) -> double& { return o->solver.adam.large_steps_lambda; }, 0, 1e4)},
+      {"adam_uniform", Bool([](O* o) -> bool& { return o->solver.adam.uniform_vertices; })},
+      {"adam_resample", Bool([](O* o) -> bool& { return o->solver.adam.resample; })},
+      {"adam_views_per_step",
+       Int([](O* o) -> int& { return o->solver.adam.views_per_step; }, 0, 100000)},
       {"laplacian_weight",
        Real([](O* o) -> double& { return o->regularizers.laplacian_weight; }, 0, 1e12)},
       {"laplacian", Choice(

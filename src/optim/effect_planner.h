@@ -159,7 +159,9 @@ struct PlannerContext {
   bool has_environment = false;
   bool has_point_lights = false;
   bool specular_nonzero = true;  // some specular weight of the material is > 0.
-  int outer_iterations = 1;      // K: the stage's outer iterations (independent seeds), >= 1.
+  // K: the number of independent seeds the stage's noise averages over, >= 1: its outer
+  // iterations (one seed each), or for Adam with `resample` its steps in full-view renders.
+  int outer_iterations = 1;
   // The largest signal (RMS of the mean values) measured earlier in the stage on the same
   // topology, for the images and the gradient; 0 = none. The share limit is taken of the larger
   // of it and the current signal: near convergence the gradient shrinks towards its noise, and a

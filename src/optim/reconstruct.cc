@@ -2,9 +2,11 @@
 
 #include <glog/logging.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
+#include "cost_functions/proximal_smoothing.h"
 #include "src/optim/problem.h"
 
 namespace sft {
@@ -150,6 +152,17 @@ Status Reconstruction::PlanEffects(int outer, EffectPlanReport* report, double i
   context.geometry_phase = options_.phases != PhaseSchedule::kTexture;
   context.fit_specular = options_.fit_specular;
   context.outer_iterations = options_.outer_iterations;
+  const AdamOptions& adam = options_.solver.adam;
+  if (options_.solver.kind == SolverKind::kAdam && adam.resample) {
+    // Every Adam step draws new samples: the noise averages over the stage's steps, each seeing
+    // views_per_step of the views (in full-view renders: outer × steps × batch / views).
+    const int views = static_cast<int>(cache_->view_indices().size());
+    const int batch =
+        adam.views_per_step > 0 && adam.views_per_step < views ? adam.views_per_step : views;
+    const int64_t renders =
+        static_cast<int64_t>(options_.outer_iterations) * options_.solver.steps * batch / views;
+    context.outer_iterations = static_cast<int>(std::clamp<int64_t>(renders, 1, 1 << 20));
+  }
   for (const LightSpec& light : dataset_->lights) {
     if (light.type == LightType::kEnvironment) {
       context.has_environment = true;
@@ -206,8 +219,12 @@ Status Reconstruction::RunOuter(int outer,
     phase_record.outer = outer;
     phase_record.phase = name;
     if (options_.solver.kind == SolverKind::kAdam) {
+      std::vector<std::vector<int>> neighbours;
+      if (active.vertices && options_.solver.adam.large_steps_lambda > 0) {
+        neighbours = VertexNeighbours(rest);
+      }
       SFT_RETURN_IF_ERROR(RunAdam(options_.solver, options_.problem, cache_.get(), &params_, hooks,
-                                  &adam_, &phase_record.stats));
+                                  neighbours, &adam_, &phase_record.stats));
     } else {
       SFT_RETURN_IF_ERROR(RunSolver(options_.solver, options_.problem, cache_.get(), &params_,
                                     hooks, &phase_record.stats));

@@ -244,8 +244,10 @@ void RenderCache::Render(bool rows) {
   has_rows_ = rows && active_.Any();
 }
 
-void RenderCache::RenderSome(const std::vector<int>& views) {
+bool RenderCache::RenderSome(const std::vector<int>& views) {
   UpdateScene();
+  finite_ = true;
+  non_finite_ = 0;
   RenderOptions render = options_.render;
   render.seed = seed_;
   for (int v : views) {
@@ -254,11 +256,13 @@ void RenderCache::RenderSome(const std::vector<int>& views) {
     RenderStats stats;
     RenderView(*scene_, material_, ScaledView(v), render, &image, &stats);
     render_seconds_ += Seconds(start);
+    non_finite_ += stats.NonFinite();
     StoreRender(v, image, nullptr);
     ++renders_;
   }
   has_rows_ = false;
   stale_ = true;
+  return finite_;
 }
 
 void RenderCache::StoreRender(int v, const Image& image, const JacobianRows* rows) {
@@ -319,17 +323,21 @@ void SquaredError(const LevelCache& level, const std::vector<uint8_t>& active, b
 
 }  // namespace
 
+double RenderCache::ViewImageCost(int v) const {
+  double cost = 0.0;
+  for (int l = 0; l < num_levels(v); ++l) {
+    const LevelCache& level = *levels_[v][l];
+    double sum = 0.0;
+    int64_t count = 0;
+    SquaredError(level, targets_[v].active[l], /*weighted=*/true, &sum, &count);
+    cost += 0.5 * level.sqrt_weight * level.sqrt_weight * sum;
+  }
+  return cost;
+}
+
 double RenderCache::ImageCost() const {
   double cost = 0.0;
-  for (int v = 0; v < num_views(); ++v) {
-    for (int l = 0; l < num_levels(v); ++l) {
-      const LevelCache& level = *levels_[v][l];
-      double sum = 0.0;
-      int64_t count = 0;
-      SquaredError(level, targets_[v].active[l], /*weighted=*/true, &sum, &count);
-      cost += 0.5 * level.sqrt_weight * level.sqrt_weight * sum;
-    }
-  }
+  for (int v = 0; v < num_views(); ++v) cost += ViewImageCost(v);
   return cost;
 }
 

@@ -86,8 +86,8 @@ class RenderCache : public ceres::EvaluationCallback {
   // Renders every view at the current parameters: rows of the `active` kinds when `rows`.
   void Render(bool rows);
   // Renders and stores only `views` (no rows), e.g. for their AdjointWeights; the next evaluation
-  // renders every view anew.
-  void RenderSome(const std::vector<int>& views);
+  // renders every view anew. Returns finite() (false when a sample or output was not finite).
+  bool RenderSome(const std::vector<int>& views);
   // The seed of the renders from now on (a new outer iteration).
   void SetSeed(uint64_t seed) {
     stale_ = stale_ || seed != seed_;
@@ -125,6 +125,8 @@ class RenderCache : public ceres::EvaluationCallback {
 
   // ½ Σ r² of the image residuals over the active pixels of every level, at the last render.
   double ImageCost() const;
+  // The part of ImageCost from view v.
+  double ViewImageCost(int v) const;
   // Mean squared error of level 0 over its active pixels and RGB, per view, at the last render.
   std::vector<double> ViewMse() const;
   // The last render of view v (level 0, RGB) and its target.

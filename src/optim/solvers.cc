@@ -5,6 +5,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <random>
+
+#include "src/optim/large_steps.h"
 
 namespace sft {
 namespace {
@@ -160,6 +163,14 @@ bool SolverOptions::Check(std::string* why) const {
     *why = "adam: learning rates and epsilon must be > 0, beta1 and beta2 in [0, 1)";
     return false;
   }
+  if (!(a.large_steps_lambda >= 0 && a.large_steps_lambda <= 1e4)) {
+    *why = "adam_large_steps: must be in [0, 10000]";
+    return false;
+  }
+  if (a.views_per_step < 0) {
+    *why = "adam_views_per_step: must be >= 0";
+    return false;
+  }
   return true;
 }
 
@@ -186,15 +197,31 @@ void AdjointObjective::Store(const double* x) const {
 }
 
 bool AdjointObjective::Evaluate(const double* x, double* cost, double* gradient) const {
+  return EvaluateViews(x, {}, cost, gradient);
+}
+
+bool AdjointObjective::EvaluateViews(const double* x, const std::vector<int>& views, double* cost,
+                                     double* gradient) const {
   Store(x);
-  cache_->Render(/*rows=*/false);
-  if (!*cache_->finite()) return false;
-  *cost = cache_->ImageCost();
+  std::vector<int> batch = views;
+  if (batch.empty()) {
+    cache_->Render(/*rows=*/false);
+    if (!*cache_->finite()) return false;
+    for (int v = 0; v < cache_->num_views(); ++v) batch.push_back(v);
+  } else if (!cache_->RenderSome(batch)) {
+    return false;
+  }
+  const double scale = static_cast<double>(cache_->num_views()) / batch.size();
+  *cost = 0.0;
+  for (int v : batch) *cost += scale * cache_->ViewImageCost(v);
   std::vector<double> full;
   if (gradient != nullptr) {
     full.assign(params_->layout().size(), 0.0);
-    for (int v = 0; v < cache_->num_views(); ++v) {
+    for (int v : batch) {
       if (!cache_->AddAdjointGradient(v, cache_->AdjointWeights(v), &full)) return false;
+    }
+    if (scale != 1.0) {
+      for (double& g : full) g *= scale;
     }
   }
   if (regularizers_ != nullptr && regularizers_->NumResidualBlocks() > 0) {
@@ -293,44 +320,111 @@ Status RunSolver(const SolverOptions& options, const ProblemOptions& problem_opt
   return Status::Ok();
 }
 
+namespace {
+
+// The minibatch of Adam step t (1-based): `per_step` views from a fixed shuffled order of all
+// `num_views`, consecutive batches taking consecutive slices (wrapping around). All views when
+// per_step is 0 or not below num_views.
+std::vector<int> AdamBatch(int num_views, int per_step, int64_t t, uint64_t seed) {
+  if (per_step <= 0 || per_step >= num_views) return {};
+  std::vector<int> order(num_views);
+  for (int v = 0; v < num_views; ++v) order[v] = v;
+  std::mt19937_64 rng(seed);
+  std::shuffle(order.begin(), order.end(), rng);
+  std::vector<int> batch;
+  for (int k = 0; k < per_step; ++k) {
+    batch.push_back(order[static_cast<size_t>(((t - 1) * per_step + k) % num_views)]);
+  }
+  std::sort(batch.begin(), batch.end());
+  return batch;
+}
+
+// One Adam update of the active parameters x (moments in `state`, indexed by flat index) for the
+// gradient `g`; with large steps the first `vertex_count` entries of x and g are replaced by u and
+// its gradient by the caller. `uniform_count` leading entries share one second moment (their
+// largest).
+void AdamUpdate(const AdamOptions& adam, const SceneParameters& params,
+                const std::vector<int>& index, const std::vector<double>& g, int uniform_count,
+                AdamState* state, std::vector<double>* x) {
+  ++state->t;
+  const double c1 = 1.0 - std::pow(adam.beta1, static_cast<double>(state->t));
+  const double c2 = 1.0 - std::pow(adam.beta2, static_cast<double>(state->t));
+  double uniform_v = 0.0;
+  for (size_t k = 0; k < g.size(); ++k) {
+    const int i = index[k];
+    state->m[i] = adam.beta1 * state->m[i] + (1.0 - adam.beta1) * g[k];
+    state->v[i] = adam.beta2 * state->v[i] + (1.0 - adam.beta2) * g[k] * g[k];
+    if (static_cast<int>(k) < uniform_count) uniform_v = std::max(uniform_v, state->v[i]);
+  }
+  for (size_t k = 0; k < g.size(); ++k) {
+    const int i = index[k];
+    const double v = static_cast<int>(k) < uniform_count ? uniform_v : state->v[i];
+    const double lr = params.layout().KindOf(i) == ParameterKind::kVertex
+                          ? adam.learning_rate_vertices
+                          : adam.learning_rate_material;
+    (*x)[k] -= lr * (state->m[i] / c1) / (std::sqrt(v / c2) + adam.epsilon);
+  }
+}
+
+}  // namespace
+
 Status RunAdam(const SolverOptions& options, const ProblemOptions& problem_options,
                RenderCache* cache, SceneParameters* params, const SolverHooks& hooks,
-               AdamState* state, SolverRunStats* stats) {
+               const std::vector<std::vector<int>>& vertex_neighbours, AdamState* state,
+               SolverRunStats* stats) {
   std::string why;
   if (!options.Check(&why)) return Status::Error(why);
   const auto start = std::chrono::steady_clock::now();
+  const AdamOptions& adam = options.adam;
   std::unique_ptr<ceres::Problem> regularizers = RegularizerProblem(hooks);
   AdjointObjective objective(cache, params, problem_options.bounds, regularizers.get());
   const int n = objective.NumParameters();
+  const int num_vertices = params->layout().num_vertices;
+  // Active parameters are in increasing flat order, so active vertices are the first 3V.
+  const int vertex_count = cache->active().vertices ? 3 * num_vertices : 0;
+  std::unique_ptr<LargeSteps> large_steps;
+  if (vertex_count > 0 && adam.large_steps_lambda > 0) {
+    if (static_cast<int>(vertex_neighbours.size()) != num_vertices) {
+      return Status::Error("adam: large steps need the mesh's vertex neighbours");
+    }
+    SFT_RETURN_IF_ERROR(
+        LargeSteps::Create(vertex_neighbours, adam.large_steps_lambda, &large_steps));
+  }
   const size_t size = params->layout().size();
-  if (state->m.size() != size) {
+  const double lambda = large_steps ? adam.large_steps_lambda : 0.0;
+  if (state->m.size() != size || state->lambda != lambda) {
     state->m.assign(size, 0.0);
     state->v.assign(size, 0.0);
+    state->t = 0;
+    state->lambda = lambda;
   }
-  std::vector<double> x = objective.Current(), gradient(n);
+  std::vector<double> x = objective.Current(), gradient(n), y(n);
   const std::vector<int>& index = objective.active_indices();
-  const AdamOptions& adam = options.adam;
+  const int uniform_count = adam.uniform_vertices ? vertex_count : 0;
+  const uint64_t base_seed = cache->seed();
   double cost = 0.0;
   stats->termination = "steps";
   const CacheClock before(*cache);
   for (int step = 1; step <= options.steps; ++step) {
-    if (!objective.Evaluate(x.data(), &cost, gradient.data())) {
+    const int64_t t = state->t + 1;
+    if (adam.resample) cache->SetSeed(base_seed + 0x9e3779b97f4a7c15ull * static_cast<uint64_t>(t));
+    const std::vector<int> batch =
+        AdamBatch(cache->num_views(), adam.views_per_step, t, base_seed ^ 0x2545f4914f6cdd1dull);
+    if (!objective.EvaluateViews(x.data(), batch, &cost, gradient.data())) {
       stats->termination = "non-finite render";
       break;
     }
-    ++state->t;
-    const double c1 = 1.0 - std::pow(adam.beta1, static_cast<double>(state->t));
-    const double c2 = 1.0 - std::pow(adam.beta2, static_cast<double>(state->t));
+    // y: the variables Adam moves (u = Mx for the vertices with large steps, x otherwise).
+    y = x;
+    if (large_steps) {
+      large_steps->ToU(x.data(), y.data());
+      large_steps->GradientToU(gradient.data(), gradient.data());
+    }
+    AdamUpdate(adam, *params, index, gradient, uniform_count, state, &y);
+    if (large_steps) large_steps->ToX(y.data(), y.data());
+    x = y;
     for (int k = 0; k < n; ++k) {
       const int i = index[k];
-      double& m = state->m[i];
-      double& v = state->v[i];
-      m = adam.beta1 * m + (1.0 - adam.beta1) * gradient[k];
-      v = adam.beta2 * v + (1.0 - adam.beta2) * gradient[k] * gradient[k];
-      const double lr = params->layout().KindOf(i) == ParameterKind::kVertex
-                            ? adam.learning_rate_vertices
-                            : adam.learning_rate_material;
-      x[k] -= lr * (m / c1) / (std::sqrt(v / c2) + adam.epsilon);
       x[k] = std::clamp(x[k], params->Lower(i, problem_options.bounds),
                         params->Upper(i, problem_options.bounds));
     }

@@ -39,6 +39,19 @@ struct AdamOptions {
   double beta1 = 0.9;                    // first-moment decay, [0, 1).
   double beta2 = 0.999;                  // second-moment decay, [0, 1).
   double epsilon = 1e-8;                 // denominator guard, > 0.
+  // λ of the large-steps reparameterisation of the vertices (src/optim/large_steps.h): Adam moves
+  // u = (I + λL)x. 0 = plain Adam on the positions; [0, 1e4]. Nicolet et al. use 19–49.
+  double large_steps_lambda = 0.0;
+  // The vertices' second moment is the largest over all vertex coordinates (Nicolet et al.'s
+  // "uniform" Adam: one step length for the whole surface, so the smoothing of large steps is not
+  // undone by per-coordinate scaling). Other kinds keep per-parameter moments.
+  bool uniform_vertices = false;
+  // A new seed at every step (stochastic gradients whose noise averages out over the steps)
+  // instead of one seed per outer iteration (common random numbers).
+  bool resample = false;
+  // Views rendered per step (a minibatch, cycling through a fixed shuffled order of the fitted
+  // views; the image part of the cost and gradient is scaled by views / batch); 0 = all views.
+  int views_per_step = 0;
 };
 
 struct SolverOptions {
@@ -107,6 +120,11 @@ class AdjointObjective : public ceres::FirstOrderFunction {
   AdjointObjective(RenderCache* cache, SceneParameters* params, const ParameterBounds& bounds,
                    ceres::Problem* regularizers);
   bool Evaluate(const double* x, double* cost, double* gradient) const override;
+  // Like Evaluate over the cache views `views` only (a minibatch): the image part of the cost and
+  // gradient is scaled by num_views / views.size(), so that it estimates the full objective.
+  // All views when `views` is empty.
+  bool EvaluateViews(const double* x, const std::vector<int>& views, double* cost,
+                     double* gradient) const;
   int NumParameters() const override { return static_cast<int>(active_.size()); }
   // The active parameters' current values (from the SceneParameters).
   std::vector<double> Current() const;
@@ -129,13 +147,19 @@ Status RunSolver(const SolverOptions& options, const ProblemOptions& problem_opt
                  SolverRunStats* stats);
 
 // Adam's moments, kept across outer iterations (indexed like the flat parameter vector).
+// With large steps the vertices' moments are of u = (I + λL)x; they restart when λ or the vertex
+// count changes (a topology change).
 struct AdamState {
   std::vector<double> m, v;
   int64_t t = 0;
+  double lambda = 0.0;  // the large-steps λ the vertex moments belong to.
 };
+// `vertex_neighbours` (VertexNeighbours of the current mesh) is needed when vertices are active
+// and options.adam.large_steps_lambda > 0; otherwise it may be empty.
 Status RunAdam(const SolverOptions& options, const ProblemOptions& problem_options,
                RenderCache* cache, SceneParameters* params, const SolverHooks& hooks,
-               AdamState* state, SolverRunStats* stats);
+               const std::vector<std::vector<int>>& vertex_neighbours, AdamState* state,
+               SolverRunStats* stats);
 
 }  // namespace sft
 

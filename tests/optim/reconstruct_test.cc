@@ -405,6 +405,34 @@ TEST_F(ReconstructTest, GradientsMatchFiniteDifferencesOfTheCost) {
   }
 }
 
+// A minibatch of the adjoint objective (Adam's views_per_step) is the batch views' part of the
+// full objective scaled by views / batch: cost and gradient, at the same point and seed.
+TEST_F(ReconstructTest, MinibatchObjectiveIsTheScaledPartOfItsViews) {
+  FitSetup s;
+  MakeSetup(dataset_, mesh_, guess_, options_.cache, ActiveParameters(), &s);
+  ASSERT_GE(s.cache->num_views(), 2);
+  AdjointObjective objective(s.cache.get(), &s.params, ParameterBounds(), nullptr);
+  const std::vector<double> x = objective.Current();
+  std::vector<double> full(x.size()), part(x.size()), all(x.size());
+  double full_cost = 0.0, part_cost = 0.0, all_cost = 0.0;
+  ASSERT_TRUE(objective.Evaluate(x.data(), &full_cost, full.data()));
+  const double view0 = s.cache->ViewImageCost(0);
+  ASSERT_TRUE(objective.EvaluateViews(x.data(), {0}, &part_cost, part.data()));
+  const double views = s.cache->num_views();
+  EXPECT_NEAR(part_cost, views * view0, 1e-9 * part_cost);
+  // Explicitly listing every view is the full objective.
+  std::vector<int> every;
+  for (int v = 0; v < s.cache->num_views(); ++v) every.push_back(v);
+  ASSERT_TRUE(objective.EvaluateViews(x.data(), every, &all_cost, all.data()));
+  EXPECT_NEAR(all_cost, full_cost, 1e-9 * full_cost);
+  double norm = 0.0;
+  for (size_t k = 0; k < x.size(); ++k) {
+    EXPECT_NEAR(all[k], full[k], 1e-9 * (1.0 + std::abs(full[k])));
+    norm += part[k] * part[k];
+  }
+  EXPECT_GT(norm, 0.0);  // the single view's gradient is not empty.
+}
+
 // Texture only, from a constant grey guess: Levenberg–Marquardt recovers the albedo texels that
 // the views see; L-BFGS and Adam lower the cost.
 TEST_F(ReconstructTest, TexturePhaseRecoversAlbedo) {
