@@ -1,5 +1,6 @@
 #include "src/optim/schedule_config.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <functional>
@@ -230,9 +231,11 @@ Status StagesFromJson(const json& list, const std::string& source,
 }
 
 std::string FormatSchedule(const std::vector<StageOptions>& stages) {
-  std::string text =
-      "stage  name        phases     scale   spp  levels  outer  steps  texels  solver  "
-      "before\n";
+  // The name column is as wide as the longest name (at least 10), so that columns stay aligned.
+  size_t width = 10;
+  for (const StageOptions& s : stages) width = std::max(width, s.name.size());
+  std::string text = "stage  " + std::string("name") + std::string(width - 2, ' ') +
+                     "phases     scale   spp  levels  outer  steps  texels  solver  before\n";
   for (size_t k = 0; k < stages.size(); ++k) {
     const StageOptions& s = stages[k];
     const ReconstructOptions& f = s.fit;
@@ -242,9 +245,10 @@ std::string FormatSchedule(const std::vector<StageOptions>& stages) {
     if (before.empty()) before = "-";
     char line[256];
     std::snprintf(line, sizeof(line),
-                  "%5zu  %-10s  %-9s  1/%-4d %4d  %6d  %5d  %5d  %6s  %-6s  %s\n", k,
-                  s.name.c_str(), PhaseScheduleName(f.phases), 1 << f.cache.image_scale_log2,
-                  f.cache.render.spp, f.cache.pyramid_levels, f.outer_iterations, f.solver.steps,
+                  "%5zu  %-*s  %-9s  1/%-4d %4d  %6d  %5d  %5d  %6s  %-6s  %s\n", k,
+                  static_cast<int>(width), s.name.c_str(), PhaseScheduleName(f.phases),
+                  1 << f.cache.image_scale_log2, f.cache.render.spp, f.cache.pyramid_levels,
+                  f.outer_iterations, f.solver.steps,
                   s.texel_resolution > 0 ? std::to_string(s.texel_resolution).c_str()
                   : s.texel_resolution == kTexelResolutionAuto ? "auto"
                                                                : "keep",

@@ -54,6 +54,26 @@ TEST(ScheduleConfigTest, FlatKeysOverrideEveryStage) {
   EXPECT_EQ(std::count(table.begin(), table.end(), '\n'), 3);
 }
 
+// A stage name longer than the default column keeps the table's columns aligned: the phases
+// column starts at the same offset on the header and on every stage line.
+TEST(ScheduleConfigTest, LongStageNamesKeepColumnsAligned) {
+  std::vector<StageOptions> stages(2);
+  stages[0].name = "a";
+  stages[1].name = "material_full_scale";
+  const std::string table = FormatSchedule(stages);
+  std::vector<std::string> lines;
+  for (size_t start = 0, end; (end = table.find('\n', start)) != std::string::npos;
+       start = end + 1) {
+    lines.push_back(table.substr(start, end - start));
+  }
+  ASSERT_EQ(lines.size(), 3u);
+  const size_t column = lines[0].find("phases");
+  ASSERT_NE(column, std::string::npos);
+  for (size_t k = 1; k < lines.size(); ++k) {
+    EXPECT_EQ(lines[k].find(PhaseScheduleName(stages[k - 1].fit.phases)), column) << lines[k];
+  }
+}
+
 TEST(ScheduleConfigTest, BuiltInListsFollowTheStart) {
   ScheduleConfig config;
   std::vector<StageOptions> stages;
