@@ -74,6 +74,33 @@ TEST(ScheduleConfigTest, LongStageNamesKeepColumnsAligned) {
   }
 }
 
+// The shipped glossy-refine schedule (data/example/glossy_refine.json, docs/reconstruct.md) parses
+// and alternates LM texture stages with Adam large-steps geometry stages that do not simulate the
+// specular lobe, with the step size falling from stage to stage.
+TEST(ScheduleConfigTest, ShippedGlossyRefineScheduleParses) {
+  ScheduleConfig config;
+  ASSERT_TRUE(ReadScheduleConfig(testing::DataDir() + "/example/glossy_refine.json", &config).ok());
+  std::vector<StageOptions> stages;
+  ASSERT_TRUE(ResolveStages(config, /*carved_start=*/false, &stages).ok());
+  ASSERT_GE(stages.size(), 5u);
+  double last_lr = 1e9;
+  for (const StageOptions& stage : stages) {
+    SCOPED_TRACE(stage.name);
+    if (stage.fit.phases == PhaseSchedule::kTexture) {
+      EXPECT_EQ(stage.fit.solver.kind, SolverKind::kLevenbergMarquardt);
+      EXPECT_TRUE(stage.fit.fit_specular);
+      continue;
+    }
+    EXPECT_EQ(stage.fit.phases, PhaseSchedule::kGeometry);
+    EXPECT_EQ(stage.fit.solver.kind, SolverKind::kAdam);
+    EXPECT_EQ(stage.fit.solver.adam.large_steps_lambda, 25.0);
+    EXPECT_TRUE(stage.fit.solver.adam.resample);
+    EXPECT_LT(stage.fit.solver.adam.learning_rate_vertices, last_lr);
+    last_lr = stage.fit.solver.adam.learning_rate_vertices;
+  }
+  EXPECT_EQ(stages.back().fit.phases, PhaseSchedule::kTexture);
+}
+
 TEST(ScheduleConfigTest, BuiltInListsFollowTheStart) {
   ScheduleConfig config;
   std::vector<StageOptions> stages;
