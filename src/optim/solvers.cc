@@ -391,11 +391,17 @@ Status RunAdam(const SolverOptions& options, const ProblemOptions& problem_optio
         LargeSteps::Create(vertex_neighbours, adam.large_steps_lambda, &large_steps));
   }
   const size_t size = params->layout().size();
-  const double lambda = large_steps ? adam.large_steps_lambda : 0.0;
-  if (state->m.size() != size || state->lambda != lambda) {
+  if (state->m.size() != size) {
     state->m.assign(size, 0.0);
     state->v.assign(size, 0.0);
     state->t = 0;
+  }
+  // Vertex moments of x and of u = (I + λL)x are not interchangeable: restart them (only them,
+  // so that a texture phase between two geometry phases keeps its own) when λ changes.
+  const double lambda = large_steps ? adam.large_steps_lambda : 0.0;
+  if (vertex_count > 0 && state->lambda != lambda) {
+    std::fill(state->m.begin(), state->m.begin() + vertex_count, 0.0);
+    std::fill(state->v.begin(), state->v.begin() + vertex_count, 0.0);
     state->lambda = lambda;
   }
   std::vector<double> x = objective.Current(), gradient(n), y(n);

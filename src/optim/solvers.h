@@ -147,8 +147,8 @@ Status RunSolver(const SolverOptions& options, const ProblemOptions& problem_opt
                  SolverRunStats* stats);
 
 // Adam's moments, kept across outer iterations (indexed like the flat parameter vector).
-// With large steps the vertices' moments are of u = (I + λL)x; they restart when λ or the vertex
-// count changes (a topology change).
+// With large steps the vertices' moments are of u = (I + λL)x; they restart when λ changes, and
+// all moments restart when the layout's size changes (a topology change).
 struct AdamState {
   std::vector<double> m, v;
   int64_t t = 0;
