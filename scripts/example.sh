@@ -2,7 +2,8 @@
 # Installs everything, builds, and runs the built-in example: a reconstruction. It synthesizes a
 # dataset of the bundled Stanford bunny (16 views, camera flash), displaces the true mesh by a
 # smooth random field (1% of the object's size) as the starting mesh, refines geometry and
-# albedo with sft reconstruct (Levenberg–Marquardt over path-traced Jacobians), and prints how
+# albedo with sft reconstruct (material by Levenberg–Marquardt over path-traced Jacobians, geometry
+# by Adam on the large-steps parameterisation, alternating), and prints how
 # far the start and the result are from the truth. Outputs under out/example/.
 set -euo pipefail
 cd "$(dirname "$0")/.."
