@@ -20,6 +20,45 @@ using json = nlohmann::json;
 // image scale, remeshing between scales, resampling before the full scale, and a final texture
 // stage at full scale with a higher texel resolution.
 const char kRefineSchedule[] = R"([{"name": "refine"}])";
+// large_steps: from a given mesh, material stages (LM: albedo, roughness, specular weight)
+// alternating with geometry stages (Adam on the large-steps parameterisation, a new seed and 8
+// views per step, the specular lobe off and silhouette edges on in the step) at a step size that
+// halves, half scale first. Measured on the glossy dragon and the README bunny
+// (docs/design-notes.md, "Large steps for Adam").
+const char kLargeStepsSchedule[] = R"([
+  {"name": "material", "phases": "texture", "image_scale": 0.5, "pyramid_levels": 3,
+   "outer_iterations": 1, "steps": 5},
+  {"name": "shape_half", "phases": "geometry", "solver": "adam", "image_scale": 0.5,
+   "pyramid_levels": 3, "outer_iterations": 2, "steps": 25, "adam_lr_vertices": 0.002},
+  {"name": "material_half", "phases": "texture", "image_scale": 0.5, "pyramid_levels": 3,
+   "outer_iterations": 1, "steps": 5},
+  {"name": "shape_full", "phases": "geometry", "solver": "adam", "image_scale": 1,
+   "pyramid_levels": 3, "outer_iterations": 2, "steps": 25, "adam_lr_vertices": 0.001},
+  {"name": "material_full", "phases": "texture", "image_scale": 1, "pyramid_levels": 3,
+   "outer_iterations": 1, "steps": 5},
+  {"name": "shape_full2", "phases": "geometry", "solver": "adam", "image_scale": 1,
+   "pyramid_levels": 3, "outer_iterations": 2, "steps": 25, "adam_lr_vertices": 0.0005},
+  {"name": "material_full2", "phases": "texture", "image_scale": 1, "pyramid_levels": 3,
+   "outer_iterations": 1, "steps": 5},
+  {"name": "shape_full3", "phases": "geometry", "solver": "adam", "image_scale": 1,
+   "pyramid_levels": 3, "outer_iterations": 2, "steps": 25, "adam_lr_vertices": 0.00025},
+  {"name": "material_final", "phases": "texture", "image_scale": 1, "pyramid_levels": 3,
+   "outer_iterations": 1, "steps": 5}
+])";
+// Keys of every large_steps stage.
+const char kLargeStepsStageKeys[] = R"({"image_loss": "relative", "fit_specular": true,
+  "adam_large_steps": 25, "adam_uniform": true, "adam_resample": true, "adam_views_per_step": 8})";
+// Keys of its geometry stages.
+const char kLargeStepsGeometryKeys[] = R"({"pin": {"specular": false, "primary_edges": true}})";
+
+// The flat keys that describe one stage's phases and solver loop: given any of them, `auto`
+// with a given mesh picks the one-stage `refine` list rather than a list whose stages set them.
+bool FlatKeysDescribeOneStage(const json& flat) {
+  for (const char* key : {"phases", "solver", "outer_iterations", "steps"}) {
+    if (flat.contains(key)) return true;
+  }
+  return false;
+}
 const char kHullSchedule[] = R"([
   {"name": "quarter", "image_scale": 0.25, "pyramid_levels": 2, "outer_iterations": 3,
    "fit_specular": true},
@@ -152,8 +191,9 @@ Status MergeScheduleConfig(const json& config, const std::string& source, Schedu
   if (!config.is_object()) return Status::Error(source + ": expected a JSON object");
   for (const auto& [name, value] : config.items()) {
     if (name == "schedule") {
-      if (!value.is_string() || (value != "auto" && value != "refine" && value != "hull")) {
-        return Status::Error(source + ": schedule: expected auto, refine or hull");
+      if (!value.is_string() ||
+          (value != "auto" && value != "refine" && value != "hull" && value != "large_steps")) {
+        return Status::Error(source + ": schedule: expected auto, refine, large_steps or hull");
       }
       out->schedule = value.get<std::string>();
     } else if (name == "stages") {
@@ -188,9 +228,22 @@ Status ResolveStages(const ScheduleConfig& config, bool carved_start,
   json list = config.stages;
   std::string source = "stages";
   if (list.is_null()) {
-    const bool hull = config.schedule == "hull" || (config.schedule == "auto" && carved_start);
-    list = json::parse(hull ? kHullSchedule : kRefineSchedule);
-    source = std::string("built-in schedule ") + (hull ? "hull" : "refine");
+    std::string name = config.schedule;
+    if (name == "auto") {
+      name = carved_start                            ? "hull"
+             : FlatKeysDescribeOneStage(config.flat) ? "refine"
+                                                     : "large_steps";
+    }
+    if (name == "large_steps") {
+      list = json::parse(kLargeStepsSchedule);
+      for (json& stage : list) {
+        stage.update(json::parse(kLargeStepsStageKeys));
+        if (stage["phases"] == "geometry") stage.update(json::parse(kLargeStepsGeometryKeys));
+      }
+    } else {
+      list = json::parse(name == "hull" ? kHullSchedule : kRefineSchedule);
+    }
+    source = "built-in schedule " + name;
   }
   stages->clear();
   for (size_t k = 0; k < list.size(); ++k) {

@@ -22,7 +22,7 @@
 namespace sft {
 
 struct ScheduleConfig {
-  std::string schedule = "auto";                   // auto | refine | hull.
+  std::string schedule = "auto";                   // auto | refine | large_steps | hull.
   nlohmann::json stages;                           // explicit list; null = the built-in one.
   nlohmann::json flat = nlohmann::json::object();  // keys that override every stage.
 };
@@ -33,8 +33,9 @@ Status MergeScheduleConfig(const nlohmann::json& config, const std::string& sour
                            ScheduleConfig* out);
 Status ReadScheduleConfig(const std::string& path, ScheduleConfig* out);
 
-// The stage list: the explicit or built-in stages (`carved_start` picks "auto"'s), each with the
-// flat keys applied, checked.
+// The stage list: the explicit or built-in stages, each with the flat keys applied, checked.
+// "auto" picks `hull` for a carved start; from a given mesh, `large_steps`, or the one-stage
+// `refine` when a flat key describes one stage's loop (phases, solver, outer_iterations, steps).
 Status ResolveStages(const ScheduleConfig& config, bool carved_start,
                      std::vector<StageOptions>* stages);
 

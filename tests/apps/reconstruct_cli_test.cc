@@ -146,17 +146,23 @@ TEST(ReconstructCliTest, InterruptWritesACheckpointAndResumes) {
   EXPECT_TRUE(resumed["finished"].get<bool>());
 }
 
-// --print-schedule prints the effective stages and writes nothing: the built-in "refine" list
-// with --init, the "hull" list when the start would be carved (no --init, no initial_mesh, masks),
-// and flags applied to every stage.
+// --print-schedule prints the effective stages and writes nothing: the built-in "large_steps" list
+// with --init (the one-stage "refine" list when a flag describes one stage's loop), the "hull" list
+// when the start would be carved (no --init, no initial_mesh, masks), and flags applied to every
+// stage.
 TEST(ReconstructCliTest, PrintScheduleFollowsTheStart) {
   testing::TempDir tmp;
   ASSERT_EQ(testing::SynthIcosphere(tmp.Join("ds"), "--cameras 2 --zooms 1 --res 8 --spp 2"), "");
   std::string out;
   const std::string base = "reconstruct --dataset " + tmp.Join("ds") + " --print-schedule";
   ASSERT_EQ(RunSft(base + " --init " + tmp.Join("ds/gt/mesh.ply") + " --spp 7", &out), 0) << out;
-  EXPECT_THAT(out, HasSubstr("refine"));
+  EXPECT_THAT(out, HasSubstr("shape_half"));
+  EXPECT_THAT(out, HasSubstr("adam"));
   EXPECT_THAT(out, HasSubstr("   7 "));
+  EXPECT_GE(CountLines(out), 6) << out;
+  // --outer describes one stage's loop: the one-stage refine list.
+  ASSERT_EQ(RunSft(base + " --init " + tmp.Join("ds/gt/mesh.ply") + " --outer 2", &out), 0) << out;
+  EXPECT_THAT(out, HasSubstr("refine"));
   EXPECT_EQ(CountLines(out), 2) << out;
   ASSERT_EQ(RunSft(base + " --out " + tmp.Join("o"), &out), 0) << out;
   EXPECT_THAT(out, HasSubstr("remesh"));

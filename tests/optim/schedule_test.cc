@@ -104,9 +104,41 @@ TEST(ScheduleConfigTest, ShippedGlossyRefineScheduleParses) {
 TEST(ScheduleConfigTest, BuiltInListsFollowTheStart) {
   ScheduleConfig config;
   std::vector<StageOptions> stages;
+  // A given mesh: the large-steps list, LM material stages alternating with Adam geometry stages
+  // on large steps whose step size falls, ending with a material stage.
   ASSERT_TRUE(ResolveStages(config, /*carved_start=*/false, &stages).ok());
-  ASSERT_EQ(stages.size(), 1u);
-  EXPECT_EQ(stages[0].name, "refine");
+  ASSERT_GE(stages.size(), 5u);
+  EXPECT_EQ(stages[0].fit.phases, PhaseSchedule::kTexture);
+  EXPECT_EQ(stages[1].fit.phases, PhaseSchedule::kGeometry);
+  EXPECT_EQ(stages[1].fit.solver.kind, SolverKind::kAdam);
+  EXPECT_EQ(stages[1].fit.solver.adam.large_steps_lambda, 25.0);
+  EXPECT_TRUE(stages[1].fit.solver.adam.resample);
+  EXPECT_EQ(stages[1].fit.planner.pins.count("specular"), 1u);
+  EXPECT_EQ(stages[0].fit.planner.pins.count("specular"), 0u);  // material stages fit the lobe.
+  EXPECT_TRUE(stages[0].fit.fit_specular);
+  EXPECT_EQ(stages.back().fit.phases, PhaseSchedule::kTexture);
+  // Flat keys that describe one stage's loop pick the one-stage refine list.
+  for (const char* key : {"phases", "solver", "outer_iterations", "steps"}) {
+    SCOPED_TRACE(key);
+    ScheduleConfig one;
+    const json value = std::string(key) == "phases"   ? json("geometry")
+                       : std::string(key) == "solver" ? json("lm")
+                                                      : json(2);
+    ASSERT_TRUE(MergeScheduleConfig({{key, value}}, "cfg", &one).ok());
+    ASSERT_TRUE(ResolveStages(one, /*carved_start=*/false, &stages).ok());
+    ASSERT_EQ(stages.size(), 1u);
+    EXPECT_EQ(stages[0].name, "refine");
+  }
+  // Other flat keys keep the list and apply to every stage.
+  ScheduleConfig spp;
+  ASSERT_TRUE(MergeScheduleConfig({{"spp", 7}}, "cfg", &spp).ok());
+  ASSERT_TRUE(ResolveStages(spp, /*carved_start=*/false, &stages).ok());
+  ASSERT_GE(stages.size(), 5u);
+  for (const StageOptions& stage : stages) EXPECT_EQ(stage.fit.cache.render.spp, 7);
+  ScheduleConfig named;
+  ASSERT_TRUE(MergeScheduleConfig({{"schedule", "refine"}}, "cfg", &named).ok());
+  ASSERT_TRUE(ResolveStages(named, /*carved_start=*/false, &stages).ok());
+  EXPECT_EQ(stages.size(), 1u);
   ASSERT_TRUE(ResolveStages(config, /*carved_start=*/true, &stages).ok());
   ASSERT_GE(stages.size(), 3u);
   EXPECT_EQ(stages.front().fit.cache.image_scale_log2, 2);  // coarse to fine.
