@@ -179,7 +179,7 @@ Status RunReconstruct(const ReconstructCommandOptions& cli_in) {
   ScheduleCallbacks callbacks;
   callbacks.on_iteration = [&](const IterationRecord& record) {
     progress.SetDetail(record.stage);
-    progress.Advance(Schedule::StepWork(schedule->CurrentStage()));
+    progress.Advance(schedule->CurrentStepWork());
     return !g_interrupted.load();
   };
   callbacks.on_event = [&](const std::string& line) { progress.Note(line); };

@@ -55,12 +55,27 @@ bool StageOptions::Check(std::string* why) const {
   return fit.Check(why) && topology.Check(why);
 }
 
-int64_t Schedule::StepWork(const StageOptions& stage) {
+int64_t Schedule::StepWork(const StageOptions& stage, int dataset_views) {
   // Relative cost of one solver step: pixels (4^-k of the dataset's) × spp, 1000 units for a
-  // full-scale step at 16 spp; every phase of an outer iteration counts `steps` steps.
+  // full-scale step at 16 spp; every phase of an outer iteration counts `steps` steps. An Adam
+  // step with a minibatch renders views_per_step of the fitted views.
   const double pixels = std::ldexp(1.0, -2 * stage.fit.cache.image_scale_log2);
-  return std::max<int64_t>(1, std::llround(1000.0 * pixels * stage.fit.cache.render.spp / 16.0));
+  double share = 1.0;
+  const int batch = stage.fit.solver.adam.views_per_step;
+  const int fitted =
+      stage.fit.views.empty() ? dataset_views : static_cast<int>(stage.fit.views.size());
+  if (stage.fit.solver.kind == SolverKind::kAdam && batch > 0 && fitted > batch) {
+    share = static_cast<double>(batch) / fitted;
+  }
+  return std::max<int64_t>(
+      1, std::llround(1000.0 * pixels * share * stage.fit.cache.render.spp / 16.0));
 }
+
+int Schedule::WorkViews() const {
+  return dataset_ ? static_cast<int>(dataset_->views.size()) : work_views_;
+}
+
+int64_t Schedule::CurrentStepWork() const { return StepWork(CurrentStage(), WorkViews()); }
 
 int64_t Schedule::RemainingWork() const {
   int64_t work = 0;
@@ -69,14 +84,16 @@ int64_t Schedule::RemainingWork() const {
     const int phases = stage.fit.phases == PhaseSchedule::kAlternate ? 2 : 1;
     const int outers = stage.fit.outer_iterations -
                        (static_cast<int>(s) == progress_.stage ? progress_.stage_outer_done : 0);
-    work += static_cast<int64_t>(outers) * phases * stage.fit.solver.steps * StepWork(stage);
+    work += static_cast<int64_t>(outers) * phases * stage.fit.solver.steps *
+            StepWork(stage, WorkViews());
   }
   return work;
 }
 
-int64_t Schedule::TotalWork(const std::vector<StageOptions>& stages) {
+int64_t Schedule::TotalWork(const std::vector<StageOptions>& stages, int dataset_views) {
   Schedule fresh;
   fresh.stages_ = stages;
+  fresh.work_views_ = dataset_views;
   return fresh.RemainingWork();
 }
 

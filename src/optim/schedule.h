@@ -102,11 +102,15 @@ class Schedule {
   Reconstruction* reconstruction() { return reconstruction_.get(); }
 
   // Total solver steps of the remaining work, each weighted by its relative cost (image pixels ×
-  // spp), for a progress line whose ETA holds across stages of different scales.
+  // spp, and the share of the views an Adam minibatch renders), for a progress line whose ETA
+  // holds across stages of different scales.
   int64_t RemainingWork() const;
-  static int64_t StepWork(const StageOptions& stage);
+  // One step's work; `dataset_views` (0 = unknown: no minibatch share) counts the dataset's views.
+  static int64_t StepWork(const StageOptions& stage, int dataset_views = 0);
+  // StepWork of the current stage for this run's dataset.
+  int64_t CurrentStepWork() const;
   // The work of a whole run of `stages` in the same units (RemainingWork of a fresh run).
-  static int64_t TotalWork(const std::vector<StageOptions>& stages);
+  static int64_t TotalWork(const std::vector<StageOptions>& stages, int dataset_views = 0);
 
  private:
   Schedule() = default;
@@ -120,8 +124,10 @@ class Schedule {
   Status Checkpoint();
   void SyncCurrent();
   double Elapsed() const;  // seconds of the run so far, all sessions.
+  int WorkViews() const;   // the dataset's view count for StepWork (work_views_ without one).
 
   const Dataset* dataset_ = nullptr;
+  int work_views_ = 0;  // TotalWork's view count (no dataset).
   std::string out_;
   std::vector<StageOptions> stages_;
   nlohmann::json run_info_;

@@ -113,7 +113,8 @@ CellWork EstimateWork(const SweepContext& context, const SweepCell& cell) {
   work.view_fraction = views > 0 ? static_cast<double>(fitted) / views : 1.0;
   work.fit = context.grid->time_budget > 0.0
                  ? kBudgetCellWork
-                 : std::max<int64_t>(1, Schedule::TotalWork(stages) * work.view_fraction);
+                 : std::max<int64_t>(1, Schedule::TotalWork(stages, static_cast<int>(views)) *
+                                            work.view_fraction);
   work.eval =
       context.grid->time_budget > 0.0
           ? 0
@@ -186,7 +187,7 @@ Status RunSweep(const SweepGrid& grid, const SweepRunOptions& options, SweepSumm
     CellCallbacks callbacks;
     callbacks.on_iteration = [&](double seconds, const StageOptions& stage) {
       // Progress within the fit: time against the budget, or solver steps done.
-      steps += Schedule::StepWork(stage);
+      steps += Schedule::StepWork(stage, static_cast<int>(context->dataset.views.size()));
       const double fraction =
           grid.time_budget > 0.0 ? seconds / grid.time_budget : steps * w.view_fraction / w.fit;
       const int64_t target = std::min<int64_t>(w.fit, static_cast<int64_t>(fraction * w.fit));

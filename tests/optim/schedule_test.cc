@@ -101,6 +101,20 @@ TEST(ScheduleConfigTest, ShippedGlossyRefineScheduleParses) {
   EXPECT_EQ(stages.back().fit.phases, PhaseSchedule::kTexture);
 }
 
+// A step's progress work: pixels × spp, and for an Adam minibatch its share of the fitted views.
+TEST(ScheduleConfigTest, StepWorkCountsTheMinibatchShare) {
+  StageOptions lm;
+  StageOptions adam = lm;
+  adam.fit.solver.kind = SolverKind::kAdam;
+  adam.fit.solver.adam.views_per_step = 8;
+  EXPECT_EQ(Schedule::StepWork(lm, 64), 1000);
+  EXPECT_EQ(Schedule::StepWork(adam, 64), 125);
+  EXPECT_EQ(Schedule::StepWork(adam, 0), 1000);  // the view count unknown: no share.
+  EXPECT_EQ(Schedule::StepWork(adam, 4), 1000);  // a batch of all views.
+  adam.fit.cache.image_scale_log2 = 1;
+  EXPECT_EQ(Schedule::StepWork(adam, 64), 31);  // a quarter of the pixels: 31.25, rounded.
+}
+
 TEST(ScheduleConfigTest, BuiltInListsFollowTheStart) {
   ScheduleConfig config;
   std::vector<StageOptions> stages;
@@ -283,7 +297,7 @@ TEST_F(ScheduleRunTest, StagesRunInOrderWithCheckpoints) {
   const int64_t work = schedule->RemainingWork();
   int64_t done = 0;
   callbacks.on_iteration = [&](const IterationRecord& r) {
-    done += Schedule::StepWork(schedule->CurrentStage());
+    done += schedule->CurrentStepWork();
     return true;
   };
   ASSERT_TRUE(schedule->Run(callbacks).ok());
