@@ -8,9 +8,15 @@
 
 namespace sft {
 
-struct LargeSteps::Factor {
+struct LargeSteps::Matrix {
+  Eigen::SparseMatrix<double> m;
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt;
 };
+
+namespace {
+// The interleaved coordinates as an n × 3 row-major block.
+using Coordinates = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
+}  // namespace
 
 LargeSteps::~LargeSteps() = default;
 
@@ -33,39 +39,28 @@ Status LargeSteps::Create(const std::vector<std::vector<int>>& neighbours, doubl
       triplets.emplace_back(i, j, -lambda);
     }
   }
-  Eigen::SparseMatrix<double> m(n, n);
-  m.setFromTriplets(triplets.begin(), triplets.end());
   std::unique_ptr<LargeSteps> steps(new LargeSteps());
-  steps->factor_ = std::make_unique<Factor>();
-  steps->factor_->ldlt.compute(m);
-  if (steps->factor_->ldlt.info() != Eigen::Success) {
+  steps->m_ = std::make_unique<Matrix>();
+  steps->m_->m.resize(n, n);
+  steps->m_->m.setFromTriplets(triplets.begin(), triplets.end());
+  steps->m_->ldlt.compute(steps->m_->m);
+  if (steps->m_->ldlt.info() != Eigen::Success) {
     return Status::Error("large steps: the factorization of I + lambda L failed");
   }
-  steps->num_vertices_ = n;
-  steps->lambda_ = lambda;
-  steps->neighbours_ = neighbours;
   *out = std::move(steps);
   return Status::Ok();
 }
 
 void LargeSteps::ToU(const double* x, double* u) const {
-  for (int i = 0; i < num_vertices_; ++i) {
-    const std::vector<int>& ring = neighbours_[i];
-    for (int k = 0; k < 3; ++k) {
-      double sum = 0.0;
-      for (int j : ring) sum += x[3 * j + k];
-      u[3 * i + k] =
-          x[3 * i + k] + lambda_ * (static_cast<double>(ring.size()) * x[3 * i + k] - sum);
-    }
-  }
+  const Eigen::MatrixXd result = m_->m * Eigen::Map<const Coordinates>(x, m_->m.rows(), 3);
+  Eigen::Map<Coordinates>(u, m_->m.rows(), 3) = result;
 }
 
 void LargeSteps::ToX(const double* u, double* x) const {
-  // The interleaved coordinates as an n × 3 row-major block: one solve with three right sides.
-  using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
-  const Eigen::Map<const RowMajor> rhs(u, num_vertices_, 3);
-  const Eigen::MatrixXd solution = factor_->ldlt.solve(Eigen::MatrixXd(rhs));
-  Eigen::Map<RowMajor>(x, num_vertices_, 3) = solution;
+  // The solution is formed before x is written, so u and x may alias.
+  const Eigen::MatrixXd result =
+      m_->ldlt.solve(Eigen::MatrixXd(Eigen::Map<const Coordinates>(u, m_->m.rows(), 3)));
+  Eigen::Map<Coordinates>(x, m_->m.rows(), 3) = result;
 }
 
 }  // namespace sft

@@ -10,7 +10,8 @@
 // λ between 19 and 49; Mitsuba 3's shape tutorial uses 25.
 //
 // Positions are interleaved as the parameter layout stores them (vertex v, coordinate k at
-// 3v + k). The factorization is a sparse LDLᵀ (Eigen), built once per mesh connectivity.
+// 3v + k). The factorization is a sparse LDLᵀ (Eigen), built by Create (Adam builds one per
+// phase, for the mesh connectivity of that phase).
 #ifndef SFT_OPTIM_LARGE_STEPS_H_
 #define SFT_OPTIM_LARGE_STEPS_H_
 
@@ -30,22 +31,17 @@ class LargeSteps {
                        std::unique_ptr<LargeSteps>* out);
   ~LargeSteps();
 
-  int num_vertices() const { return num_vertices_; }
-  double lambda() const { return lambda_; }
-  // u = M x, for 3·num_vertices() interleaved coordinates.
+  // u = M x, for 3 × (vertex count) interleaved coordinates. x and u may be the same array.
   void ToU(const double* x, double* u) const;
-  // x = M⁻¹ u.
+  // x = M⁻¹ u. u and x may be the same array.
   void ToX(const double* u, double* x) const;
   // M⁻¹ g: the gradient with respect to u from the gradient g with respect to x.
   void GradientToU(const double* g, double* out) const { ToX(g, out); }
 
  private:
-  struct Factor;
+  struct Matrix;  // M and its factorization.
   LargeSteps() = default;
-  int num_vertices_ = 0;
-  double lambda_ = 0.0;
-  std::vector<std::vector<int>> neighbours_;
-  std::unique_ptr<Factor> factor_;
+  std::unique_ptr<Matrix> m_;
 };
 
 }  // namespace sft

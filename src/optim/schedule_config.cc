@@ -50,15 +50,6 @@ const char kLargeStepsStageKeys[] = R"({"image_loss": "relative", "fit_specular"
   "adam_large_steps": 25, "adam_uniform": true, "adam_resample": true, "adam_views_per_step": 8})";
 // Keys of its geometry stages.
 const char kLargeStepsGeometryKeys[] = R"({"pin": {"specular": false, "primary_edges": true}})";
-
-// The flat keys that describe one stage's phases and solver loop: given any of them, `auto`
-// with a given mesh picks the one-stage `refine` list rather than a list whose stages set them.
-bool FlatKeysDescribeOneStage(const json& flat) {
-  for (const char* key : {"phases", "solver", "outer_iterations", "steps"}) {
-    if (flat.contains(key)) return true;
-  }
-  return false;
-}
 const char kHullSchedule[] = R"([
   {"name": "quarter", "image_scale": 0.25, "pyramid_levels": 2, "outer_iterations": 3,
    "fit_specular": true},
@@ -69,6 +60,15 @@ const char kHullSchedule[] = R"([
   {"name": "texture", "phases": "texture", "image_scale": 1, "outer_iterations": 2,
    "texel_resolution": 3, "fit_specular": true}
 ])";
+
+// The flat keys that describe one stage's phases and solver loop: given any of them, `auto`
+// with a given mesh picks the one-stage `refine` list rather than a list whose stages set them.
+bool FlatKeysDescribeOneStage(const json& flat) {
+  for (const char* key : {"phases", "solver", "outer_iterations", "steps"}) {
+    if (flat.contains(key)) return true;
+  }
+  return false;
+}
 
 // Stage-only keys: how to apply a value ("" or what is wrong) and read it back.
 struct StageKey {

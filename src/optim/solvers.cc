@@ -322,15 +322,21 @@ Status RunSolver(const SolverOptions& options, const ProblemOptions& problem_opt
 
 namespace {
 
-// The minibatch of Adam step t (1-based): `per_step` views from a fixed shuffled order of all
-// `num_views`, consecutive batches taking consecutive slices (wrapping around). All views when
-// per_step is 0 or not below num_views.
-std::vector<int> AdamBatch(int num_views, int per_step, int64_t t, uint64_t seed) {
-  if (per_step <= 0 || per_step >= num_views) return {};
+// The views 0 .. num_views − 1 in an order shuffled by `seed`.
+std::vector<int> ShuffledViews(int num_views, uint64_t seed) {
   std::vector<int> order(num_views);
   for (int v = 0; v < num_views; ++v) order[v] = v;
   std::mt19937_64 rng(seed);
   std::shuffle(order.begin(), order.end(), rng);
+  return order;
+}
+
+// The minibatch of Adam step t (1-based): `per_step` views of `order`, consecutive batches taking
+// consecutive slices (wrapping around). All views (empty) when per_step is 0 or not below the
+// view count.
+std::vector<int> AdamBatch(const std::vector<int>& order, int per_step, int64_t t) {
+  const int num_views = static_cast<int>(order.size());
+  if (per_step <= 0 || per_step >= num_views) return {};
   std::vector<int> batch;
   for (int k = 0; k < per_step; ++k) {
     batch.push_back(order[static_cast<size_t>(((t - 1) * per_step + k) % num_views)]);
@@ -366,6 +372,22 @@ void AdamUpdate(const AdamOptions& adam, const SceneParameters& params,
   }
 }
 
+// Sizes the moments for `size` parameters (all restart when the size changes: a topology
+// change). Vertex moments of x and of u = (I + λL)x are not interchangeable: they restart (only
+// they, so that a texture phase between two geometry phases keeps its own) when λ changes.
+void PrepareAdamState(size_t size, int vertex_count, double lambda, AdamState* state) {
+  if (state->m.size() != size) {
+    state->m.assign(size, 0.0);
+    state->v.assign(size, 0.0);
+    state->t = 0;
+  }
+  if (vertex_count > 0 && state->lambda != lambda) {
+    std::fill(state->m.begin(), state->m.begin() + vertex_count, 0.0);
+    std::fill(state->v.begin(), state->v.begin() + vertex_count, 0.0);
+    state->lambda = lambda;
+  }
+}
+
 }  // namespace
 
 Status RunAdam(const SolverOptions& options, const ProblemOptions& problem_options,
@@ -390,32 +412,21 @@ Status RunAdam(const SolverOptions& options, const ProblemOptions& problem_optio
     SFT_RETURN_IF_ERROR(
         LargeSteps::Create(vertex_neighbours, adam.large_steps_lambda, &large_steps));
   }
-  const size_t size = params->layout().size();
-  if (state->m.size() != size) {
-    state->m.assign(size, 0.0);
-    state->v.assign(size, 0.0);
-    state->t = 0;
-  }
-  // Vertex moments of x and of u = (I + λL)x are not interchangeable: restart them (only them,
-  // so that a texture phase between two geometry phases keeps its own) when λ changes.
-  const double lambda = large_steps ? adam.large_steps_lambda : 0.0;
-  if (vertex_count > 0 && state->lambda != lambda) {
-    std::fill(state->m.begin(), state->m.begin() + vertex_count, 0.0);
-    std::fill(state->v.begin(), state->v.begin() + vertex_count, 0.0);
-    state->lambda = lambda;
-  }
+  PrepareAdamState(params->layout().size(), vertex_count,
+                   large_steps ? adam.large_steps_lambda : 0.0, state);
   std::vector<double> x = objective.Current(), gradient(n), y(n);
   const std::vector<int>& index = objective.active_indices();
   const int uniform_count = adam.uniform_vertices ? vertex_count : 0;
   const uint64_t base_seed = cache->seed();
+  const std::vector<int> order =
+      ShuffledViews(cache->num_views(), base_seed ^ 0x2545f4914f6cdd1dull);
   double cost = 0.0;
   stats->termination = "steps";
   const CacheClock before(*cache);
   for (int step = 1; step <= options.steps; ++step) {
     const int64_t t = state->t + 1;
     if (adam.resample) cache->SetSeed(base_seed + 0x9e3779b97f4a7c15ull * static_cast<uint64_t>(t));
-    const std::vector<int> batch =
-        AdamBatch(cache->num_views(), adam.views_per_step, t, base_seed ^ 0x2545f4914f6cdd1dull);
+    const std::vector<int> batch = AdamBatch(order, adam.views_per_step, t);
     if (!objective.EvaluateViews(x.data(), batch, &cost, gradient.data())) {
       stats->termination = "non-finite render";
       break;

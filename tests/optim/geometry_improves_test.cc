@@ -30,6 +30,24 @@ double Chamfer(const std::string& reference_path, const std::string& mesh_path) 
   return metrics.chamfer;
 }
 
+// The tests' case under `tmp`: ds/ (8 views of 32² of a unit-diagonal icosphere, Lambertian) and
+// init.ply (the true mesh displaced by a smooth field of at most 2% of the diagonal, seed 4).
+// Returns "" or what failed.
+std::string PerturbedSphere(const testing::TempDir& tmp) {
+  const std::string error =
+      testing::SynthIcosphere(tmp.Join("ds"),
+                              "--cameras 8 --zooms 1 --res 32 --spp 32 --bounces 1 "
+                              "--material '{\"albedo\": [0.7, 0.6, 0.5], \"roughness\": 0.5}'");
+  if (!error.empty()) return error;
+  std::string out;
+  if (RunSft("perturb --mesh " + tmp.Join("ds/gt/mesh.ply") + " --out " + tmp.Join("init.ply") +
+                 " --amplitude 0.02 --seed 4",
+             &out) != 0) {
+    return "sft perturb failed: " + out;
+  }
+  return "";
+}
+
 // 8 views of 32² of a unit-diagonal icosphere, start displaced by at most 2% of the diagonal,
 // 2 outer iterations × 5 LM steps of geometry at 8 spp with the true material (~4 s on 2 cores).
 // Measured 2026-11-26 over perturbation seeds 1–6: Chamfer 4.1e-3–6.5e-3 before, 4.9e-4–5.9e-4
@@ -40,18 +58,9 @@ double Chamfer(const std::string& reference_path, const std::string& mesh_path) 
 // images fails it.
 TEST(GeometryImprovesTest, ChamferFallsBySeventyPercentOnAPerturbedSphere) {
   testing::TempDir tmp;
-  ASSERT_EQ(testing::SynthIcosphere(tmp.Join("ds"),
-                                    "--cameras 8 --zooms 1 --res 32 --spp 32 --bounces 1 "
-                                    "--material '{\"albedo\": [0.7, 0.6, 0.5], \"roughness\": "
-                                    "0.5}'"),
-            "");
+  ASSERT_EQ(PerturbedSphere(tmp), "");
   const std::string truth = tmp.Join("ds/gt/mesh.ply");
   std::string out;
-  ASSERT_EQ(RunSft("perturb --mesh " + truth + " --out " + tmp.Join("init.ply") +
-                       " --amplitude 0.02 --seed 4",
-                   &out),
-            0)
-      << out;
   ASSERT_EQ(RunSft("reconstruct --quiet --no-report --dataset " + tmp.Join("ds") + " --init " +
                        tmp.Join("init.ply") + " --material " + tmp.Join("ds/gt/material.json") +
                        " --out " + tmp.Join("r") +
@@ -76,18 +85,9 @@ TEST(GeometryImprovesTest, ChamferFallsBySeventyPercentOnAPerturbedSphere) {
 // steps driven by regularizers alone) must leave the mesh where it was (above 0.95 × the start).
 TEST(GeometryImprovesTest, AdamWithLargeStepsLowersChamferOnAPerturbedSphere) {
   testing::TempDir tmp;
-  ASSERT_EQ(testing::SynthIcosphere(tmp.Join("ds"),
-                                    "--cameras 8 --zooms 1 --res 32 --spp 32 --bounces 1 "
-                                    "--material '{\"albedo\": [0.7, 0.6, 0.5], \"roughness\": "
-                                    "0.5}'"),
-            "");
+  ASSERT_EQ(PerturbedSphere(tmp), "");
   const std::string truth = tmp.Join("ds/gt/mesh.ply");
   std::string out;
-  ASSERT_EQ(RunSft("perturb --mesh " + truth + " --out " + tmp.Join("init.ply") +
-                       " --amplitude 0.02 --seed 4",
-                   &out),
-            0)
-      << out;
   const auto run = [&](const std::string& name, double image_weight) {
     const std::string config = tmp.Join(name + ".json");
     testing::WriteTestFile(
