@@ -387,7 +387,10 @@ Image RenderCache::AdjointWeights(int v) const {
 }
 
 bool RenderCache::AddAdjointGradient(int v, const Image& weights, std::vector<double>* gradient) {
-  return AddAdjointGradientWith(v, weights, plan(), seed_, gradient);
+  // Any fixed odd multiplier gives a seed stream disjoint in practice from the renders' seeds.
+  const uint64_t seed =
+      options_.independent_gradient ? seed_ * 0xd1342543de82ef95ull + 1ull : seed_;
+  return AddAdjointGradientWith(v, weights, plan(), seed, gradient);
 }
 
 bool RenderCache::AddAdjointGradientWith(int v, const Image& weights, const EffectPlan& plan,

@@ -57,6 +57,14 @@ struct RenderCacheOptions {
   // masks and the adjoint alike: kBox (2 × 2 means) or kBinomial ([1 2 1]/4 separable).
   PyramidFilter pyramid_filter = PyramidFilter::kBox;
   ImageLoss image_loss = ImageLoss::kL2;  // per-pixel weighting of the image term (above).
+  // The adjoint (gradient) pass draws its own paths, with a seed independent of the render the
+  // residual comes from. With one set of paths for both, E[(R̂ − y)·∂R̂] = (E R̂ − y)·∂E R̂ +
+  // ½∂Var R̂: the gradient also descends the render's variance, so glossy, low-roughness and
+  // high-specular states are pushed away (the bias Azinović et al. 2019, "Inverse Path Tracing",
+  // avoid with two independent sample sets).
+  // Independent paths make the gradient an unbiased estimate of the noise-free loss's. Used by
+  // the first-order solvers (the adjoint pass); LM's rows come from the residual's own pass.
+  bool independent_gradient = false;
 
   bool Check(std::string* why) const;
 };

@@ -42,8 +42,9 @@ const char kLargeStepsSchedule[] = R"([
    "outer_iterations": 1, "steps": 5},
   {"name": "shape_full3", "phases": "geometry", "solver": "adam", "image_scale": 1,
    "pyramid_levels": 3, "outer_iterations": 2, "steps": 25, "adam_lr_vertices": 0.00025},
-  {"name": "material_final", "phases": "texture", "image_scale": 1, "pyramid_levels": 3,
-   "outer_iterations": 1, "steps": 5}
+  {"name": "material_final", "phases": "texture", "solver": "adam", "image_scale": 1,
+   "pyramid_levels": 3, "outer_iterations": 1, "steps": 120, "independent_gradient": true,
+   "adam_views_per_step": 16}
 ])";
 // Keys of every large_steps stage.
 const char kLargeStepsStageKeys[] = R"({"image_loss": "relative", "fit_specular": true,
@@ -237,8 +238,10 @@ Status ResolveStages(const ScheduleConfig& config, bool carved_start,
     if (name == "large_steps") {
       list = json::parse(kLargeStepsSchedule);
       for (json& stage : list) {
+        const json own = stage;  // a stage's own keys win over the list's.
         stage.update(json::parse(kLargeStepsStageKeys));
         if (stage["phases"] == "geometry") stage.update(json::parse(kLargeStepsGeometryKeys));
+        stage.update(own);
       }
     } else {
       list = json::parse(name == "hull" ? kHullSchedule : kRefineSchedule);

@@ -76,7 +76,8 @@ TEST(ScheduleConfigTest, LongStageNamesKeepColumnsAligned) {
 
 // The shipped glossy-refine schedule (data/example/glossy_refine.json, docs/reconstruct.md) parses
 // and alternates LM texture stages with Adam large-steps geometry stages that do not simulate the
-// specular lobe, with the step size falling from stage to stage.
+// specular lobe, with the step size falling from stage to stage, and ends with an Adam texture
+// stage on independent gradient paths.
 TEST(ScheduleConfigTest, ShippedGlossyRefineScheduleParses) {
   ScheduleConfig config;
   ASSERT_TRUE(ReadScheduleConfig(testing::DataDir() + "/example/glossy_refine.json", &config).ok());
@@ -87,7 +88,9 @@ TEST(ScheduleConfigTest, ShippedGlossyRefineScheduleParses) {
   for (const StageOptions& stage : stages) {
     SCOPED_TRACE(stage.name);
     if (stage.fit.phases == PhaseSchedule::kTexture) {
-      EXPECT_EQ(stage.fit.solver.kind, SolverKind::kLevenbergMarquardt);
+      const bool last = &stage == &stages.back();
+      EXPECT_EQ(stage.fit.solver.kind, last ? SolverKind::kAdam : SolverKind::kLevenbergMarquardt);
+      EXPECT_EQ(stage.fit.cache.independent_gradient, last);
       EXPECT_TRUE(stage.fit.fit_specular);
       continue;
     }
@@ -95,6 +98,7 @@ TEST(ScheduleConfigTest, ShippedGlossyRefineScheduleParses) {
     EXPECT_EQ(stage.fit.solver.kind, SolverKind::kAdam);
     EXPECT_EQ(stage.fit.solver.adam.large_steps_lambda, 25.0);
     EXPECT_TRUE(stage.fit.solver.adam.resample);
+    EXPECT_FALSE(stage.fit.cache.independent_gradient);
     EXPECT_LT(stage.fit.solver.adam.learning_rate_vertices, last_lr);
     last_lr = stage.fit.solver.adam.learning_rate_vertices;
   }
@@ -119,7 +123,8 @@ TEST(ScheduleConfigTest, BuiltInListsFollowTheStart) {
   ScheduleConfig config;
   std::vector<StageOptions> stages;
   // A given mesh: the large-steps list, LM material stages alternating with Adam geometry stages
-  // on large steps whose step size falls, ending with a material stage.
+  // on large steps whose step size falls, ending with an Adam material stage on independent
+  // gradient paths.
   ASSERT_TRUE(ResolveStages(config, /*carved_start=*/false, &stages).ok());
   ASSERT_GE(stages.size(), 5u);
   EXPECT_EQ(stages[0].fit.phases, PhaseSchedule::kTexture);
@@ -130,7 +135,12 @@ TEST(ScheduleConfigTest, BuiltInListsFollowTheStart) {
   EXPECT_EQ(stages[1].fit.planner.pins.count("specular"), 1u);
   EXPECT_EQ(stages[0].fit.planner.pins.count("specular"), 0u);  // material stages fit the lobe.
   EXPECT_TRUE(stages[0].fit.fit_specular);
+  EXPECT_EQ(stages[0].fit.solver.kind, SolverKind::kLevenbergMarquardt);
+  EXPECT_FALSE(stages[1].fit.cache.independent_gradient);
   EXPECT_EQ(stages.back().fit.phases, PhaseSchedule::kTexture);
+  EXPECT_EQ(stages.back().fit.solver.kind, SolverKind::kAdam);
+  EXPECT_TRUE(stages.back().fit.cache.independent_gradient);
+  EXPECT_EQ(stages.back().fit.solver.adam.views_per_step, 16);
   // Flat keys that describe one stage's loop pick the one-stage refine list.
   for (const char* key : {"phases", "solver", "outer_iterations", "steps"}) {
     SCOPED_TRACE(key);
