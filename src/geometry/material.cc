@@ -1,14 +1,17 @@
 #include "src/geometry/material.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <set>
 
 #include "src/core/file_util.h"
 #include "src/core/image.h"
+#include "src/geometry/mtl_material.h"
 #include "src/geometry/procedural_pattern.h"
 #include "src/geometry/texture_sampling.h"
 
@@ -25,17 +28,22 @@ constexpr int kMaxResolution = 64;
 constexpr double kDefaultWoodScale = 10.0;
 constexpr double kDefaultNoiseScale = 4.0;
 
-// Where errors point: the JSON file's path or "material (inline JSON)".
+// Where errors point: the JSON or MTL file's path or "material (inline JSON)", and for an MTL file
+// the statement each field came from.
 class Context {
  public:
-  explicit Context(std::string where) : where_(std::move(where)) {}
+  explicit Context(std::string where, std::map<std::string, std::string> aliases = {})
+      : where_(std::move(where)), aliases_(std::move(aliases)) {}
   Status Error(const std::string& field, const std::string& what) const {
-    return Status::Error(where_ + ": \"" + field + "\": " + what);
+    const auto alias = aliases_.find(field);
+    return Status::Error(where_ + ": \"" + (alias == aliases_.end() ? field : alias->second) +
+                         "\": " + what);
   }
   Status Error(const std::string& what) const { return Status::Error(where_ + ": " + what); }
 
  private:
   std::string where_;
+  std::map<std::string, std::string> aliases_;
 };
 
 std::string FormatNumber(double v) {
@@ -91,9 +99,10 @@ void FillConstant(int num_faces, int resolution, const double* value, int channe
 
 const std::set<std::string>& KnownKeys() {
   static const std::set<std::string> keys = {
-      "albedo",     "albedo_texture", "colorspace", "mesh_colors", "roughness_mesh_colors",
-      "procedural", "colors",         "scale",      "roughness",   "roughness_range",
-      "specular",   "fresnel",        "resolution", "seed"};
+      "albedo",      "albedo_texture", "colorspace", "mesh_colors", "roughness_mesh_colors",
+      "procedural",  "colors",         "scale",      "roughness",   "roughness_range",
+      "specular",    "fresnel",        "resolution", "seed",        "uv_albedo",
+      "uv_roughness"};
   return keys;
 }
 
@@ -119,9 +128,32 @@ Status ReadMeshColorsFor(const Context& ctx, const std::string& field, const std
   return Status::Ok();
 }
 
+// The UV-texture form: "uv_albedo" and/or "uv_roughness" (with a constant "albedo" or the default
+// when there is no "uv_albedo"); *source becomes "uv". Refused for fitting (MaterialUse::kFit).
+Status CheckUvForm(const Context& ctx, const Json& json, MaterialUse use, std::string* source) {
+  const bool uv_albedo = json.contains("uv_albedo"), uv_roughness = json.contains("uv_roughness");
+  if (!uv_albedo && !uv_roughness) return Status::Ok();
+  if (uv_roughness && *source != "albedo" && *source != "uv_albedo") {
+    return ctx.Error("uv_roughness", "cannot be combined with \"" + *source + "\"");
+  }
+  const char* field = uv_albedo ? "uv_albedo" : "uv_roughness";
+  if (json.contains("roughness_mesh_colors")) {
+    return ctx.Error("roughness_mesh_colors",
+                     std::string("cannot be combined with \"") + field + "\"");
+  }
+  if (use == MaterialUse::kFit) {
+    return ctx.Error(field,
+                     "a UV-texture material can be rendered (sft render, sft gradcheck) but not "
+                     "fitted or saved; \"albedo_texture\" samples a texture into mesh colors");
+  }
+  *source = "uv";
+  return Status::Ok();
+}
+
 // Checks the keys: all known, exactly one albedo source (none: the default constant; its name in
-// *source), keys of one form only with that form, at most one roughness source.
-Status CheckForm(const Context& ctx, const Json& json, std::string* source) {
+// *source, "uv" for the UV-texture form), keys of one form only with that form, at most one
+// roughness source, the UV-texture form only for rendering.
+Status CheckForm(const Context& ctx, const Json& json, MaterialUse use, std::string* source) {
   if (!json.is_object()) return ctx.Error("expected a JSON object");
   for (auto it = json.begin(); it != json.end(); ++it) {
     if (KnownKeys().count(it.key()) == 0) {
@@ -130,13 +162,14 @@ Status CheckForm(const Context& ctx, const Json& json, std::string* source) {
   }
   auto has = [&](const char* key) { return json.contains(key); };
   std::vector<std::string> sources;
-  for (const char* key : {"albedo", "albedo_texture", "mesh_colors", "procedural"}) {
+  for (const char* key : {"albedo", "albedo_texture", "mesh_colors", "procedural", "uv_albedo"}) {
     if (has(key)) sources.push_back(key);
   }
   if (sources.size() > 1) {
     return ctx.Error(sources[1], "cannot be combined with \"" + sources[0] + "\"");
   }
   *source = sources.empty() ? "albedo" : sources[0];
+  SFT_RETURN_IF_ERROR(CheckUvForm(ctx, json, use, source));
   // Keys that belong to one form only.
   const std::pair<const char*, const char*> form_keys[] = {{"colorspace", "albedo_texture"},
                                                            {"colors", "procedural"},
@@ -144,21 +177,27 @@ Status CheckForm(const Context& ctx, const Json& json, std::string* source) {
                                                            {"seed", "procedural"},
                                                            {"roughness_range", "procedural"}};
   for (const auto& fk : form_keys) {
-    if (has(fk.first) && *source != fk.second) {
+    const bool uv_colorspace =
+        *source == "uv" && has("uv_albedo") && std::string(fk.first) == "colorspace";
+    if (has(fk.first) && *source != fk.second && !uv_colorspace) {
       return ctx.Error(fk.first, std::string("only applies with \"") + fk.second + "\"");
     }
   }
   if (has("resolution") && *source == "mesh_colors") {
     return ctx.Error("resolution", "does not apply with \"mesh_colors\" (the file has its own)");
   }
+  if (has("resolution") && *source == "uv") {
+    return ctx.Error("resolution", "does not apply to UV textures (they have their own size)");
+  }
   int roughness_sources = 0;
-  for (const char* key : {"roughness", "roughness_mesh_colors", "roughness_range"}) {
+  for (const char* key :
+       {"roughness", "roughness_mesh_colors", "roughness_range", "uv_roughness"}) {
     roughness_sources += has(key) ? 1 : 0;
   }
   if (roughness_sources > 1) {
     return ctx.Error("roughness",
                      "give only one of \"roughness\", \"roughness_mesh_colors\", "
-                     "\"roughness_range\"");
+                     "\"roughness_range\", \"uv_roughness\"");
   }
   return Status::Ok();
 }
@@ -300,15 +339,85 @@ Status ParseRoughness(const Context& ctx, const Json& json, const std::string& b
   return Status::Ok();
 }
 
+// The texture file of `field` of the UV-texture form: an RGB(A) image for albedo (alpha ignored),
+// a grey one for roughness.
+Status ReadUvTexture(const Context& ctx, const std::string& field, const std::string& file,
+                     bool srgb, UvTexture* texture) {
+  const bool rgb = field == "uv_albedo";
+  Image image;
+  const Status status = ReadTextureImage(file, srgb, rgb ? "albedo" : "roughness", &image);
+  if (!status.ok()) return ctx.Error(field, status.message());
+  if (rgb && image.channels < 3) {
+    return ctx.Error(field, file + ": expected an RGB image, got " +
+                                std::to_string(image.channels) + " channel(s)");
+  }
+  if (!rgb && image.channels != 1) {
+    return ctx.Error(field, file + ": expected a grey (1-channel) image, got " +
+                                std::to_string(image.channels) + " channels");
+  }
+  *texture = UvTexture::FromImage(image, rgb ? 3 : 1);
+  return Status::Ok();
+}
+
+// The UV-texture form: the mesh's corner UVs, the albedo texture or constant, the roughness
+// texture or constant (constants become 1×1 textures).
+Status ParseUvMaterial(const Context& ctx, const Json& json, const std::string& base_dir,
+                       const TriMesh& mesh, UvMaterialMaps* maps) {
+  const int num_faces = static_cast<int>(mesh.n_faces());
+  maps->corner_uvs = FaceCornerUvs(mesh);
+  if (maps->corner_uvs.size() != 3 * static_cast<size_t>(num_faces) || num_faces == 0) {
+    return ctx.Error(json.contains("uv_albedo") ? "uv_albedo" : "uv_roughness",
+                     "the mesh has no texture coordinates (UVs)");
+  }
+  bool srgb = false;
+  if (json.contains("colorspace")) {
+    const Json& v = json["colorspace"];
+    if (v != "linear" && v != "srgb") {
+      return ctx.Error("colorspace", "expected \"linear\" or \"srgb\", got " + v.dump());
+    }
+    srgb = v == "srgb";
+  }
+  std::string file;
+  if (json.contains("uv_albedo")) {
+    SFT_RETURN_IF_ERROR(ReadString(ctx, json, "uv_albedo", &file));
+    SFT_RETURN_IF_ERROR(
+        ReadUvTexture(ctx, "uv_albedo", JoinPath(base_dir, file), srgb, &maps->albedo));
+  } else {
+    Eigen::Vector3d albedo = Eigen::Vector3d::Constant(kDefaultAlbedo);
+    if (json.contains("albedo")) {
+      SFT_RETURN_IF_ERROR(ParseColor(ctx, "albedo", json["albedo"], &albedo));
+    }
+    maps->albedo = UvTexture(1, 1, 3);
+    for (int c = 0; c < 3; ++c) maps->albedo.texel(0)[c] = albedo[c];
+  }
+  if (json.contains("uv_roughness")) {
+    SFT_RETURN_IF_ERROR(ReadString(ctx, json, "uv_roughness", &file));
+    SFT_RETURN_IF_ERROR(ReadUvTexture(ctx, "uv_roughness", JoinPath(base_dir, file),
+                                      /*srgb=*/false, &maps->roughness));
+  } else {
+    double roughness = kDefaultRoughness;
+    if (json.contains("roughness")) {
+      SFT_RETURN_IF_ERROR(ReadNumber(ctx, json, "roughness", 0.0, 1.0, &roughness));
+    }
+    maps->roughness = UvTexture(1, 1, 1, roughness);
+  }
+  return Status::Ok();
+}
+
 Status BuildMaterial(const Context& ctx, const Json& json, const std::string& base_dir,
-                     const TriMesh& mesh, Material* material) {
+                     const TriMesh& mesh, MaterialUse use, Material* material) {
   std::string source;
-  SFT_RETURN_IF_ERROR(CheckForm(ctx, json, &source));
+  SFT_RETURN_IF_ERROR(CheckForm(ctx, json, use, &source));
   const int num_faces = static_cast<int>(mesh.n_faces());
   Material result;
   int resolution = 1;
   SFT_RETURN_IF_ERROR(ParseCommon(ctx, json, source, &result, &resolution));
   std::vector<double> weights;  // Procedural mixing weight per texel (for roughness_range).
+  if (source == "uv") {
+    SFT_RETURN_IF_ERROR(ParseUvMaterial(ctx, json, base_dir, mesh, &result.uv));
+    *material = std::move(result);
+    return Status::Ok();
+  }
   if (source == "albedo") {
     Eigen::Vector3d albedo = Eigen::Vector3d::Constant(kDefaultAlbedo);
     if (json.contains("albedo")) {
@@ -333,6 +442,13 @@ Status BuildMaterial(const Context& ctx, const Json& json, const std::string& ba
   return Status::Ok();
 }
 
+// Whether `path` names an MTL file (extension .mtl, any case).
+bool IsMtlPath(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext == ".mtl";
+}
+
 }  // namespace
 
 Material ConstantMaterial(int num_faces, const Eigen::Vector3d& albedo, double roughness,
@@ -344,7 +460,27 @@ Material ConstantMaterial(int num_faces, const Eigen::Vector3d& albedo, double r
   return material;
 }
 
-Status LoadMaterial(const std::string& spec, const TriMesh& mesh, Material* material) {
+int Material::NumAlbedoTexels() const {
+  return has_uv_textures() ? uv.albedo.num_texels() : albedo.num_texels();
+}
+int Material::NumRoughnessTexels() const {
+  return has_uv_textures() ? uv.roughness.num_texels() : roughness.num_texels();
+}
+std::vector<double>& Material::AlbedoValues() {
+  return has_uv_textures() ? uv.albedo.values() : albedo.values();
+}
+const std::vector<double>& Material::AlbedoValues() const {
+  return has_uv_textures() ? uv.albedo.values() : albedo.values();
+}
+std::vector<double>& Material::RoughnessValues() {
+  return has_uv_textures() ? uv.roughness.values() : roughness.values();
+}
+const std::vector<double>& Material::RoughnessValues() const {
+  return has_uv_textures() ? uv.roughness.values() : roughness.values();
+}
+
+Status LoadMaterial(const std::string& spec, const TriMesh& mesh, Material* material,
+                    MaterialUse use) {
   const size_t first = spec.find_first_not_of(" \t\r\n");
   if (first == std::string::npos) {
     *material = ConstantMaterial(static_cast<int>(mesh.n_faces()),
@@ -363,15 +499,23 @@ Status LoadMaterial(const std::string& spec, const TriMesh& mesh, Material* mate
     base_dir = std::filesystem::path(spec).parent_path().string();
     where = spec;
   }
-  const Context ctx(where);
   Json json;
-  try {
-    json = Json::parse(text);
-  } catch (const Json::exception& e) {
-    return ctx.Error(std::string("invalid JSON (") + e.what() + ")");
+  std::map<std::string, std::string> aliases;
+  if (spec[first] != '{' && IsMtlPath(spec)) {
+    MtlMaterial mtl;
+    SFT_RETURN_IF_ERROR(ParseMtl(text, spec, &mtl));
+    json = std::move(mtl.json);
+    aliases = std::move(mtl.statement_of_field);
+  } else {
+    try {
+      json = Json::parse(text);
+    } catch (const Json::exception& e) {
+      return Context(where).Error(std::string("invalid JSON (") + e.what() + ")");
+    }
   }
+  const Context ctx(where, std::move(aliases));
   try {
-    return BuildMaterial(ctx, json, base_dir, mesh, material);
+    return BuildMaterial(ctx, json, base_dir, mesh, use, material);
   } catch (const Json::exception& e) {
     // Every access is type-checked above; this is a safety net so that no exception escapes.
     return ctx.Error(std::string("malformed material (") + e.what() + ")");
@@ -379,6 +523,9 @@ Status LoadMaterial(const std::string& spec, const TriMesh& mesh, Material* mate
 }
 
 Status SaveMaterial(const std::string& json_path, const Material& material) {
+  if (material.has_uv_textures()) {
+    return Status::Error(json_path + ": a UV-texture material cannot be saved as mesh colors");
+  }
   if (material.albedo.channels() != 3 || material.roughness.channels() != 1) {
     return Status::Error(json_path + ": material needs 3 albedo channels and 1 roughness channel");
   }

@@ -5,7 +5,11 @@
 //
 // Parameters live in one flat index space (ParameterLayout): vertex coordinates, albedo texels
 // (RGB), roughness texels, the specular weight, and one intensity scale per dataset light (the
-// light's radiance/intensity is multiplied by it; derivatives are taken at scale 1).
+// light's radiance/intensity is multiplied by it; derivatives are taken at scale 1). The texels
+// are those of the material's active representation (Material::AlbedoValues): mesh colors, where
+// a hit uses one texel, or UV textures (texel y·W + x, uv_texture.h), where a hit blends four
+// bilinearly and each gets its bilinear weight times the derivative with respect to the blended
+// value. UV textures have no texel-boundary terms (internal/texel_edges.h says why).
 //
 // What is differentiated (the estimator treats sampled directions, lobe choices, pdfs and MIS
 // weights as constants — "detached sampling" — which is unbiased for the derivative of the

@@ -38,13 +38,24 @@ struct Context {
   const VertexNormalJacobian* normal_jacobian;
 };
 
-// Texel indices of a hit, and the BSDF parameters there.
+// The texels whose values a hit's material parameter blends, and their weights (the parameter is
+// Σ weight·texel, so ∂parameter/∂texel = weight): one texel of weight 1 for mesh colors (the
+// nearest texel), up to four bilinear texels for UV textures (zero weights left out).
+struct TexelWeights {
+  int count = 0;
+  int texel[4] = {0, 0, 0, 0};
+  double weight[4] = {0.0, 0.0, 0.0, 0.0};
+};
+
+// The texels of a hit, and the BSDF parameters there.
 struct SurfaceMaterial {
-  int albedo_texel = 0;
-  int roughness_texel = 0;
+  TexelWeights albedo_texels;
+  TexelWeights roughness_texels;
   BsdfParams params;
 };
 
+// The material at barycentrics (1 − u − v, u, v) of `face`: the one place where the renderer reads
+// albedo and roughness, from mesh colors or from UV textures (material.h).
 SurfaceMaterial LookUpMaterial(const Context& ctx, const Material& material, int face, double u,
                                double v);
 

@@ -240,14 +240,49 @@ double PowerHeuristic(double pdf_a, double pdf_b) {
   return a2 / (a2 + b2);
 }
 
+namespace {
+
+// The bilinear texels of `texture` at `uv` with non-zero weight, and the interpolated value
+// (Σ weight·texel, channels() values into `value`).
+TexelWeights BilinearTexels(const UvTexture& texture, const Eigen::Vector2d& uv, double* value) {
+  const BilinearFootprint footprint = texture.Footprint(uv);
+  TexelWeights out;
+  for (int c = 0; c < texture.channels(); ++c) value[c] = 0.0;
+  for (int k = 0; k < 4; ++k) {
+    if (footprint.weight[k] == 0.0) continue;
+    out.texel[out.count] = footprint.texel[k];
+    out.weight[out.count] = footprint.weight[k];
+    ++out.count;
+    const double* texel = texture.texel(footprint.texel[k]);
+    for (int c = 0; c < texture.channels(); ++c) value[c] += footprint.weight[k] * texel[c];
+  }
+  return out;
+}
+
+TexelWeights NearestTexel(int texel) {
+  TexelWeights out;
+  out.count = 1;
+  out.texel[0] = texel;
+  out.weight[0] = 1.0;
+  return out;
+}
+
+}  // namespace
+
 SurfaceMaterial LookUpMaterial(const Context& ctx, const Material& material, int face, double u,
                                double v) {
   SurfaceMaterial m;
-  m.albedo_texel = material.albedo.TexelIndex(face, u, v);
-  m.roughness_texel = material.roughness.TexelIndex(face, u, v);
-  const double* albedo = material.albedo.texel(m.albedo_texel);
-  m.params.albedo = Eigen::Vector3d(albedo[0], albedo[1], albedo[2]);
-  m.params.roughness = *material.roughness.texel(m.roughness_texel);
+  if (material.has_uv_textures()) {
+    const Eigen::Vector2d uv = material.uv.Uv(face, u, v);
+    m.albedo_texels = BilinearTexels(material.uv.albedo, uv, m.params.albedo.data());
+    m.roughness_texels = BilinearTexels(material.uv.roughness, uv, &m.params.roughness);
+  } else {
+    m.albedo_texels = NearestTexel(material.albedo.TexelIndex(face, u, v));
+    m.roughness_texels = NearestTexel(material.roughness.TexelIndex(face, u, v));
+    const double* albedo = material.albedo.texel(m.albedo_texels.texel[0]);
+    m.params.albedo = Eigen::Vector3d(albedo[0], albedo[1], albedo[2]);
+    m.params.roughness = *material.roughness.texel(m.roughness_texels.texel[0]);
+  }
   m.params.specular = material.specular * ctx.specular_scale;
   m.params.fresnel = material.fresnel;
   return m;

@@ -108,16 +108,23 @@ void PathDerivatives::AddMaterial(const SurfaceMaterial& surface, const BsdfDeri
                                   const Eigen::Vector3d& base) {
   const ParameterSelection& sel = ctx_.request->params;
   const ParameterLayout& layout = *ctx_.layout;
+  // ∂/∂texel = the texel's weight × ∂/∂(the blended parameter) (context.h, TexelWeights).
   if (sel.albedo && d.d_albedo != 0.0) {
-    const int first = layout.AlbedoOffset() + 3 * surface.albedo_texel;
-    for (int c = 0; c < 3; ++c) {
-      Eigen::Vector3d v = Eigen::Vector3d::Zero();
-      v[c] = base[c] * d.d_albedo;
-      Add(first + c, v);
+    const TexelWeights& texels = surface.albedo_texels;
+    for (int k = 0; k < texels.count; ++k) {
+      const int first = layout.AlbedoOffset() + 3 * texels.texel[k];
+      for (int c = 0; c < 3; ++c) {
+        Eigen::Vector3d v = Eigen::Vector3d::Zero();
+        v[c] = base[c] * (texels.weight[k] * d.d_albedo);
+        Add(first + c, v);
+      }
     }
   }
   if (sel.roughness && d.d_roughness != 0.0) {
-    Add(layout.RoughnessOffset() + surface.roughness_texel, base * d.d_roughness);
+    const TexelWeights& texels = surface.roughness_texels;
+    for (int k = 0; k < texels.count; ++k) {
+      Add(layout.RoughnessOffset() + texels.texel[k], base * (texels.weight[k] * d.d_roughness));
+    }
   }
   if (sel.specular && d.d_specular != 0.0) {
     Add(layout.SpecularIndex(), base * d.d_specular);
