@@ -13,6 +13,8 @@
 // - Borders: repeat (wrap) in both directions, as Blender's default image extension and glTF's
 //   default sampler do; UVs outside [0, 1] tile the texture. An atlas from `sft export` keeps
 //   its charts inside [0, 1] with dilated gutters, so wrapping only blends gutter texels there.
+// - Derivatives (src/render/derivatives.h): texels exactly; vertex derivatives leave out the
+//   texture's slide under a moving face (stated there).
 // - Values are linear: an sRGB-encoded albedo PNG is decoded on load (material.h), roughness is
 //   stored linearly (GGX α = roughness²).
 #ifndef SFT_GEOMETRY_UV_TEXTURE_H_
