@@ -52,7 +52,22 @@ BilinearFootprint UvTexture::Footprint(const Eigen::Vector2d& uv) const {
   f.weight[1] = s * (1 - t);
   f.weight[2] = (1 - s) * t;
   f.weight[3] = s * t;
+  f.s = s;
+  f.t = t;
   return f;
+}
+
+void UvTexture::Gradient(const BilinearFootprint& f, double* d_du, double* d_dv) const {
+  const double* t0 = texel(f.texel[0]);
+  const double* t1 = texel(f.texel[1]);
+  const double* t2 = texel(f.texel[2]);
+  const double* t3 = texel(f.texel[3]);
+  for (int c = 0; c < channels_; ++c) {
+    const double d_ds = (1 - f.t) * (t1[c] - t0[c]) + f.t * (t3[c] - t2[c]);
+    const double d_dt = (1 - f.s) * (t2[c] - t0[c]) + f.s * (t3[c] - t1[c]);
+    d_du[c] = width_ * d_ds;    // s = u·W − ½ − x0.
+    d_dv[c] = -height_ * d_dt;  // t = (1 − v)·H − ½ − y0.
+  }
 }
 
 void UvTexture::Sample(const Eigen::Vector2d& uv, double* out) const {

@@ -13,8 +13,8 @@
 // - Borders: repeat (wrap) in both directions, as Blender's default image extension and glTF's
 //   default sampler do; UVs outside [0, 1] tile the texture. An atlas from `sft export` keeps
 //   its charts inside [0, 1] with dilated gutters, so wrapping only blends gutter texels there.
-// - Derivatives (src/render/derivatives.h): texels exactly; vertex derivatives leave out the
-//   texture's slide under a moving face (stated there).
+// - Derivatives (src/render/derivatives.h): texels, and vertices through the texture sliding
+//   under a moving face; jumps at UV seams between coplanar faces are not sampled.
 // - Values are linear: an sRGB-encoded albedo PNG is decoded on load (material.h), roughness is
 //   stored linearly (GGX α = roughness²).
 #ifndef SFT_GEOMETRY_UV_TEXTURE_H_
@@ -30,8 +30,9 @@ namespace sft {
 // The four texels that a bilinear lookup blends and their weights (non-negative, sum 1). Texels
 // may repeat (a 1-texel-wide texture); the weights of a repeated texel then add.
 struct BilinearFootprint {
-  int texel[4];
-  double weight[4];
+  int texel[4];      // (x0, y0), (x1, y0), (x0, y1), (x1, y1).
+  double weight[4];  // (1 − s)(1 − t), s(1 − t), (1 − s)t, st.
+  double s, t;       // position in the cell, [0, 1): s along +x (+u), t along +y (−v).
 };
 
 // A W × H grid of texels with `channels` values each, sampled bilinearly.
@@ -56,6 +57,10 @@ class UvTexture {
   BilinearFootprint Footprint(const Eigen::Vector2d& uv) const;
   // The interpolated value at `uv`: channels() values into `out`.
   void Sample(const Eigen::Vector2d& uv, double* out) const;
+  // The gradient of the interpolant with respect to uv at a lookup with footprint `f`:
+  // channels() values each of ∂/∂u and ∂/∂v, those of the cell the footprint is in (on a cell
+  // border, where the interpolant has a kink, the cell to the right / below).
+  void Gradient(const BilinearFootprint& f, double* d_du, double* d_dv) const;
 
  private:
   int width_ = 0, height_ = 0, channels_ = 0;

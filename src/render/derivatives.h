@@ -10,13 +10,11 @@
 // a hit uses one texel, or UV textures (texel y·W + x, uv_texture.h), where a hit blends four
 // bilinearly and each gets its bilinear weight times the derivative with respect to the blended
 // value. UV textures have no texel-boundary terms (internal/texel_edges.h says why).
-// Missing for UV textures: the vertices' interior term through the texture. A bilinear texture
-// varies continuously inside a face, so as a face moves under a fixed ray the hit's UV slides and
-// its albedo and roughness change (∇_uv T · ∂uv/∂b · ∂b/∂p, the barycentric motion that
-// internal/shading_normal.h already derives for smooth normals); it is not included, so vertex
-// derivatives with a UV-texture material are biased where the texture varies (`sft gradcheck
-// --param vertices` on an exported icosphere with a wood texture, 256 spp, direct light: 10%
-// block error against 4% for the same object with mesh colors). Texel derivatives are exact.
+// UV textures also add an interior vertex term: a bilinear texture varies continuously inside a
+// face, so as a face moves under a fixed ray the hit's UV slides and its albedo and roughness
+// change (∇_uv T · ∂uv/∂δ · ∂δ/∂p, with δ the hit's motion relative to its face as in
+// internal/shading_normal.h; PathDerivatives::MapSlide). Seams are the one part left out
+// (internal/texel_edges.h).
 //
 // What is differentiated (the estimator treats sampled directions, lobe choices, pdfs and MIS
 // weights as constants — "detached sampling" — which is unbiased for the derivative of the

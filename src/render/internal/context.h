@@ -52,6 +52,13 @@ struct SurfaceMaterial {
   TexelWeights albedo_texels;
   TexelWeights roughness_texels;
   BsdfParams params;
+  // UV textures with vertex derivatives requested: how albedo (rows: channels) and roughness
+  // change with δ = dx − Σ_j b_j·dp_j, the hit point's motion relative to its face (the texture
+  // slides under the hit as the face moves; shading_normal.h derives db from δ). Mesh colors are
+  // constant inside a texel: `slides` false, their jumps are texel-boundary terms.
+  bool slides = false;
+  Eigen::Matrix3d d_albedo_d_delta = Eigen::Matrix3d::Zero();
+  Eigen::RowVector3d d_roughness_d_delta = Eigen::RowVector3d::Zero();
 };
 
 // The material at barycentrics (1 − u − v, u, v) of `face`: the one place where the renderer reads

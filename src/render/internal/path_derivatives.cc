@@ -6,6 +6,10 @@ namespace render_internal {
 void PathDerivatives::SetVertex(int face, const Eigen::Vector3d& barycentrics,
                                 const Eigen::Vector3d& dir, double sign, bool track_point) {
   if (!vertices_) return;
+  corners_ = ctx_.scene.faces()[face];
+  barycentrics_ = barycentrics;
+  // A UV texture slides under the hit as its face moves: that term needs x's Jacobian.
+  if (ctx_.material.has_uv_textures()) track_point = true;
   if (ctx_.normal_jacobian != nullptr) {
     normal_.SetSmooth(ctx_.scene, *ctx_.normal_jacobian, face, barycentrics, sign,
                       ctx_.request->normal_sliding);
@@ -58,6 +62,24 @@ void PathDerivatives::AddContribution(const Eigen::Vector3d& prefix, const Surfa
   for (int j = 0; j < count_; ++j) {
     AddVertices(scatters_[j].ds_dvertices, excluded_[j].cwiseProduct(f_q));
   }
+  if (surface.slides) {
+    const BsdfDerivatives d = EvalBsdfDerivatives(surface.params, n, wo, wi, ctx_.specular_scale);
+    scratch_.clear();
+    MapSlide(prefix.cwiseProduct(q).asDiagonal() * MaterialSlide(surface, d), &scratch_);
+    AddVertices(scratch_);
+  }
+}
+
+Eigen::Matrix3d PathDerivatives::MaterialSlide(const SurfaceMaterial& surface,
+                                               const BsdfDerivatives& d) {
+  return d.d_albedo * surface.d_albedo_d_delta +
+         Eigen::Vector3d::Constant(d.d_roughness) * surface.d_roughness_d_delta;
+}
+
+void PathDerivatives::MapSlide(const Eigen::Matrix3d& g, VertexGradients* out) const {
+  if (!point_.valid) return;
+  for (int j = 0; j < 3; ++j) out->emplace_back(corners_[j], -barycentrics_[j] * g);
+  for (int e = 0; e < point_.count; ++e) out->emplace_back(point_.vertex[e], g * point_.m[e]);
 }
 
 void PathDerivatives::AddBoundary(const Eigen::Vector3d& weight, const int* vertices,
@@ -100,6 +122,7 @@ void PathDerivatives::AddScatter(const Eigen::Vector3d& prefix, const SurfaceMat
         (f * wi.transpose() + n.dot(wi) * Eigen::Vector3d::Ones() * dg_dn.transpose()) / pdf;
     scatter.ds_dvertices.clear();
     normal_.Map(ds_dn, point_, &scatter.ds_dvertices);
+    if (surface.slides) MapSlide(MaterialSlide(surface, scatter.d_s), &scatter.ds_dvertices);
   }
   ++count_;
 }
