@@ -101,7 +101,7 @@ int RunGradcheckCommand(const GradcheckCommandOptions& opts) {
   status = ReadMesh(opts.mesh, &mesh);
   if (!status.ok()) return PrintError("gradcheck", status);
   Material material;
-  status = LoadMaterial(opts.material, mesh, &material);
+  status = LoadMaterial(opts.material, mesh, &material, MaterialUse::kRender);
   if (!status.ok()) return PrintError("gradcheck", status);
   if (opts.consistency_seeds > 0) return RunConsistency(opts, check, dataset, mesh, material);
   GradcheckResult result;

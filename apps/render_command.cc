@@ -207,7 +207,7 @@ Status RunRender(const RenderCommandOptions& opts) {
   TriMesh mesh;
   SFT_RETURN_IF_ERROR(ReadMesh(opts.mesh, &mesh));
   Material material;
-  SFT_RETURN_IF_ERROR(LoadMaterial(opts.material, mesh, &material));
+  SFT_RETURN_IF_ERROR(LoadMaterial(opts.material, mesh, &material, MaterialUse::kRender));
   DatasetViews views;
   SFT_RETURN_IF_ERROR(MakeDatasetViews(dataset, &views));
   std::vector<int> selected;

@@ -18,11 +18,11 @@ namespace {
 Material PerturbMaterial(const Material& base, const ParameterLayout& layout,
                          const std::vector<double>& delta, double t) {
   Material m = base;
-  for (size_t i = 0; i < m.albedo.values().size(); ++i) {
-    m.albedo.values()[i] += t * delta[layout.AlbedoOffset() + i];
+  for (size_t i = 0; i < m.AlbedoValues().size(); ++i) {
+    m.AlbedoValues()[i] += t * delta[layout.AlbedoOffset() + i];
   }
-  for (size_t i = 0; i < m.roughness.values().size(); ++i) {
-    m.roughness.values()[i] += t * delta[layout.RoughnessOffset() + i];
+  for (size_t i = 0; i < m.RoughnessValues().size(); ++i) {
+    m.RoughnessValues()[i] += t * delta[layout.RoughnessOffset() + i];
   }
   m.specular += t * delta[layout.SpecularIndex()];
   return m;
@@ -87,7 +87,7 @@ constexpr double kAutomaticVertexStep = 5e-3;
 double GlossyStepFactor(const Material& material, const Effects& effects) {
   if (!effects.specular || !(material.specular > 0.0)) return 1.0;
   double min_roughness = 1.0;
-  for (double r : material.roughness.values()) min_roughness = std::min(min_roughness, r);
+  for (double r : material.RoughnessValues()) min_roughness = std::min(min_roughness, r);
   return std::clamp(2.0 * min_roughness * min_roughness, 1.0 / 16.0, 1.0);
 }
 
@@ -288,8 +288,8 @@ Status RunGradcheck(const Dataset& dataset, const TriMesh& mesh, const Material&
   double step = options.step;
   if (step == 0.0) {
     double mean_roughness = 0.0;
-    for (double r : material.roughness.values()) mean_roughness += r;
-    mean_roughness /= std::max<size_t>(1, material.roughness.values().size());
+    for (double r : material.RoughnessValues()) mean_roughness += r;
+    mean_roughness /= std::max<size_t>(1, material.RoughnessValues().size());
     step = options.kind == ParameterKind::kRoughness ? 1e-4 * std::max(mean_roughness, 0.01)
            : vertices ? kAutomaticVertexStep * GlossyStepFactor(material, options.render.effects) *
                             scene.extent()

@@ -5,7 +5,16 @@
 //
 // Parameters live in one flat index space (ParameterLayout): vertex coordinates, albedo texels
 // (RGB), roughness texels, the specular weight, and one intensity scale per dataset light (the
-// light's radiance/intensity is multiplied by it; derivatives are taken at scale 1).
+// light's radiance/intensity is multiplied by it; derivatives are taken at scale 1). The texels
+// are those of the material's active representation (Material::AlbedoValues): mesh colors, where
+// a hit uses one texel, or UV textures (texel y·W + x, uv_texture.h), where a hit blends four
+// bilinearly and each gets its bilinear weight times the derivative with respect to the blended
+// value. UV textures have no texel-boundary terms (internal/texel_edges.h says why).
+// UV textures also add an interior vertex term: a bilinear texture varies continuously inside a
+// face, so as a face moves under a fixed ray the hit's UV slides and its albedo and roughness
+// change (∇_uv T · ∂uv/∂δ · ∂δ/∂p, with δ the hit's motion relative to its face as in
+// internal/shading_normal.h; PathDerivatives::MapSlide). Seams are the one part left out
+// (internal/texel_edges.h).
 //
 // What is differentiated (the estimator treats sampled directions, lobe choices, pdfs and MIS
 // weights as constants — "detached sampling" — which is unbiased for the derivative of the

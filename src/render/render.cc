@@ -292,8 +292,8 @@ ParameterLayout MakeParameterLayout(const RenderScene& scene, const Material& ma
                                     int num_lights) {
   ParameterLayout layout;
   layout.num_vertices = static_cast<int>(scene.positions().size());
-  layout.num_albedo_texels = material.albedo.num_texels();
-  layout.num_roughness_texels = material.roughness.num_texels();
+  layout.num_albedo_texels = material.NumAlbedoTexels();
+  layout.num_roughness_texels = material.NumRoughnessTexels();
   layout.num_lights = num_lights;
   return layout;
 }

@@ -38,13 +38,31 @@ struct Context {
   const VertexNormalJacobian* normal_jacobian;
 };
 
-// Texel indices of a hit, and the BSDF parameters there.
-struct SurfaceMaterial {
-  int albedo_texel = 0;
-  int roughness_texel = 0;
-  BsdfParams params;
+// The texels whose values a hit's material parameter blends, and their weights (the parameter is
+// Σ weight·texel, so ∂parameter/∂texel = weight): one texel of weight 1 for mesh colors (the
+// nearest texel), up to four bilinear texels for UV textures (zero weights left out).
+struct TexelWeights {
+  int count = 0;
+  int texel[4] = {0, 0, 0, 0};
+  double weight[4] = {0.0, 0.0, 0.0, 0.0};
 };
 
+// The texels of a hit, and the BSDF parameters there.
+struct SurfaceMaterial {
+  TexelWeights albedo_texels;
+  TexelWeights roughness_texels;
+  BsdfParams params;
+  // UV textures with vertex derivatives requested: how albedo (rows: channels) and roughness
+  // change with δ = dx − Σ_j b_j·dp_j, the hit point's motion relative to its face (the texture
+  // slides under the hit as the face moves; shading_normal.h derives db from δ). Mesh colors are
+  // constant inside a texel: `slides` false, their jumps are texel-boundary terms.
+  bool slides = false;
+  Eigen::Matrix3d d_albedo_d_delta = Eigen::Matrix3d::Zero();
+  Eigen::RowVector3d d_roughness_d_delta = Eigen::RowVector3d::Zero();
+};
+
+// The material at barycentrics (1 − u − v, u, v) of `face`: the one place where the renderer reads
+// albedo and roughness, from mesh colors or from UV textures (material.h).
 SurfaceMaterial LookUpMaterial(const Context& ctx, const Material& material, int face, double u,
                                double v);
 

@@ -240,14 +240,85 @@ double PowerHeuristic(double pdf_a, double pdf_b) {
   return a2 / (a2 + b2);
 }
 
+namespace {
+
+// The bilinear texels of `texture` at `uv` with non-zero weight, and the interpolated value
+// (Σ weight·texel, channels() values into `value`); with `d_du`, `d_dv` also its gradient.
+TexelWeights BilinearTexels(const UvTexture& texture, const Eigen::Vector2d& uv, double* value,
+                            double* d_du = nullptr, double* d_dv = nullptr) {
+  const BilinearFootprint footprint = texture.Footprint(uv);
+  if (d_du != nullptr) texture.Gradient(footprint, d_du, d_dv);
+  TexelWeights out;
+  for (int c = 0; c < texture.channels(); ++c) value[c] = 0.0;
+  for (int k = 0; k < 4; ++k) {
+    if (footprint.weight[k] == 0.0) continue;
+    out.texel[out.count] = footprint.texel[k];
+    out.weight[out.count] = footprint.weight[k];
+    ++out.count;
+    const double* texel = texture.texel(footprint.texel[k]);
+    for (int c = 0; c < texture.channels(); ++c) value[c] += footprint.weight[k] * texel[c];
+  }
+  return out;
+}
+
+// ∂uv/∂δ (2 × 3) on `face`: uv = Σ_j b_j·uv_j with db_k = g_k·δ (k = 1, 2), db_0 = −db_1 − db_2
+// and the dual basis g1 = (e2 × N)/|N|², g2 = (N × e1)/|N|² (shading_normal.h). False for a
+// degenerate face.
+bool UvSlide(const RenderScene& scene, const UvMaterialMaps& maps, int face,
+             Eigen::Matrix<double, 2, 3>* d_uv_d_delta) {
+  const Eigen::Vector3i& corners = scene.faces()[face];
+  const auto& p = scene.positions();
+  const Eigen::Vector3d e1 = p[corners[1]] - p[corners[0]];
+  const Eigen::Vector3d e2 = p[corners[2]] - p[corners[0]];
+  const Eigen::Vector3d n = e1.cross(e2);
+  const double n2 = n.squaredNorm();
+  if (!(n2 > 0.0) || !std::isfinite(n2)) return false;
+  const Eigen::Vector3d g1 = e2.cross(n) / n2, g2 = n.cross(e1) / n2;
+  const Eigen::Vector2d* uv = &maps.corner_uvs[3 * face];
+  *d_uv_d_delta = (uv[1] - uv[0]) * g1.transpose() + (uv[2] - uv[0]) * g2.transpose();
+  return true;
+}
+
+TexelWeights NearestTexel(int texel) {
+  TexelWeights out;
+  out.count = 1;
+  out.texel[0] = texel;
+  out.weight[0] = 1.0;
+  return out;
+}
+
+}  // namespace
+
 SurfaceMaterial LookUpMaterial(const Context& ctx, const Material& material, int face, double u,
                                double v) {
   SurfaceMaterial m;
-  m.albedo_texel = material.albedo.TexelIndex(face, u, v);
-  m.roughness_texel = material.roughness.TexelIndex(face, u, v);
-  const double* albedo = material.albedo.texel(m.albedo_texel);
-  m.params.albedo = Eigen::Vector3d(albedo[0], albedo[1], albedo[2]);
-  m.params.roughness = *material.roughness.texel(m.roughness_texel);
+  if (material.has_uv_textures()) {
+    const Eigen::Vector2d uv = material.uv.Uv(face, u, v);
+    Eigen::Matrix<double, 2, 3> d_uv_d_delta;
+    if (ctx.request != nullptr && ctx.request->params.vertices &&
+        UvSlide(ctx.scene, material.uv, face, &d_uv_d_delta)) {
+      Eigen::Matrix<double, 3, 2> d_albedo_d_uv;
+      Eigen::RowVector2d d_roughness_d_uv;
+      double d_du[3], d_dv[3];
+      m.albedo_texels = BilinearTexels(material.uv.albedo, uv, m.params.albedo.data(), d_du, d_dv);
+      for (int c = 0; c < 3; ++c) d_albedo_d_uv.row(c) << d_du[c], d_dv[c];
+      m.roughness_texels =
+          BilinearTexels(material.uv.roughness, uv, &m.params.roughness, d_du, d_dv);
+      d_roughness_d_uv << d_du[0], d_dv[0];
+      m.slides = true;
+      m.d_albedo_d_delta = d_albedo_d_uv * d_uv_d_delta;
+      m.d_roughness_d_delta = d_roughness_d_uv * d_uv_d_delta;
+    } else {
+      m.albedo_texels = BilinearTexels(material.uv.albedo, uv, m.params.albedo.data());
+      m.roughness_texels = BilinearTexels(material.uv.roughness, uv, &m.params.roughness);
+    }
+  } else {
+    m.albedo_texels = NearestTexel(material.albedo.TexelIndex(face, u, v));
+    m.roughness_texels = NearestTexel(material.roughness.TexelIndex(face, u, v));
+    const double* albedo = material.albedo.texel(m.albedo_texels.texel[0]);
+    m.params.albedo = Eigen::Vector3d(albedo[0], albedo[1], albedo[2]);
+    m.params.roughness = *material.roughness.texel(m.roughness_texels.texel[0]);
+  }
   m.params.specular = material.specular * ctx.specular_scale;
   m.params.fresnel = material.fresnel;
   return m;

@@ -6,6 +6,10 @@ namespace render_internal {
 void PathDerivatives::SetVertex(int face, const Eigen::Vector3d& barycentrics,
                                 const Eigen::Vector3d& dir, double sign, bool track_point) {
   if (!vertices_) return;
+  corners_ = ctx_.scene.faces()[face];
+  barycentrics_ = barycentrics;
+  // A UV texture slides under the hit as its face moves: that term needs x's Jacobian.
+  if (ctx_.material.has_uv_textures()) track_point = true;
   if (ctx_.normal_jacobian != nullptr) {
     normal_.SetSmooth(ctx_.scene, *ctx_.normal_jacobian, face, barycentrics, sign,
                       ctx_.request->normal_sliding);
@@ -58,6 +62,24 @@ void PathDerivatives::AddContribution(const Eigen::Vector3d& prefix, const Surfa
   for (int j = 0; j < count_; ++j) {
     AddVertices(scatters_[j].ds_dvertices, excluded_[j].cwiseProduct(f_q));
   }
+  if (surface.slides) {
+    const BsdfDerivatives d = EvalBsdfDerivatives(surface.params, n, wo, wi, ctx_.specular_scale);
+    scratch_.clear();
+    MapSlide(prefix.cwiseProduct(q).asDiagonal() * MaterialSlide(surface, d), &scratch_);
+    AddVertices(scratch_);
+  }
+}
+
+Eigen::Matrix3d PathDerivatives::MaterialSlide(const SurfaceMaterial& surface,
+                                               const BsdfDerivatives& d) {
+  return d.d_albedo * surface.d_albedo_d_delta +
+         Eigen::Vector3d::Constant(d.d_roughness) * surface.d_roughness_d_delta;
+}
+
+void PathDerivatives::MapSlide(const Eigen::Matrix3d& g, VertexGradients* out) const {
+  if (!point_.valid) return;
+  for (int j = 0; j < 3; ++j) out->emplace_back(corners_[j], -barycentrics_[j] * g);
+  for (int e = 0; e < point_.count; ++e) out->emplace_back(point_.vertex[e], g * point_.m[e]);
 }
 
 void PathDerivatives::AddBoundary(const Eigen::Vector3d& weight, const int* vertices,
@@ -100,6 +122,7 @@ void PathDerivatives::AddScatter(const Eigen::Vector3d& prefix, const SurfaceMat
         (f * wi.transpose() + n.dot(wi) * Eigen::Vector3d::Ones() * dg_dn.transpose()) / pdf;
     scatter.ds_dvertices.clear();
     normal_.Map(ds_dn, point_, &scatter.ds_dvertices);
+    if (surface.slides) MapSlide(MaterialSlide(surface, scatter.d_s), &scatter.ds_dvertices);
   }
   ++count_;
 }
@@ -108,16 +131,23 @@ void PathDerivatives::AddMaterial(const SurfaceMaterial& surface, const BsdfDeri
                                   const Eigen::Vector3d& base) {
   const ParameterSelection& sel = ctx_.request->params;
   const ParameterLayout& layout = *ctx_.layout;
+  // ∂/∂texel = the texel's weight × ∂/∂(the blended parameter) (context.h, TexelWeights).
   if (sel.albedo && d.d_albedo != 0.0) {
-    const int first = layout.AlbedoOffset() + 3 * surface.albedo_texel;
-    for (int c = 0; c < 3; ++c) {
-      Eigen::Vector3d v = Eigen::Vector3d::Zero();
-      v[c] = base[c] * d.d_albedo;
-      Add(first + c, v);
+    const TexelWeights& texels = surface.albedo_texels;
+    for (int k = 0; k < texels.count; ++k) {
+      const int first = layout.AlbedoOffset() + 3 * texels.texel[k];
+      for (int c = 0; c < 3; ++c) {
+        Eigen::Vector3d v = Eigen::Vector3d::Zero();
+        v[c] = base[c] * (texels.weight[k] * d.d_albedo);
+        Add(first + c, v);
+      }
     }
   }
   if (sel.roughness && d.d_roughness != 0.0) {
-    Add(layout.RoughnessOffset() + surface.roughness_texel, base * d.d_roughness);
+    const TexelWeights& texels = surface.roughness_texels;
+    for (int k = 0; k < texels.count; ++k) {
+      Add(layout.RoughnessOffset() + texels.texel[k], base * (texels.weight[k] * d.d_roughness));
+    }
   }
   if (sel.specular && d.d_specular != 0.0) {
     Add(layout.SpecularIndex(), base * d.d_specular);

@@ -220,6 +220,13 @@ class PathDerivatives {
     }
   }
 
+  // UV textures: ∂(factor)/∂δ (rows: channels) of a BSDF factor with derivatives `d` as the
+  // texture slides under the hit (SurfaceMaterial::slides; δ = dx − Σ_j b_j·dp_j).
+  static Eigen::Matrix3d MaterialSlide(const SurfaceMaterial& surface, const BsdfDerivatives& d);
+  // Appends g·∂δ/∂(vertex coordinates) of the current vertex to *out (nothing when its point
+  // Jacobian is undefined).
+  void MapSlide(const Eigen::Matrix3d& g, VertexGradients* out) const;
+
   // Adds base ⊙ ∂(factor)/∂θ for the material parameters of `surface`, where ∂factor/∂θ is
   // described by `d` (albedo: own channel only; roughness and specular: all channels).
   void AddMaterial(const SurfaceMaterial& surface, const BsdfDerivatives& d,
@@ -237,6 +244,8 @@ class PathDerivatives {
   // The current vertex's normal chain and its position's Jacobian.
   ShadingNormalChain normal_;
   PointJacobian point_;
+  Eigen::Vector3i corners_ = Eigen::Vector3i::Zero();       // the current vertex's face corners
+  Eigen::Vector3d barycentrics_ = Eigen::Vector3d::Zero();  // and barycentrics.
   VertexGradients scratch_;  // the current contribution's normal terms.
 };
 

@@ -263,6 +263,8 @@ uint64_t SegmentsKey(const RenderScene& scene, const Material& material, bool gl
 std::shared_ptr<const std::vector<TexelSegment>> TexelSegments(const RenderScene& scene,
                                                                const Material& material,
                                                                bool glossy) {
+  // A bilinear UV texture is continuous inside every face: no texel boundaries (texel_edges.h).
+  if (material.has_uv_textures()) return std::make_shared<const std::vector<TexelSegment>>();
   // The last build, shared by every view of a pass, by both passes of an evaluation and by the
   // direct and secondary terms of a view, until the mesh state or material changes.
   static std::mutex mutex;

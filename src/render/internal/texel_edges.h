@@ -3,6 +3,14 @@
 // faces (not a primary edge). The points y = Σ_k b_k·p_k of such a line have fixed barycentrics
 // b, so ∂y/∂p_k = b_k·I, and the jump is that of the full paths across the line. Seen directly
 // they are image curves (AddTexelEdgeTerms); seen through a bounce, secondary edges (C).
+//
+// UV-texture materials (uv_texture.h) have none: their bilinear interpolant is continuous inside
+// every face, so its texel grid lines are not discontinuities. Their only possible jumps are at
+// UV seams, which are mesh edges: where two faces meet with different UVs the textures' values on
+// the two sides may differ (an atlas baked with dilated gutters makes them nearly equal, not
+// exactly). Seam edges between coplanar faces are not sampled, so vertex derivatives miss that
+// (small) jump there; across non-coplanar faces under flat shading, or at silhouettes, the
+// primary and secondary edge terms already include the material on both sides.
 #ifndef SFT_RENDER_INTERNAL_TEXEL_EDGES_H_
 #define SFT_RENDER_INTERNAL_TEXEL_EDGES_H_
 
