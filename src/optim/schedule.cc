@@ -52,6 +52,11 @@ bool StageOptions::Check(std::string* why) const {
     *why = "material_model: only \"mesh_colors\" is available";
     return false;
   }
+  if (!(restart_roughness >= 0.0 && restart_roughness <= 1.0) ||
+      !(restart_specular >= 0.0 && restart_specular <= 1.0)) {
+    *why = "restart_roughness, restart_specular: must be in [0, 1] (0 = keep)";
+    return false;
+  }
   return fit.Check(why) && topology.Check(why);
 }
 
@@ -240,8 +245,24 @@ Status Schedule::PrepareStage(const ScheduleCallbacks& callbacks) {
                          (stage.texel_resolution == kTexelResolutionAuto ? " (auto)" : ""));
     }
   }
+  RestartLobe(stage, callbacks);
   progress_.stage_prepared = true;
   return CreateReconstruction();
+}
+
+// The stage's restart of the glossy lobe (StageOptions::restart_roughness, restart_specular).
+void Schedule::RestartLobe(const StageOptions& stage, const ScheduleCallbacks& callbacks) {
+  if (stage.restart_roughness > 0.0) {
+    std::vector<double>& values = current_.material.roughness.values();
+    std::fill(values.begin(), values.end(), stage.restart_roughness);
+  }
+  if (stage.restart_specular > 0.0) current_.material.specular = stage.restart_specular;
+  if ((stage.restart_roughness > 0.0 || stage.restart_specular > 0.0) && callbacks.on_event) {
+    char line[128];
+    std::snprintf(line, sizeof(line), "restart: roughness %g, specular %g (0 = kept)",
+                  stage.restart_roughness, stage.restart_specular);
+    callbacks.on_event(line);
+  }
 }
 
 // metrics.json's per-outer entry: cost, time, faces, mesh quality against the baseline and the

@@ -37,6 +37,12 @@ struct StageOptions {
   // at the stage's scale (ResolveTexelResolution). Texels are resampled (same mesh) or
   // re-projected (after a topology change).
   int texel_resolution = 0;
+  // At the stage's start, every roughness texel is set to this value, (0, 1]; 0 = keep. For a
+  // last texture stage whose earlier stages drove the roughness to its floor (docs/reconstruct.md,
+  // "Glossy objects").
+  double restart_roughness = 0.0;
+  // At the stage's start, the specular weight is set to this value, (0, 1]; 0 = keep.
+  double restart_specular = 0.0;
   TopologyOptions topology;  // remeshing / resampling before the stage, and on folds.
   // Slot for UV textures; accepts its one current value:
   std::string material_model = "mesh_colors";  // "mesh_colors": per-face texel grids.
@@ -115,6 +121,7 @@ class Schedule {
  private:
   Schedule() = default;
   Status PrepareStage(const ScheduleCallbacks& callbacks);
+  void RestartLobe(const StageOptions& stage, const ScheduleCallbacks& callbacks);
   Status CreateReconstruction();
   Status RunStageOuter(const ScheduleCallbacks& callbacks, bool* stop);
   Status ChangeTopology(TopologyChange change, const ScheduleCallbacks& callbacks);

@@ -44,7 +44,7 @@ const char kLargeStepsSchedule[] = R"([
    "pyramid_levels": 3, "outer_iterations": 2, "steps": 25, "adam_lr_vertices": 0.00025},
   {"name": "material_final", "phases": "texture", "solver": "adam", "image_scale": 1,
    "pyramid_levels": 3, "outer_iterations": 1, "steps": 120, "independent_gradient": true,
-   "adam_views_per_step": 16}
+   "adam_views_per_step": 16, "restart_roughness": 0.5, "restart_specular": 0.2}
 ])";
 // Keys of every large_steps stage.
 const char kLargeStepsStageKeys[] = R"({"image_loss": "relative", "fit_specular": true,
@@ -127,6 +127,10 @@ const std::map<std::string, StageKey>& StageKeys() {
           return s.texel_resolution == kTexelResolutionAuto ? json("auto")
                                                             : json(s.texel_resolution);
         }}},
+      {"restart_roughness",
+       RealIn([](S* s) -> double& { return s->restart_roughness; }, 0, 1, false)},
+      {"restart_specular",
+       RealIn([](S* s) -> double& { return s->restart_specular; }, 0, 1, false)},
       {"remesh", OneOf([](S* s) -> std::string& { return s->topology.remesh; },
                        {"none", "adaptive", "isotropic"}, "")},
       {"remesh_edge_pixels",

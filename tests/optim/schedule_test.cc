@@ -141,6 +141,9 @@ TEST(ScheduleConfigTest, BuiltInListsFollowTheStart) {
   EXPECT_EQ(stages.back().fit.solver.kind, SolverKind::kAdam);
   EXPECT_TRUE(stages.back().fit.cache.independent_gradient);
   EXPECT_EQ(stages.back().fit.solver.adam.views_per_step, 16);
+  EXPECT_EQ(stages.back().restart_roughness, 0.5);  // the LM stages leave it at its floor.
+  EXPECT_EQ(stages.back().restart_specular, 0.2);
+  EXPECT_EQ(stages[0].restart_roughness, 0.0);
   // Flat keys that describe one stage's loop pick the one-stage refine list.
   for (const char* key : {"phases", "solver", "outer_iterations", "steps"}) {
     SCOPED_TRACE(key);
@@ -195,6 +198,8 @@ TEST(ScheduleConfigTest, ErrorsNameTheStageAndKey) {
   EXPECT_THAT(error(R"({"pin": {"shadows": 1}})"),
               HasSubstr("pin: shadows: expected true or false"));
   EXPECT_THAT(error(R"({"texel_resolution": 65})"), HasSubstr("texel_resolution"));
+  EXPECT_THAT(error(R"({"stages": [{"restart_roughness": 1.5}]})"),
+              HasSubstr("stages[0]: restart_roughness: expected a number in [0.0, 1.0]"));
 }
 
 // A textured icosphere at 32², 4 views, flash-lit, one segment.
