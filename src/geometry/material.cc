@@ -106,6 +106,18 @@ const std::set<std::string>& KnownKeys() {
   return keys;
 }
 
+// "colorspace": "linear" (the default) or "srgb"; *srgb is true for the latter.
+Status ReadColorspace(const Context& ctx, const Json& json, bool* srgb) {
+  *srgb = false;
+  if (!json.contains("colorspace")) return Status::Ok();
+  const Json& v = json["colorspace"];
+  if (v != "linear" && v != "srgb") {
+    return ctx.Error("colorspace", "expected \"linear\" or \"srgb\", got " + v.dump());
+  }
+  *srgb = v == "srgb";
+  return Status::Ok();
+}
+
 Status ReadMeshColorsFor(const Context& ctx, const std::string& field, const std::string& path,
                          int channels, int num_faces, MeshColors* colors) {
   Status status = ReadMeshColors(path, colors);
@@ -244,13 +256,7 @@ Status ParseTextureAlbedo(const Context& ctx, const Json& json, const std::strin
   // Default: texel values are albedo as stored (the issue-2 CLI contract), for PNG and EXR
   // alike; "colorspace": "srgb" decodes sRGB-encoded textures.
   bool srgb = false;
-  if (json.contains("colorspace")) {
-    const Json& v = json["colorspace"];
-    if (v != "linear" && v != "srgb") {
-      return ctx.Error("colorspace", "expected \"linear\" or \"srgb\", got " + v.dump());
-    }
-    srgb = v == "srgb";
-  }
+  SFT_RETURN_IF_ERROR(ReadColorspace(ctx, json, &srgb));
   const std::vector<Eigen::Vector2d> corner_uvs = FaceCornerUvs(mesh);
   if (corner_uvs.size() != 3 * static_cast<size_t>(num_faces) || num_faces == 0) {
     return ctx.Error("albedo_texture", "the mesh has no texture coordinates (UVs)");
@@ -370,13 +376,7 @@ Status ParseUvMaterial(const Context& ctx, const Json& json, const std::string& 
                      "the mesh has no texture coordinates (UVs)");
   }
   bool srgb = false;
-  if (json.contains("colorspace")) {
-    const Json& v = json["colorspace"];
-    if (v != "linear" && v != "srgb") {
-      return ctx.Error("colorspace", "expected \"linear\" or \"srgb\", got " + v.dump());
-    }
-    srgb = v == "srgb";
-  }
+  SFT_RETURN_IF_ERROR(ReadColorspace(ctx, json, &srgb));
   std::string file;
   if (json.contains("uv_albedo")) {
     SFT_RETURN_IF_ERROR(ReadString(ctx, json, "uv_albedo", &file));
