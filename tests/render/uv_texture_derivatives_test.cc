@@ -24,6 +24,7 @@
 #include "src/geometry/mesh.h"
 #include "src/render/render.h"
 #include "tests/testing/temp_dir.h"
+#include "tests/testing/views.h"
 
 namespace sft {
 namespace {
@@ -51,19 +52,9 @@ struct Fixture {
                                 (p.y() - lo.y()) / (hi.y() - lo.y()));
       }
     }
-    view.camera.model = CameraModel::kPinhole;
-    view.camera.width = view.camera.height = kRes;
-    view.camera.params = {40, 40, 16, 16};
-    const Eigen::Vector3d c(0.3, 0.5, 3.5);
-    const Eigen::Vector3d fwd = (-c).normalized();
-    const Eigen::Vector3d right = fwd.cross(Eigen::Vector3d(0, 1, 0)).normalized();
-    const Eigen::Vector3d down = fwd.cross(right);
-    Eigen::Matrix3d r;
-    r.row(0) = right;
-    r.row(1) = down;
-    r.row(2) = fwd;
-    view.cam_from_world.rotation = Eigen::Quaterniond(r);
-    view.cam_from_world.translation = -(r * c);
+    // Camera at (0.3, 0.5, 3.5) looking at the origin (the bunny is y-up, ~[-1, 1]).
+    view = testing::LookAtView(Eigen::Vector3d(0.3, 0.5, 3.5), Eigen::Vector3d::Zero(), kRes, 40,
+                               Eigen::Vector3d::UnitY());
     PointLight light;
     light.position = Eigen::Vector3d(0.5, 1.0, 3.0);
     light.intensity = Eigen::Vector3d(6.0, 5.0, 4.0);
