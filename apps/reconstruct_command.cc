@@ -179,7 +179,7 @@ Status RunReconstruct(const ReconstructCommandOptions& cli_in) {
   ScheduleCallbacks callbacks;
   callbacks.on_iteration = [&](const IterationRecord& record) {
     progress.SetDetail(record.stage);
-    progress.Advance(schedule->CurrentStepWork());
+    if (!record.full) progress.Advance(schedule->CurrentStepWork());  // not a step.
     return !g_interrupted.load();
   };
   callbacks.on_event = [&](const std::string& line) { progress.Note(line); };

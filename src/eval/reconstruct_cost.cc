@@ -49,7 +49,7 @@ Status MeasureReconstructCost(const Dataset& dataset, const TriMesh& mesh, const
     if (first) report->cost_before = record.cost;
     first = false;
     report->cost_after = record.cost;
-    report->accepted_steps += record.accepted && record.iteration > 0;
+    report->accepted_steps += record.accepted && record.iteration > 0 && !record.full;
     if (options.progress) {
       std::fprintf(stderr, "bench reconstruct: %s iteration %d cost %.6g %s (%.1f s)\n",
                    record.phase.c_str(), record.iteration, record.cost,

@@ -9,6 +9,8 @@
 #ifndef SFT_INIT_SELF_INTERSECTION_H_
 #define SFT_INIT_SELF_INTERSECTION_H_
 
+#include <vector>
+
 #include "src/geometry/mesh.h"
 
 namespace sft {
@@ -20,6 +22,11 @@ namespace sft {
 // or a corner repeated after merging) counts as self-intersecting, and so does each extra copy of
 // a repeated face. Returns −1 when the mesh has no faces or CGAL fails.
 int CountSelfIntersectingFaces(const TriMesh& mesh);
+
+// The indices (into `mesh`'s faces, increasing) of the faces that intersect some other face.
+// False when the answer cannot be given in `mesh`'s indices: no faces, a CGAL failure, or a
+// repair that dropped faces (degenerate or repeated ones).
+bool SelfIntersectingFaces(const TriMesh& mesh, std::vector<int>* faces);
 
 }  // namespace sft
 

@@ -225,6 +225,7 @@ const std::map<std::string, Key>& Keys() {
        Real([](O* o) -> double& { return o->solver.adam.large_steps_lambda; }, 0, 1e4)},
       {"adam_uniform", Bool([](O* o) -> bool& { return o->solver.adam.uniform_vertices; })},
       {"adam_resample", Bool([](O* o) -> bool& { return o->solver.adam.resample; })},
+      {"adam_average", Real([](O* o) -> double& { return o->solver.adam.average_tail; }, 0, 0.999)},
       {"adam_views_per_step",
        Int([](O* o) -> int& { return o->solver.adam.views_per_step; }, 0, 100000)},
       {"laplacian_weight",

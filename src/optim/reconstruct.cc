@@ -204,6 +204,7 @@ Status Reconstruction::RunOuter(int outer,
       record.iteration = info.iteration;
       record.cost = info.cost;
       record.accepted = info.accepted;
+      record.full = info.full;
       record.seconds = elapsed_offset + NowSeconds() - start_time_;
       // A rejected trial leaves its render in the cache: report the accepted point's PSNR.
       if (info.accepted || last_psnr.empty()) {

@@ -57,6 +57,7 @@ struct IterationRecord {
   double cost = 0.0;     // objective (image + regularizers) at the accepted point.
   double seconds = 0.0;  // wall time since the start of the run (resumed runs continue it).
   bool accepted = false;
+  bool full = false;  // Adam's closing evaluation of all views, not a step (IterationInfo::full).
   std::vector<double> view_psnr;  // level-0 PSNR over active pixels, peak 1, per fitted view.
 };
 

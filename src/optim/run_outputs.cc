@@ -125,6 +125,7 @@ Status WriteMetrics(const std::string& out, const std::vector<IterationRecord>& 
                           {"cost", r.cost},
                           {"seconds", r.seconds},
                           {"accepted", r.accepted},
+                          {"full", r.full},
                           {"view_psnr", r.view_psnr}});
   }
   json phase_list = json::array();
@@ -181,6 +182,7 @@ Status ReadIterationRecords(const std::string& out, std::vector<IterationRecord>
     r.cost = e.value("cost", 0.0);
     r.seconds = e.value("seconds", 0.0);
     r.accepted = e.value("accepted", false);
+    r.full = e.value("full", false);
     if (e.contains("view_psnr") && e["view_psnr"].is_array()) {
       for (const json& p : e["view_psnr"])
         r.view_psnr.push_back(p.is_number() ? p.get<double>() : 0.0);

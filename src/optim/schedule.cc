@@ -7,6 +7,7 @@
 
 #include "src/core/file_util.h"
 #include "src/init/self_intersection.h"
+#include "src/init/untangle.h"
 #include "src/io/image_io.h"
 #include "src/io/scene_setup.h"
 #include "src/optim/run_outputs.h"
@@ -265,6 +266,35 @@ void Schedule::RestartLobe(const StageOptions& stage, const ScheduleCallbacks& c
   }
 }
 
+// Smooths away the self-intersections a geometry phase left (StageOptions::topology.untangle);
+// `record` gets the counts when there were any. The reconstruction is rebuilt on the moved
+// vertices (the topology is unchanged, so texels and the folded-face baseline carry over).
+Status Schedule::UntangleCurrent(const ScheduleCallbacks& callbacks, json* record) {
+  if (CountSelfIntersectingFaces(current_.mesh) <= 0) return Status::Ok();
+  const double start = NowSeconds();
+  UntangleReport report;
+  const Status status = Untangle(UntangleOptions(), &current_.mesh, &report);
+  if (!status.ok()) {
+    // Not a reason to stop the run: resampling remains the remedy for what cannot be listed.
+    if (callbacks.on_event) callbacks.on_event("untangle skipped: " + status.message());
+    return Status::Ok();
+  }
+  *record = {{"faces_before", report.faces_before},
+             {"faces_after", report.faces_after},
+             {"rounds", report.rounds},
+             {"moved_vertices", report.moved_vertices},
+             {"seconds", NowSeconds() - start}};
+  if (callbacks.on_event) {
+    char line[256];
+    std::snprintf(line, sizeof(line),
+                  "%s: untangle: %d -> %d self-intersecting faces, %d vertices moved in %.1f s",
+                  CurrentStage().name.c_str(), report.faces_before, report.faces_after,
+                  report.moved_vertices, NowSeconds() - start);
+    callbacks.on_event(line);
+  }
+  return CreateReconstruction();
+}
+
 // metrics.json's per-outer entry: cost, time, faces, mesh quality against the baseline and the
 // callbacks' scores.
 Status Schedule::OuterRecord(const ScheduleCallbacks& callbacks, int outer, json* out) {
@@ -349,6 +379,10 @@ Status Schedule::RunStageOuter(const ScheduleCallbacks& callbacks, bool* stop) {
     return go_on;
   }));
   SyncCurrent();
+  json untangled;
+  if (!*stop && stage.topology.untangle && stage.fit.phases != PhaseSchedule::kTexture) {
+    SFT_RETURN_IF_ERROR(UntangleCurrent(callbacks, &untangled));
+  }
   if (!*stop) {
     ++progress_.outer_done;
     ++progress_.stage_outer_done;
@@ -358,6 +392,7 @@ Status Schedule::RunStageOuter(const ScheduleCallbacks& callbacks, bool* stop) {
   json record;
   SFT_RETURN_IF_ERROR(OuterRecord(callbacks, outer, &record));
   if (!plan_record.is_null()) record["effects"] = plan_record;
+  if (!untangled.is_null()) record["untangle"] = untangled;
   outer_records_.push_back(record);
   const bool stage_done = progress_.stage_outer_done >= stage.fit.outer_iterations;
   // CountSelfIntersectingFaces is -1 when CGAL fails: no evidence of folds then.

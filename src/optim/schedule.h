@@ -124,6 +124,7 @@ class Schedule {
   void RestartLobe(const StageOptions& stage, const ScheduleCallbacks& callbacks);
   Status CreateReconstruction();
   Status RunStageOuter(const ScheduleCallbacks& callbacks, bool* stop);
+  Status UntangleCurrent(const ScheduleCallbacks& callbacks, nlohmann::json* record);
   Status ChangeTopology(TopologyChange change, const ScheduleCallbacks& callbacks);
   Status PlanEffects(const ScheduleCallbacks& callbacks, nlohmann::json* record);
   Status OuterRecord(const ScheduleCallbacks& callbacks, int outer, nlohmann::json* out);

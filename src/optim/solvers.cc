@@ -171,6 +171,10 @@ bool SolverOptions::Check(std::string* why) const {
     *why = "adam_views_per_step: must be >= 0";
     return false;
   }
+  if (!(a.average_tail >= 0 && a.average_tail < 1)) {
+    *why = "adam_average: must be in [0, 1)";
+    return false;
+  }
   return true;
 }
 
@@ -422,6 +426,11 @@ Status RunAdam(const SolverOptions& options, const ProblemOptions& problem_optio
       ShuffledViews(cache->num_views(), base_seed ^ 0x2545f4914f6cdd1dull);
   double cost = 0.0;
   stats->termination = "steps";
+  // Iterates after step `average_from` are summed for tail averaging.
+  const int average_from =
+      options.steps - static_cast<int>(std::floor(adam.average_tail * options.steps));
+  std::vector<double> sum(average_from < options.steps ? n : 0, 0.0);
+  int summed = 0;
   const CacheClock before(*cache);
   for (int step = 1; step <= options.steps; ++step) {
     const int64_t t = state->t + 1;
@@ -447,10 +456,29 @@ Status RunAdam(const SolverOptions& options, const ProblemOptions& problem_optio
     }
     objective.Store(x.data());
     stats->iterations = step;
+    if (step > average_from) {
+      for (int k = 0; k < n; ++k) sum[k] += x[k];
+      ++summed;
+    }
     // Adam reports the cost at the point where its gradient was taken (before the step).
     if (hooks.on_iteration && !hooks.on_iteration({step, cost, true})) {
       stats->termination = "stopped";
       break;
+    }
+  }
+  if (summed > 0 && stats->termination == "steps") {
+    // The mean of iterates within the bounds is within them. A stopped run keeps its last iterate.
+    for (int k = 0; k < n; ++k) x[k] = sum[k] / summed;
+    objective.Store(x.data());
+  }
+  // The end point's cost over all views (forward renders only), so that the run's last record
+  // is the objective where it ends rather than a minibatch estimate before the last step.
+  if (stats->termination == "steps" && options.steps > 0) {
+    if (!objective.EvaluateViews(x.data(), {}, &cost, nullptr)) {
+      stats->termination = "non-finite render";
+    } else if (hooks.on_iteration &&
+               !hooks.on_iteration({options.steps, cost, true, /*full=*/true})) {
+      stats->termination = "stopped";
     }
   }
   CacheClock(*cache).AddSince(before, &stats->time, &stats->evaluations);

@@ -52,6 +52,10 @@ struct AdamOptions {
   // Views rendered per step (a minibatch, cycling through a fixed shuffled order of the fitted
   // views; the image part of the cost and gradient is scaled by views / batch); 0 = all views.
   int views_per_step = 0;
+  // Tail averaging (Polyak and Juditsky 1992): the run ends at the mean of the iterates of its
+  // last `average_tail` fraction of steps instead of at the last iterate, which removes most of
+  // the gradient noise that a constant step size leaves; [0, 1), 0 = the last iterate.
+  double average_tail = 0.0;
 };
 
 struct SolverOptions {
@@ -74,6 +78,9 @@ struct IterationInfo {
   int iteration = 0;      // within the call.
   double cost = 0.0;      // objective after the iteration (of the accepted point).
   bool accepted = false;  // the step was taken.
+  // Not a step: Adam's closing evaluation of every view at the point it ends at (its step
+  // records carry minibatch estimates at the points before their steps).
+  bool full = false;
 };
 
 // Hooks of a run: `on_iteration` after every iteration (return false to stop early, e.g. on

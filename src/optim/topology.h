@@ -33,6 +33,9 @@ struct TopologyOptions {
   // After an outer iteration, resample when folded plus self-intersecting faces exceed this
   // fraction of the faces; [0, 1], 0 = never.
   double resample_fold_fraction = 0.01;
+  // After an outer iteration with a geometry phase that leaves self-intersecting faces (and no
+  // resampling), smooth the surface around them until none is left (src/init/untangle.h).
+  bool untangle = true;
   int max_faces = 200000;  // cap on the faces a topology change may produce, [100, 5e6].
 
   bool Check(std::string* why) const;

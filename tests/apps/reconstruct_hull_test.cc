@@ -38,16 +38,16 @@ TEST(ReconstructHullTest, CarveRefineRemeshResampleTexture) {
             0)
       << out;
   // One line per stage start and per topology change, the stage names on the progress line.
-  EXPECT_THAT(out, HasSubstr("stage 1/4 quarter"));
+  EXPECT_THAT(out, HasSubstr("stage 1/9 material_quarter"));
   EXPECT_THAT(out, HasSubstr("remesh adaptive"));
   EXPECT_THAT(out, HasSubstr("resample"));
-  EXPECT_THAT(out, HasSubstr("stage 4/4 texture"));
+  EXPECT_THAT(out, HasSubstr("stage 9/9 material_final"));
 
   const nlohmann::json state = ReadJson(tmp.Join("r/state.json"));
   EXPECT_EQ(state["run"]["start"], "carved hull");
   EXPECT_TRUE(state["finished"].get<bool>());
   const nlohmann::json metrics = ReadJson(tmp.Join("r/metrics.json"));
-  ASSERT_EQ(metrics["stages"].size(), 4u);
+  ASSERT_EQ(metrics["stages"].size(), 9u);
   for (const auto& stage : metrics["stages"]) {
     EXPECT_TRUE(fs::exists(tmp.Join("r/" + stage["normals"].get<std::string>())));
   }
@@ -66,7 +66,6 @@ TEST(ReconstructHullTest, CarveRefineRemeshResampleTexture) {
   EXPECT_EQ(last["flipped_faces"], 0);
   EXPECT_EQ(last["self_intersecting_faces"], 0);
   EXPECT_GT(last["f1"].get<double>(), 0.8);
-  // The final texture stage ran at texel resolution 3.
   const nlohmann::json material = ReadJson(tmp.Join("r/material.json"));
   EXPECT_TRUE(fs::exists(tmp.Join("r/report.html")));
   EXPECT_FALSE(material.is_null());

@@ -88,6 +88,10 @@ TEST(SelfIntersectionTest, TwoInterpenetratingSpheresCountTheCrossingFaces) {
   ASSERT_GT(crossing.size(), 20u);
   EXPECT_EQ(CountSelfIntersectingFaces(MeshOf(positions, faces)),
             static_cast<int>(crossing.size()));
+  // The listed faces are exactly those, in the mesh's own face indices.
+  std::vector<int> listed;
+  ASSERT_TRUE(SelfIntersectingFaces(MeshOf(positions, faces), &listed));
+  EXPECT_EQ(listed, std::vector<int>(crossing.begin(), crossing.end()));
 }
 
 TEST(SelfIntersectionTest, EmptyMeshIsMinusOne) {

@@ -171,7 +171,15 @@ TEST(ScheduleConfigTest, BuiltInListsFollowTheStart) {
   EXPECT_EQ(stages.front().fit.cache.image_scale_log2, 2);  // coarse to fine.
   EXPECT_EQ(stages.back().fit.cache.image_scale_log2, 0);
   EXPECT_EQ(stages.back().fit.phases, PhaseSchedule::kTexture);
-  EXPECT_GT(stages.back().texel_resolution, 1);
+  // The large_steps stage keys: Adam on the large-steps parameterisation for geometry, and the
+  // closing material stage with independent adjoint paths.
+  for (const StageOptions& stage : stages) {
+    if (stage.fit.phases == PhaseSchedule::kGeometry) {
+      EXPECT_EQ(stage.fit.solver.kind, SolverKind::kAdam) << stage.name;
+      EXPECT_EQ(stage.fit.solver.adam.large_steps_lambda, 25.0) << stage.name;
+    }
+  }
+  EXPECT_TRUE(stages.back().fit.cache.independent_gradient);
   // "schedule": "hull" picks the hull list from any start.
   ASSERT_TRUE(MergeScheduleConfig({{"schedule", "hull"}}, "cfg", &config).ok());
   ASSERT_TRUE(ResolveStages(config, /*carved_start=*/false, &stages).ok());
@@ -421,6 +429,50 @@ TEST_F(ScheduleRunTest, StopAndResumeMidStage) {
   EXPECT_EQ(outers.front(), 2);  // the interrupted outer iteration runs again.
   EXPECT_EQ(outers.back(), 3);
   EXPECT_EQ(resumed->progress().outer_done, 4);
+}
+
+// A geometry outer iteration that leaves self-intersecting faces is followed by untangling (the
+// default): the outer record counts none, and its `untangle` entry says how many there were.
+// With `untangle` off they stay.
+TEST_F(ScheduleRunTest, GeometryOuterUntanglesSelfIntersections) {
+  // One vertex pushed through the centre and out beyond the far side.
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  for (TriMesh::VertexHandle v : start_.mesh.vertices()) {
+    const TriMesh::Point p = start_.mesh.point(v);
+    centre += Eigen::Vector3d(p[0], p[1], p[2]) / start_.mesh.n_vertices();
+  }
+  const TriMesh::VertexHandle pushed = start_.mesh.vertex_handle(0);
+  const TriMesh::Point p = start_.mesh.point(pushed);
+  const Eigen::Vector3d moved = centre - 1.3 * (Eigen::Vector3d(p[0], p[1], p[2]) - centre);
+  start_.mesh.set_point(pushed, TriMesh::Point(moved.x(), moved.y(), moved.z()));
+  for (const bool untangle : {true, false}) {
+    testing::TempDir out;
+    const auto stages = Stages(std::string(R"({"spp": 4, "bounces": 1, "steps": 1,
+        "phases": "geometry", "resample_fold_fraction": 0, "untangle": )") +
+                               (untangle ? "true" : "false") + R"(,
+        "stages": [{"name": "shape", "outer_iterations": 1}]})");
+    std::unique_ptr<Schedule> schedule;
+    ASSERT_TRUE(
+        Schedule::Start(dataset_, out.Join("r"), stages, start_, {{"dataset", "ds"}}, &schedule)
+            .ok());
+    std::vector<std::string> events;
+    ScheduleCallbacks callbacks;
+    callbacks.on_event = [&](const std::string& line) { events.push_back(line); };
+    ASSERT_TRUE(schedule->Run(callbacks).ok());
+    const json& outer = schedule->outer_records().back();
+    if (untangle) {
+      ASSERT_TRUE(outer.contains("untangle"));
+      EXPECT_GE(outer["untangle"]["faces_before"].get<int>(), 10);
+      EXPECT_EQ(outer["untangle"]["faces_after"], 0);
+      EXPECT_EQ(outer["self_intersecting_faces"], 0);
+      bool logged = false;
+      for (const std::string& line : events) logged |= line.find("shape: untangle: ") == 0;
+      EXPECT_TRUE(logged);
+    } else {
+      EXPECT_FALSE(outer.contains("untangle"));
+      EXPECT_GE(outer["self_intersecting_faces"].get<int>(), 10);
+    }
+  }
 }
 
 TEST(RunStateTest, OlderFormatIsRefusedWithOneLine) {
