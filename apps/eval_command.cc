@@ -46,8 +46,9 @@ RunInputs ReconstructionInputs(const EvalCommandOptions& opts) {
     inputs.files.push_back(opts.images.material);
   }
   for (const std::string& spec : opts.images.relight) {
-    if (spec != "side")
-      inputs.files.push_back(spec.rfind("probe:", 0) == 0 ? spec.substr(6) : spec);
+    if (spec == "side") continue;
+    const std::string probe = "probe:";
+    inputs.files.push_back(spec.rfind(probe, 0) == 0 ? spec.substr(probe.size()) : spec);
   }
   return inputs;
 }
