@@ -6,8 +6,10 @@
 //          F1 at the tolerance, precision, recall and the Chamfer distance in units of the
 //          reference's bounding-box diagonal (src/eval/mesh_metrics.h).
 //   reconstruction   --dataset D --reconstruction O [--spp 64] [--bounces 2] [--views ...]
+//          [--mesh M] [--material SPEC] [--relight SPEC ...] [--out DIR]
 //          PSNR and SSIM of re-renders of O against D's images and true albedo/roughness
-//          (src/eval/reconstruction_eval.h).
+//          (src/eval/reconstruction_eval.h); with --relight, of O against D's true object under
+//          other lights (src/eval/relight_eval.h), the renders written under --out.
 #include <cstdio>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -35,6 +37,21 @@ struct EvalCommandOptions {
   ReconstructionEvalOptions images;  // reconstruction mode: re-render settings.
   std::string json;                  // optional copy of the printed JSON.
 };
+
+// The files the reconstruction mode reads (for the --json and --out location checks).
+RunInputs ReconstructionInputs(const EvalCommandOptions& opts) {
+  RunInputs inputs{{opts.dataset, opts.reconstruction}, {opts.mesh.mesh}};
+  // An inline JSON material is no file.
+  if (!opts.images.material.empty() && opts.images.material.front() != '{') {
+    inputs.files.push_back(opts.images.material);
+  }
+  for (const std::string& spec : opts.images.relight) {
+    if (spec == "side") continue;
+    const std::string probe = "probe:";
+    inputs.files.push_back(spec.rfind(probe, 0) == 0 ? spec.substr(probe.size()) : spec);
+  }
+  return inputs;
+}
 
 Status RunMeshEval(const MeshEvalOptions& opts, nlohmann::json* report) {
   std::string why;
@@ -76,15 +93,29 @@ int RunEvalCommand(const EvalCommandOptions& opts) {
     return PrintError("eval", Status::Error("--reference and --mesh are both required (or "
                                             "--dataset and --reconstruction)"));
   }
+  if (!images &&
+      (!opts.images.relight.empty() || !opts.images.out.empty() || !opts.images.material.empty())) {
+    return PrintError("eval", Status::Error("--relight, --out and --material need --dataset and "
+                                            "--reconstruction"));
+  }
+  if (images && !opts.images.out.empty() && opts.images.relight.empty()) {
+    return PrintError("eval", Status::Error("--out holds the --relight renders: give --relight"));
+  }
+  RunInputs inputs = ReconstructionInputs(opts);
+  inputs.files.push_back(opts.mesh.reference);
   if (!opts.json.empty()) {
-    const Status where = CheckOutputFile(
-        opts.json, {{opts.dataset, opts.reconstruction}, {opts.mesh.reference, opts.mesh.mesh}},
-        "--json");
+    const Status where = CheckOutputFile(opts.json, inputs, "--json");
+    if (!where.ok()) return PrintError("eval", where);
+  }
+  if (!opts.images.out.empty()) {
+    const Status where = CheckOutputDirectory(opts.images.out, inputs, "--out");
     if (!where.ok()) return PrintError("eval", where);
   }
   nlohmann::json report;
+  ReconstructionEvalOptions image_options = opts.images;
+  image_options.mesh = opts.mesh.mesh;  // --mesh: in this mode, the mesh to render.
   Status status =
-      images ? EvaluateReconstruction(opts.dataset, opts.reconstruction, opts.images, &report)
+      images ? EvaluateReconstruction(opts.dataset, opts.reconstruction, image_options, &report)
              : RunMeshEval(opts.mesh, &report);
   if (!status.ok()) return PrintError("eval", status);
   const std::string text = report.dump(1) + "\n";
@@ -101,7 +132,9 @@ int RunEvalCommand(const EvalCommandOptions& opts) {
 CommandRunner SetupEvalCommand(CLI::App* app) {
   auto opts = std::make_shared<EvalCommandOptions>();
   app->add_option("--reference", opts->mesh.reference, "Ground-truth mesh (OBJ, PLY, OFF)");
-  app->add_option("--mesh", opts->mesh.mesh, "Mesh to evaluate (OBJ, PLY, OFF)");
+  app->add_option("--mesh", opts->mesh.mesh,
+                  "Mesh to evaluate (OBJ, PLY, OFF); reconstruction mode: render it instead of "
+                  "O/mesh.ply (e.g. an export's model.obj)");
   app->add_option("--tolerance", opts->mesh.metrics.tolerance,
                   "F1 distance threshold, fraction of the reference's bounding-box diagonal, "
                   "(0, 1]")
@@ -120,6 +153,18 @@ CommandRunner SetupEvalCommand(CLI::App* app) {
       ->capture_default_str();
   app->add_option("--views", opts->images.views, "Reconstruction mode: only these views")
       ->delimiter(',');
+  app->add_option("--material", opts->images.material,
+                  "Reconstruction mode: material instead of O/material.json (JSON file, inline "
+                  "JSON or an export's model.mtl)");
+  app->add_option("--relight", opts->images.relight,
+                  "Reconstruction mode: also score O against the dataset's true object under "
+                  "these lights: LIGHTS.json (scene.json's light format, one condition per "
+                  "light), probe:PATH.exr, or side (capture point lights turned 90 degrees); "
+                  "repeatable")
+      ->expected(1)
+      ->take_all();
+  app->add_option("--out", opts->images.out,
+                  "Reconstruction mode: write the --relight renders under DIR/relight/");
   app->add_option("--json", opts->json, "Also write the JSON to this file");
   return [opts]() { return RunEvalCommand(*opts); };
 }

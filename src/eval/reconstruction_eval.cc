@@ -2,9 +2,13 @@
 
 #include <cmath>
 #include <filesystem>
+#include <limits>
+#include <memory>
 
 #include "src/core/file_util.h"
 #include "src/eval/image_metrics.h"
+#include "src/eval/relight_eval.h"
+#include "src/eval/view_scores.h"
 #include "src/geometry/material.h"
 #include "src/geometry/mesh.h"
 #include "src/io/dataset.h"
@@ -17,49 +21,6 @@ namespace sft {
 namespace {
 
 using json = nlohmann::json;
-
-// A number for JSON: null when not finite (a relative RMSE against a black reference).
-json Finite(double value) { return std::isfinite(value) ? json(value) : json(nullptr); }
-
-// Per-view scores of one pass and their means over views (the relative RMSE's over the views
-// where it is defined).
-struct Measure {
-  json views = json::array();
-  ImageScores sum;
-  double rel_rmse_sum = 0.0;
-  int count = 0, rel_rmse_count = 0;
-
-  Status Add(int v, const Image& ours, const Image& reference, const Image& mask) {
-    ImageScores s;
-    SFT_RETURN_IF_ERROR(ComputeImageScores(ours, reference, mask, ImageMetricsOptions(), &s)
-                            .Prefixed("view " + std::to_string(v)));
-    views.push_back({{"view", v},
-                     {"psnr_srgb", s.psnr_srgb},
-                     {"ssim_srgb", s.ssim_srgb},
-                     {"psnr_linear", s.psnr_linear},
-                     {"ssim_linear", s.ssim_linear},
-                     {"rel_rmse", Finite(s.relative_rmse)}});
-    sum.psnr_srgb += s.psnr_srgb;
-    sum.ssim_srgb += s.ssim_srgb;
-    sum.psnr_linear += s.psnr_linear;
-    sum.ssim_linear += s.ssim_linear;
-    if (std::isfinite(s.relative_rmse)) {
-      rel_rmse_sum += s.relative_rmse;
-      ++rel_rmse_count;
-    }
-    ++count;
-    return Status::Ok();
-  }
-  json ToJson() const {
-    if (count == 0) return nullptr;
-    return {{"psnr_srgb", sum.psnr_srgb / count},
-            {"ssim_srgb", sum.ssim_srgb / count},
-            {"psnr_linear", sum.psnr_linear / count},
-            {"ssim_linear", sum.ssim_linear / count},
-            {"rel_rmse", rel_rmse_count > 0 ? json(rel_rmse_sum / rel_rmse_count) : json(nullptr)},
-            {"views", views}};
-  }
-};
 
 // A ground-truth pass folder named by `key` of the dataset's ground_truth, or "" when absent.
 Status PassFolder(const Dataset& dataset, const char* key, std::string* folder) {
@@ -94,19 +55,6 @@ Status TruePass(const Dataset& dataset, int v, const std::string& folder, const 
   return Status::Ok();
 }
 
-// What each key of a measure means (written into the report so that the JSON explains itself).
-json MeasureDefinitions() {
-  return {{"psnr_srgb",
-           "PSNR (dB, peak 1) of the display images: linear values clipped to [0, 1], then "
-           "sRGB-encoded"},
-          {"ssim_srgb", "SSIM of the display images (dynamic range 1)"},
-          {"psnr_linear", "PSNR (dB, peak 1) of the linear values"},
-          {"ssim_linear", "SSIM of the linear values (dynamic range 1)"},
-          {"rel_rmse",
-           "sqrt(sum (ours - reference)^2 / sum reference^2) of the linear values; null when the "
-           "reference is black"}};
-}
-
 }  // namespace
 
 bool ReconstructionEvalOptions::Check(std::string* why) const {
@@ -121,16 +69,79 @@ bool ReconstructionEvalOptions::Check(std::string* why) const {
   return true;
 }
 
+namespace {
+
+// The reconstruction to render: O/mesh.ply and O/material.json, or the overrides of `options`.
+Status LoadReconstruction(const std::string& reconstruction,
+                          const ReconstructionEvalOptions& options, TriMesh* mesh,
+                          Material* material) {
+  const std::string mesh_path =
+      options.mesh.empty() ? JoinPath(reconstruction, "mesh.ply") : options.mesh;
+  SFT_RETURN_IF_ERROR(ReadMesh(mesh_path, mesh));
+  const std::string material_spec =
+      options.material.empty() ? JoinPath(reconstruction, "material.json") : options.material;
+  // Rendered only: the UV-texture forms (an export's model.mtl) are allowed.
+  SFT_RETURN_IF_ERROR(LoadMaterial(material_spec, *mesh, material, MaterialUse::kRender));
+  return Status::Ok();
+}
+
+// The ground truth to render: ground_truth.mesh with ground_truth.material, when both are given.
+struct Truth {
+  TriMesh mesh;
+  Material material;
+  std::unique_ptr<RenderScene> scene;  // null when the dataset has no renderable truth.
+};
+
+Status LoadTruth(const Dataset& dataset, Truth* truth) {
+  std::string material_path;
+  SFT_RETURN_IF_ERROR(PassFolder(dataset, "material", &material_path));
+  if (dataset.gt_mesh.empty() || material_path.empty()) return Status::Ok();
+  SFT_RETURN_IF_ERROR(ReadMesh(JoinPath(dataset.root, dataset.gt_mesh), &truth->mesh));
+  SFT_RETURN_IF_ERROR(LoadMaterial(JoinPath(dataset.root, material_path), truth->mesh,
+                                   &truth->material, MaterialUse::kRender));
+  truth->scene = std::make_unique<RenderScene>(truth->mesh);
+  return Status::Ok();
+}
+
+// The centre of the mesh's bounding box.
+Eigen::Vector3d BoundingBoxCentre(const TriMesh& mesh) {
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector3d hi = -lo;
+  for (const auto& vh : mesh.vertices()) {
+    const auto& p = mesh.point(vh);
+    const Eigen::Vector3d q(p[0], p[1], p[2]);
+    lo = lo.cwiseMin(q);
+    hi = hi.cwiseMax(q);
+  }
+  return 0.5 * (lo + hi);
+}
+
+// The relighting conditions of options.relight; refuses a dataset without a renderable truth.
+Status PrepareRelight(const Dataset& dataset, const Truth& truth,
+                      const ReconstructionEvalOptions& options,
+                      std::vector<RelightCondition>* conditions) {
+  conditions->clear();
+  if (options.relight.empty()) return Status::Ok();
+  if (truth.scene == nullptr) {
+    return Status::Error(JoinPath(dataset.root, "scene.json") +
+                         ": --relight needs the true object, ground_truth.mesh and "
+                         "ground_truth.material, and this dataset has not both");
+  }
+  return MakeRelightConditions(options.relight, dataset, BoundingBoxCentre(truth.mesh), conditions);
+}
+
+}  // namespace
+
 Status EvaluateReconstruction(const std::string& dataset_dir, const std::string& reconstruction,
                               const ReconstructionEvalOptions& options, json* report) {
   std::string why;
   if (!options.Check(&why)) return Status::Error("--" + why);
   Dataset dataset;
   SFT_RETURN_IF_ERROR(ReadDataset(dataset_dir, &dataset));
+  const Dataset capture = dataset;  // before the fitted light scales: relighting's "capture".
   TriMesh mesh;
-  SFT_RETURN_IF_ERROR(ReadMesh(JoinPath(reconstruction, "mesh.ply"), &mesh));
   Material material;
-  SFT_RETURN_IF_ERROR(LoadMaterial(JoinPath(reconstruction, "material.json"), mesh, &material));
+  SFT_RETURN_IF_ERROR(LoadReconstruction(reconstruction, options, &mesh, &material));
   const std::string lights = JoinPath(reconstruction, "lights.json");
   if (FileExists(lights)) {
     std::vector<double> scales;
@@ -140,19 +151,11 @@ Status EvaluateReconstruction(const std::string& dataset_dir, const std::string&
   std::string albedo_folder, roughness_folder;
   SFT_RETURN_IF_ERROR(PassFolder(dataset, "albedo", &albedo_folder));
   SFT_RETURN_IF_ERROR(PassFolder(dataset, "roughness", &roughness_folder));
-  // A rendered truth needs the true mesh and material.
-  TriMesh true_mesh;
-  Material true_material;
-  std::unique_ptr<RenderScene> true_scene;
-  std::string true_material_path;
-  SFT_RETURN_IF_ERROR(PassFolder(dataset, "material", &true_material_path));
-  const bool can_render_truth = !dataset.gt_mesh.empty() && !true_material_path.empty();
-  if (can_render_truth) {
-    SFT_RETURN_IF_ERROR(ReadMesh(JoinPath(dataset.root, dataset.gt_mesh), &true_mesh));
-    SFT_RETURN_IF_ERROR(
-        LoadMaterial(JoinPath(dataset.root, true_material_path), true_mesh, &true_material));
-    true_scene = std::make_unique<RenderScene>(true_mesh);
-  }
+  Truth truth;
+  SFT_RETURN_IF_ERROR(LoadTruth(dataset, &truth));
+  const bool can_render_truth = truth.scene != nullptr;
+  std::vector<RelightCondition> conditions;
+  SFT_RETURN_IF_ERROR(PrepareRelight(capture, truth, options, &conditions));
   DatasetViews views;
   SFT_RETURN_IF_ERROR(MakeDatasetViews(dataset, &views));
   std::vector<int> selected;
@@ -167,7 +170,7 @@ Status EvaluateReconstruction(const std::string& dataset_dir, const std::string&
   albedo_pass.pass = RenderPass::kAlbedo;
   RenderOptions roughness_pass = render;
   roughness_pass.pass = RenderPass::kRoughness;
-  Measure full, albedo, roughness;
+  ViewScores full, albedo, roughness;
   for (int v : selected) {
     Image target, mask, ours;
     SFT_RETURN_IF_ERROR(LoadViewImage(dataset, v, &target));
@@ -175,31 +178,48 @@ Status EvaluateReconstruction(const std::string& dataset_dir, const std::string&
     RenderView(scene, material, views.views[v], render, &ours);
     SFT_RETURN_IF_ERROR(full.Add(v, ToRgb(ours), target, mask));
     if (!albedo_folder.empty() || can_render_truth) {
-      Image truth;
-      SFT_RETURN_IF_ERROR(TruePass(dataset, v, albedo_folder, true_scene.get(), &true_material,
-                                   views.views[v], albedo_pass, &truth));
+      Image true_pass;
+      SFT_RETURN_IF_ERROR(TruePass(dataset, v, albedo_folder, truth.scene.get(), &truth.material,
+                                   views.views[v], albedo_pass, &true_pass));
       RenderView(scene, material, views.views[v], albedo_pass, &ours);
-      SFT_RETURN_IF_ERROR(albedo.Add(v, ToRgb(ours), truth, mask));
+      SFT_RETURN_IF_ERROR(albedo.Add(v, ToRgb(ours), true_pass, mask));
     }
     if (!roughness_folder.empty() || can_render_truth) {
-      Image truth;
-      SFT_RETURN_IF_ERROR(TruePass(dataset, v, roughness_folder, true_scene.get(), &true_material,
-                                   views.views[v], roughness_pass, &truth));
+      Image true_pass;
+      SFT_RETURN_IF_ERROR(TruePass(dataset, v, roughness_folder, truth.scene.get(), &truth.material,
+                                   views.views[v], roughness_pass, &true_pass));
       RenderView(scene, material, views.views[v], roughness_pass, &ours);
-      SFT_RETURN_IF_ERROR(roughness.Add(v, ToRgb(ours), truth, mask));
+      SFT_RETURN_IF_ERROR(roughness.Add(v, ToRgb(ours), true_pass, mask));
     }
+  }
+  json relight = nullptr;
+  if (!conditions.empty()) {
+    RelightInputs inputs;
+    inputs.dataset = &capture;
+    inputs.scene = &scene;
+    inputs.material = &material;
+    inputs.truth = truth.scene.get();
+    inputs.true_material = &truth.material;
+    inputs.views = selected;
+    inputs.render = render;
+    inputs.out = options.out;
+    SFT_RETURN_IF_ERROR(EvaluateRelighting(inputs, conditions, &relight));
   }
   *report = {{"mode", "reconstruction"},
              {"dataset", dataset_dir},
              {"reconstruction", reconstruction},
+             {"mesh", options.mesh.empty() ? JoinPath(reconstruction, "mesh.ply") : options.mesh},
+             {"material", options.material.empty() ? JoinPath(reconstruction, "material.json")
+                                                   : options.material},
              {"spp", options.spp},
              {"bounces", options.bounces},
              {"views", selected},
              {"psnr_peak", 1.0},
-             {"definitions", MeasureDefinitions()},
+             {"definitions", ViewScoreDefinitions()},
              {"full", full.ToJson()},
              {"albedo", albedo.ToJson()},
-             {"roughness", roughness.ToJson()}};
+             {"roughness", roughness.ToJson()},
+             {"relight", relight}};
   return Status::Ok();
 }
 

@@ -10,6 +10,8 @@
 // views (src/eval/image_metrics.h): PSNR and SSIM of the display images (clipped to [0, 1] and
 // sRGB-encoded: what a viewer sees, meaningful on HDR data), PSNR and SSIM of the linear values
 // (peak 1), and the relative RMSE of the linear values.
+// With --relight, the reconstruction and the true object are also rendered under other lights and
+// compared with each other (src/eval/relight_eval.h).
 #ifndef SFT_EVAL_RECONSTRUCTION_EVAL_H_
 #define SFT_EVAL_RECONSTRUCTION_EVAL_H_
 
@@ -26,12 +28,20 @@ struct ReconstructionEvalOptions {
   int bounces = 2;         // path segments of the colour re-render, [1, 16].
   uint64_t seed = 99;      // re-render seed.
   std::vector<int> views;  // view indices; empty = all.
+  std::string mesh;        // mesh to render instead of O/mesh.ply (e.g. an export's model.obj).
+  std::string material;    // material spec instead of O/material.json (LoadMaterial: a JSON
+                           // file, inline JSON or an export's model.mtl).
+  // --relight specs (src/eval/relight_eval.h: a lights file, "probe:PATH" or "side"); empty =
+  // no relighting. Needs the dataset's ground_truth.mesh and ground_truth.material.
+  std::vector<std::string> relight;
+  std::string out;  // folder for the relit renders; empty = none written.
 
   bool Check(std::string* why) const;
 };
 
 // Fills *report with {"mode": "reconstruction", "views": [...], "full": {...}, "albedo": {...} |
-// null, "roughness": {...} | null, "definitions": {...}, ...}; each pass {"psnr_srgb",
+// null, "roughness": {...} | null, "relight": {...} | null (EvaluateRelighting), "definitions":
+// {...}, ...}; each pass {"psnr_srgb",
 // "ssim_srgb", "psnr_linear", "ssim_linear", "rel_rmse", "views": [{"view", the same five}]}
 // (rel_rmse null where undefined).
 Status EvaluateReconstruction(const std::string& dataset_dir, const std::string& reconstruction,

@@ -93,6 +93,8 @@ std::string Describe(const json& value) {
 class SceneParser {
  public:
   explicit SceneParser(std::string file) : file_(std::move(file)) {}
+  // A lights file (ReadLightsFile) may name probes anywhere: absolute paths and ".." allowed.
+  void AllowAnyPath() { any_path_ = true; }
 
   Status Error(const std::string& path, const std::string& what) const {
     return Status::Error(file_ + ": " + path + ": " + what);
@@ -111,6 +113,18 @@ class SceneParser {
     SFT_RETURN_IF_ERROR(ParseGroundTruth(root, dataset));
     SFT_RETURN_IF_ERROR(ParseImportKeys(root, dataset));
     dataset->extra = UnknownKeys(root, kTopLevelKeys);
+    return Status::Ok();
+  }
+
+  // A lights file: an object whose "lights" array (required, non-empty) is read like scene.json's.
+  Status ParseLightsOnly(const json& root, std::vector<LightSpec>* lights) const {
+    if (!root.is_object()) {
+      return Status::Error(file_ + ": expected a JSON object at the top level, got " +
+                           Describe(root));
+    }
+    Dataset dataset;
+    SFT_RETURN_IF_ERROR(ParseLights(root, &dataset, /*required=*/true));
+    *lights = std::move(dataset.lights);
     return Status::Ok();
   }
 
@@ -140,6 +154,7 @@ class SceneParser {
   // else, so that no command can be led outside the dataset (or, mirroring the path under its
   // output folder, outside that) by scene.json.
   Status ContainedPath(const std::string& path, const std::string& value) const {
+    if (any_path_ && !value.empty()) return Status::Ok();
     std::string why;
     if (!IsContainedRelativePath(value, &why)) return Error(path, why);
     return Status::Ok();
@@ -331,9 +346,10 @@ class SceneParser {
     return Status::Ok();
   }
 
-  Status ParseLights(const json& root, Dataset* dataset) const {
+  Status ParseLights(const json& root, Dataset* dataset, bool required = false) const {
     const json* lights = nullptr;
-    SFT_RETURN_IF_ERROR(Array(root, "lights", /*required=*/false, &lights));
+    SFT_RETURN_IF_ERROR(Array(root, "lights", required, &lights));
+    if (required && lights->empty()) return Error("lights", "expected at least one light");
     if (lights == nullptr) return Status::Ok();
     std::map<std::string, size_t> seen;
     for (size_t i = 0; i < lights->size(); ++i) {
@@ -532,6 +548,7 @@ class SceneParser {
   }
 
   std::string file_;
+  bool any_path_ = false;
 };
 
 Status CheckSize(const std::string& path, const char* what, const Image& image,
@@ -598,6 +615,35 @@ Status ParseSceneJson(std::string text, const std::string& dir, Dataset* dataset
     result.root = dir;
     SFT_RETURN_IF_ERROR(SceneParser(file).Parse(root, &result));
     *dataset = std::move(result);
+    return Status::Ok();
+  } catch (const std::exception& e) {
+    return Status::Error(file + ": " + StripJsonExceptionId(e.what()));
+  }
+}
+
+Status ReadLightsFile(const std::string& file, std::vector<LightSpec>* lights) {
+  std::string text;
+  SFT_RETURN_IF_ERROR(ReadTextFile(file, &text));
+  StripUtf8Bom(&text);
+  try {
+    json root;
+    try {
+      root = json::parse(text);
+    } catch (const json::exception& e) {
+      return Status::Error(file + ": invalid JSON: " + StripJsonExceptionId(e.what()));
+    }
+    SceneParser parser(file);
+    parser.AllowAnyPath();
+    std::vector<LightSpec> result;
+    SFT_RETURN_IF_ERROR(parser.ParseLightsOnly(root, &result));
+    const std::string folder = std::filesystem::path(file).parent_path().string();
+    for (LightSpec& light : result) {
+      // Absolute, so that the light can join any dataset (LoadProbe joins onto its root).
+      if (light.type == LightType::kEnvironment) {
+        light.image = std::filesystem::absolute(JoinPath(folder, light.image)).string();
+      }
+    }
+    *lights = std::move(result);
     return Status::Ok();
   } catch (const std::exception& e) {
     return Status::Error(file + ": " + StripJsonExceptionId(e.what()));
