@@ -236,6 +236,12 @@ Status Reconstruction::RunOuter(int outer,
   return Status::Ok();
 }
 
+bool Reconstruction::SetAdamState(const AdamState& state) {
+  if (state.m.size() != static_cast<size_t>(params_.layout().size()) || state.v.size() != state.m.size()) return false;
+  adam_ = state;
+  return true;
+}
+
 TriMesh Reconstruction::Mesh() const {
   TriMesh mesh = mesh_;
   std::vector<Eigen::Vector3d> positions;

@@ -98,6 +98,11 @@ class Reconstruction {
   const RenderCache& cache() const { return *cache_; }
   const std::vector<PhaseRecord>& phases() const { return phase_records_; }
   const std::vector<int>& view_indices() const { return cache_->view_indices(); }
+  // Adam's moments (kept across outer iterations; empty before the first Adam phase), for
+  // checkpoints. SetAdamState refuses (false, state unchanged) moments whose size is not the
+  // parameter layout's, or m and v of different sizes.
+  const AdamState& adam_state() const { return adam_; }
+  bool SetAdamState(const AdamState& state);
   double elapsed_offset = 0.0;  // seconds of earlier (resumed) runs, added to records.
 
  private:

@@ -161,6 +161,11 @@ Status Schedule::Resume(const Dataset& dataset, const std::string& out,
   if (metrics.contains("stages") && metrics["stages"].is_array()) {
     s->stage_records_ = metrics["stages"];
   }
+  // Older run folders have no adam_state.bin: their Adam stages resume with fresh moments.
+  auto saved_adam = std::make_unique<AdamCheckpoint>();
+  bool found = false;
+  SFT_RETURN_IF_ERROR(ReadAdamCheckpoint(out, saved_adam.get(), &found));
+  if (found) s->saved_adam_ = std::move(saved_adam);
   *schedule = std::move(s);
   return Status::Ok();
 }
@@ -172,8 +177,32 @@ Status Schedule::CreateReconstruction() {
   SFT_RETURN_IF_ERROR(Reconstruction::Create(*dataset_, current_.mesh, current_.material,
                                              current_.light_scales, stage.fit, &reconstruction_));
   reconstruction_->elapsed_offset = Elapsed();
+  reconstruction_stage_ = progress_.stage;
   phases_seen_ = 0;
   return Status::Ok();
+}
+
+// Gives the fit of a resumed stage the Adam moments of the checkpoint, when they belong to it:
+// the same stage and outer iteration (else the stage changed, or a crash left state.json behind
+// the moments) and the same parameter layout.
+void Schedule::RestoreAdamState(const ScheduleCallbacks& callbacks) {
+  if (!saved_adam_) return;
+  const std::unique_ptr<AdamCheckpoint> saved = std::move(saved_adam_);
+  if (saved->state.m.empty()) return;
+  const std::string name = JoinPath(out_, kAdamStateFile);
+  std::string line;
+  if (saved->stage != progress_.stage || saved->outer_done != progress_.outer_done) {
+    line = name + ": moments of stage " + std::to_string(saved->stage + 1) + " after outer " +
+           std::to_string(saved->outer_done) + ", the run stands at stage " +
+           std::to_string(progress_.stage + 1) + " after outer " +
+           std::to_string(progress_.outer_done) + ": Adam starts fresh";
+  } else if (!reconstruction_->SetAdamState(saved->state)) {
+    line = name + ": " + std::to_string(saved->state.m.size()) +
+           " moments do not match the parameters: Adam starts fresh";
+  } else {
+    line = "resume: Adam's moments restored (step " + std::to_string(saved->state.t) + ")";
+  }
+  if (callbacks.on_event) callbacks.on_event(line);
 }
 
 void Schedule::SyncCurrent() {
@@ -411,6 +440,16 @@ Status Schedule::Checkpoint() {
   progress_.seconds = Elapsed();
   SFT_RETURN_IF_ERROR(
       WriteRunSnapshot(out_, *dataset_, current_.mesh, current_.material, current_.light_scales));
+  // Before state.json (the commit point): see src/optim/adam_checkpoint.h.
+  if (reconstruction_ && !reconstruction_->adam_state().m.empty()) {
+    AdamCheckpoint adam;
+    adam.stage = reconstruction_stage_;
+    adam.outer_done = progress_.outer_done;
+    adam.state = reconstruction_->adam_state();
+    SFT_RETURN_IF_ERROR(WriteAdamCheckpoint(out_, adam));
+  } else {
+    RemoveAdamCheckpoint(out_);  // no moments (yet) in this fit: none from an earlier one.
+  }
   json info = run_info_;
   info["outer"] = outer_records_;
   info["topology_changes"] = topology_records_;
@@ -431,8 +470,9 @@ Status Schedule::Run(const ScheduleCallbacks& callbacks) {
   while (!finished()) {
     if (!progress_.stage_prepared) {
       SFT_RETURN_IF_ERROR(PrepareStage(callbacks));
-    } else if (!reconstruction_) {
+    } else if (!reconstruction_) {  // resumed within a stage.
       SFT_RETURN_IF_ERROR(CreateReconstruction());
+      RestoreAdamState(callbacks);
     }
     if (progress_.stage_outer_done >= CurrentStage().fit.outer_iterations) {
       // Resumed with fewer outer iterations than this stage already ran.

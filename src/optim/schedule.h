@@ -4,7 +4,8 @@
 // are applied; the mesh-colour texels carry across by re-projection onto the new surface. Within
 // a stage, an outer iteration that leaves too many folded or self-intersecting faces triggers a
 // resampling. After every outer iteration the run folder receives a checkpoint (state.json,
-// mesh, material, metrics) that `Resume` continues from, also across topology changes.
+// mesh, material, metrics, Adam's moments) that `Resume` continues from, also across topology
+// changes.
 //
 // Modelled on a pipeline controller: the CLI configures the stages (schedule_config.h), calls
 // Run with callbacks for progress, console lines and extra per-outer scores, and reports. The
@@ -23,6 +24,7 @@
 #include "src/geometry/material.h"
 #include "src/geometry/mesh.h"
 #include "src/io/dataset.h"
+#include "src/optim/adam_checkpoint.h"
 #include "src/optim/reconstruct.h"
 #include "src/optim/topology.h"
 
@@ -123,6 +125,7 @@ class Schedule {
   Status PrepareStage(const ScheduleCallbacks& callbacks);
   void RestartLobe(const StageOptions& stage, const ScheduleCallbacks& callbacks);
   Status CreateReconstruction();
+  void RestoreAdamState(const ScheduleCallbacks& callbacks);
   Status RunStageOuter(const ScheduleCallbacks& callbacks, bool* stop);
   Status UntangleCurrent(const ScheduleCallbacks& callbacks, nlohmann::json* record);
   Status ChangeTopology(TopologyChange change, const ScheduleCallbacks& callbacks);
@@ -143,6 +146,9 @@ class Schedule {
   ScheduleStart current_;  // the state at the last sync (mesh, material, light scales).
   TriMesh baseline_;       // folded faces are counted against it (reset at topology changes).
   std::unique_ptr<Reconstruction> reconstruction_;
+  int reconstruction_stage_ = 0;  // the stage reconstruction_ was created for.
+  // Adam's moments read by Resume (adam_state.bin), applied to the resumed stage's fit.
+  std::unique_ptr<AdamCheckpoint> saved_adam_;
   std::vector<IterationRecord> records_;
   std::vector<PhaseRecord> phase_records_;
   nlohmann::json outer_records_ = nlohmann::json::array();

@@ -8,10 +8,12 @@
 
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <sstream>
 
 #include "src/geometry/material.h"
 #include "src/io/dataset.h"
+#include "src/optim/adam_checkpoint.h"
 #include "src/optim/run_outputs.h"
 #include "src/optim/schedule_config.h"
 #include "tests/testing/synth_dataset.h"
@@ -429,6 +431,130 @@ TEST_F(ScheduleRunTest, StopAndResumeMidStage) {
   EXPECT_EQ(outers.front(), 2);  // the interrupted outer iteration runs again.
   EXPECT_EQ(outers.back(), 3);
   EXPECT_EQ(resumed->progress().outer_done, 4);
+}
+
+// The texels of a run's current material (albedo, then roughness).
+std::vector<double> Texels(Schedule* schedule) {
+  const Material material = schedule->reconstruction()->CurrentMaterial();
+  std::vector<double> texels = material.albedo.values();
+  texels.insert(texels.end(), material.roughness.values().begin(),
+                material.roughness.values().end());
+  return texels;
+}
+
+double MaxDifference(const std::vector<double>& a, const std::vector<double>& b) {
+  EXPECT_EQ(a.size(), b.size());
+  double d = 0.0;
+  for (size_t k = 0; k < a.size() && k < b.size(); ++k) d = std::max(d, std::abs(a[k] - b[k]));
+  return d;
+}
+
+// An Adam texture stage (new samples every step, 2 renders threads) of 2 outer iterations. The
+// uninterrupted run is bit-reproducible. A copy of its folder taken right after the first outer
+// iteration's checkpoint (a run killed then) resumes to the same texels up to what the
+// checkpoint's float32 material file rounds away (< 1e-6); without adam_state.bin (moments, step
+// count and hence per-step seeds restart) the resumed run ends more than 100 times further away.
+TEST_F(ScheduleRunTest, AdamMomentsSurviveResume) {
+  const auto stages = Stages(R"({"spp": 4, "bounces": 1, "effects": "direct", "threads": 2,
+      "phases": "texture", "solver": "adam", "adam_resample": true, "steps": 3,
+      "stages": [{"name": "adam", "outer_iterations": 2}]})");
+  testing::TempDir out;
+  // Runs the stage in `run`; with `copy`, copies the folder when the second outer iteration
+  // reports its first step (the checkpoint after the first is complete then).
+  const auto run_whole = [&](const std::string& run, const std::string& copy) {
+    std::unique_ptr<Schedule> schedule;
+    EXPECT_TRUE(Schedule::Start(dataset_, run, stages, start_, {{"dataset", "ds"}}, &schedule).ok());
+    ScheduleCallbacks callbacks;
+    callbacks.on_iteration = [&](const IterationRecord& r) {
+      if (!copy.empty() && r.outer == 1 && r.iteration == 1) {
+        std::filesystem::copy(run, copy, std::filesystem::copy_options::recursive);
+      }
+      return true;
+    };
+    EXPECT_TRUE(schedule->Run(callbacks).ok());
+    EXPECT_TRUE(schedule->finished());
+    return Texels(schedule.get());
+  };
+  const std::vector<double> whole = run_whole(out.Join("whole"), out.Join("killed"));
+  EXPECT_EQ(MaxDifference(run_whole(out.Join("again"), ""), whole), 0.0);
+  ASSERT_TRUE(std::filesystem::exists(out.Join("killed/adam_state.bin")));
+  std::filesystem::copy(out.Join("killed"), out.Join("killed_old"),
+                        std::filesystem::copy_options::recursive);
+  std::filesystem::remove(out.Join("killed_old/adam_state.bin"));
+
+  const auto resume = [&](const std::string& run, std::vector<std::string>* events) {
+    RunState state;
+    EXPECT_TRUE(ReadRunState(run, &state).ok());
+    EXPECT_EQ(state.progress.outer_done, 1);
+    std::unique_ptr<Schedule> resumed;
+    EXPECT_TRUE(
+        Schedule::Resume(dataset_, run, stages, state.run_info, state.progress, &resumed).ok());
+    ScheduleCallbacks callbacks;
+    callbacks.on_event = [&](const std::string& line) { events->push_back(line); };
+    EXPECT_TRUE(resumed->Run(callbacks).ok());
+    EXPECT_TRUE(resumed->finished());
+    EXPECT_EQ(resumed->progress().outer_done, 2);
+    return Texels(resumed.get());
+  };
+  std::vector<std::string> events, old_events;
+  const double restored = MaxDifference(resume(out.Join("killed"), &events), whole);
+  const double fresh = MaxDifference(resume(out.Join("killed_old"), &old_events), whole);
+  EXPECT_THAT(events, ::testing::Contains("resume: Adam's moments restored (step 3)"));
+  EXPECT_TRUE(old_events.empty());  // an older run folder resumes silently, as before.
+  EXPECT_LT(restored, 1e-6);
+  EXPECT_GT(fresh, 100.0 * std::max(restored, 1e-7)) << restored << " " << fresh;
+  std::cout << "texels after resume, max |difference| to the uninterrupted run: with moments "
+            << restored << ", without " << fresh << "\n";
+}
+
+// A truncated adam_state.bin stops the resume with one line naming the file; one whose moments do
+// not fit the parameters is set aside with one console line.
+TEST_F(ScheduleRunTest, BrokenAdamStateIsReported) {
+  testing::TempDir out;
+  const auto stages = Stages(R"({"spp": 2, "bounces": 1, "effects": "direct", "phases": "texture",
+      "solver": "adam", "steps": 1, "stages": [{"name": "adam", "outer_iterations": 1}]})");
+  std::unique_ptr<Schedule> schedule;
+  ASSERT_TRUE(
+      Schedule::Start(dataset_, out.Join("r"), stages, start_, {{"dataset", "ds"}}, &schedule)
+          .ok());
+  ASSERT_TRUE(schedule->Run(ScheduleCallbacks()).ok());
+  const std::string file = out.Join("r/adam_state.bin");
+  const uintmax_t size = std::filesystem::file_size(file);
+  RunState state;
+  ASSERT_TRUE(ReadRunState(out.Join("r"), &state).ok());
+  // --outer 2 on resume: the finished stage continues, with its moments.
+  auto more = stages;
+  more[0].fit.outer_iterations = 2;
+  std::unique_ptr<Schedule> resumed;
+  AdamCheckpoint saved;
+  bool found = false;
+  ASSERT_TRUE(ReadAdamCheckpoint(out.Join("r"), &saved, &found).ok());
+  ASSERT_TRUE(found);
+
+  std::filesystem::resize_file(file, size - 8);
+  Status status =
+      Schedule::Resume(dataset_, out.Join("r"), more, state.run_info, state.progress, &resumed);
+  ASSERT_FALSE(status.ok());
+  EXPECT_THAT(status.message(), HasSubstr(file + ": truncated or corrupt"));
+  EXPECT_EQ(status.message().find('\n'), std::string::npos);
+  std::filesystem::resize_file(file, 20);
+  status = Schedule::Resume(dataset_, out.Join("r"), more, state.run_info, state.progress, &resumed);
+  ASSERT_FALSE(status.ok());
+  EXPECT_THAT(status.message(), HasSubstr(file + ": not an sft Adam state"));
+
+  saved.state.m.pop_back();
+  saved.state.v.pop_back();
+  ASSERT_TRUE(WriteAdamCheckpoint(out.Join("r"), saved).ok());
+  ASSERT_TRUE(
+      Schedule::Resume(dataset_, out.Join("r"), more, state.run_info, state.progress, &resumed)
+          .ok());
+  std::vector<std::string> events;
+  ScheduleCallbacks callbacks;
+  callbacks.on_event = [&](const std::string& line) { events.push_back(line); };
+  ASSERT_TRUE(resumed->Run(callbacks).ok());
+  ASSERT_FALSE(events.empty());
+  EXPECT_THAT(events.front(), HasSubstr("moments do not match the parameters: Adam starts fresh"));
+  EXPECT_THAT(events.front(), HasSubstr(file));
 }
 
 // A geometry outer iteration that leaves self-intersecting faces is followed by untangling (the
