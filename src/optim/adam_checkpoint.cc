@@ -85,11 +85,10 @@ Status ReadAdamCheckpoint(const std::string& out, AdamCheckpoint* checkpoint, bo
   const double lambda = GetDouble(bytes, &pos);
   const uint64_t payload = bytes.size() - kHeaderBytes;
   if (n > payload / 16 || payload != 16 * n) {
-    return Status::Error(path + ": truncated or corrupt (" + std::to_string(bytes.size()) +
-                         " bytes; the header's " + std::to_string(n) + " moments need " +
-                         (n > payload / 16 ? std::string("more")
-                                           : std::to_string(kHeaderBytes + 16 * n)) +
-                         ")");
+    return Status::Error(
+        path + ": truncated or corrupt (" + std::to_string(bytes.size()) + " bytes; the header's " +
+        std::to_string(n) + " moments need " +
+        (n > payload / 16 ? std::string("more") : std::to_string(kHeaderBytes + 16 * n)) + ")");
   }
   if (checkpoint->outer_done < 0 || t < 0 || !std::isfinite(lambda) || lambda < 0.0) {
     return Status::Error(path + ": corrupt header (negative outer_done or t, or invalid lambda)");

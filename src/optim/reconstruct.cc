@@ -237,7 +237,9 @@ Status Reconstruction::RunOuter(int outer,
 }
 
 bool Reconstruction::SetAdamState(const AdamState& state) {
-  if (state.m.size() != static_cast<size_t>(params_.layout().size()) || state.v.size() != state.m.size()) return false;
+  if (state.m.size() != static_cast<size_t>(params_.layout().size()) ||
+      state.v.size() != state.m.size())
+    return false;
   adam_ = state;
   return true;
 }

@@ -8,6 +8,8 @@
 //                               statistics, per-outer records, topology changes and stages;
 //   state.json                  what --resume needs (format sft-reconstruct-state/2): the run's
 //                               info (dataset, start, config), the stages, where the run stands;
+//   adam_state.bin              Adam's moments and step count in an Adam stage
+//                               (src/optim/adam_checkpoint.h);
 //   initial_mesh.ply            the run's starting mesh;
 //   baseline_mesh.ply           the mesh after the last topology change: folded faces are
 //                               counted against it;

@@ -463,7 +463,8 @@ TEST_F(ScheduleRunTest, AdamMomentsSurviveResume) {
   // reports its first step (the checkpoint after the first is complete then).
   const auto run_whole = [&](const std::string& run, const std::string& copy) {
     std::unique_ptr<Schedule> schedule;
-    EXPECT_TRUE(Schedule::Start(dataset_, run, stages, start_, {{"dataset", "ds"}}, &schedule).ok());
+    EXPECT_TRUE(
+        Schedule::Start(dataset_, run, stages, start_, {{"dataset", "ds"}}, &schedule).ok());
     ScheduleCallbacks callbacks;
     callbacks.on_iteration = [&](const IterationRecord& r) {
       if (!copy.empty() && r.outer == 1 && r.iteration == 1) {
@@ -538,7 +539,8 @@ TEST_F(ScheduleRunTest, BrokenAdamStateIsReported) {
   EXPECT_THAT(status.message(), HasSubstr(file + ": truncated or corrupt"));
   EXPECT_EQ(status.message().find('\n'), std::string::npos);
   std::filesystem::resize_file(file, 20);
-  status = Schedule::Resume(dataset_, out.Join("r"), more, state.run_info, state.progress, &resumed);
+  status =
+      Schedule::Resume(dataset_, out.Join("r"), more, state.run_info, state.progress, &resumed);
   ASSERT_FALSE(status.ok());
   EXPECT_THAT(status.message(), HasSubstr(file + ": not an sft Adam state"));
 
