@@ -83,12 +83,12 @@ Status ReadAdamCheckpoint(const std::string& out, AdamCheckpoint* checkpoint, bo
   const uint64_t n = GetUint(bytes, &pos, 8);
   const int64_t t = static_cast<int64_t>(GetUint(bytes, &pos, 8));
   const double lambda = GetDouble(bytes, &pos);
-  const uint64_t payload = bytes.size() - kHeaderBytes;
-  if (n > payload / 16 || payload != 16 * n) {
-    return Status::Error(
-        path + ": truncated or corrupt (" + std::to_string(bytes.size()) + " bytes; the header's " +
-        std::to_string(n) + " moments need " +
-        (n > payload / 16 ? std::string("more") : std::to_string(kHeaderBytes + 16 * n)) + ")");
+  // 16 n + header overflows only for a corrupt n.
+  const bool representable = n <= (UINT64_MAX - kHeaderBytes) / 16;
+  if (!representable || bytes.size() != kHeaderBytes + 16 * n) {
+    return Status::Error(path + ": truncated or corrupt (" + std::to_string(bytes.size()) +
+                         " bytes; the header's " + std::to_string(n) + " moments need " +
+                         (representable ? std::to_string(kHeaderBytes + 16 * n) : "more") + ")");
   }
   if (checkpoint->outer_done < 0 || t < 0 || !std::isfinite(lambda) || lambda < 0.0) {
     return Status::Error(path + ": corrupt header (negative outer_done or t, or invalid lambda)");

@@ -537,6 +537,7 @@ TEST_F(ScheduleRunTest, BrokenAdamStateIsReported) {
       Schedule::Resume(dataset_, out.Join("r"), more, state.run_info, state.progress, &resumed);
   ASSERT_FALSE(status.ok());
   EXPECT_THAT(status.message(), HasSubstr(file + ": truncated or corrupt"));
+  EXPECT_THAT(status.message(), HasSubstr("need " + std::to_string(size) + ")"));
   EXPECT_EQ(status.message().find('\n'), std::string::npos);
   std::filesystem::resize_file(file, 20);
   status =
