@@ -7,7 +7,6 @@
 #include <cmath>
 #include <random>
 
-#include "cost_functions/exposure_prior.h"
 #include "src/geometry/material.h"
 #include "src/geometry/mesh.h"
 #include "src/io/dataset.h"
@@ -276,20 +275,6 @@ TEST_F(ExposureTest, GradientsMatchFiniteDifferencesOfTheCost) {
   // Pixels with no parameters are left out but constant: the same cost up to them.
   EXPECT_LE(problem_cost, cost * (1 + 1e-9));
   EXPECT_NEAR(problem_directional / fd_gains, 1.0, 2e-3);
-}
-
-// The prior's residual and Jacobian.
-TEST(ExposurePriorCostTest, ResidualAndJacobian) {
-  ExposurePriorCost cost(2.0, 3.0, 4.0);
-  const double g[3] = {1.5, 1.0, 0.25};
-  const double* params[] = {g};
-  double r[3], j[9];
-  double* jacobians[] = {j};
-  ASSERT_TRUE(cost.Evaluate(params, r, jacobians));
-  EXPECT_DOUBLE_EQ(r[0], 1.0);
-  EXPECT_DOUBLE_EQ(r[1], 0.0);
-  EXPECT_DOUBLE_EQ(r[2], -3.0);
-  for (int e = 0; e < 9; ++e) EXPECT_DOUBLE_EQ(j[e], e % 4 == 0 ? 2.0 + e / 4 : 0.0);
 }
 
 // Sum of |albedo pass − truth| over the dataset's views (where the texels are seen).
