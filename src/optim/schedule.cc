@@ -302,7 +302,8 @@ Status Schedule::UntangleCurrent(const ScheduleCallbacks& callbacks, json* recor
                   report.moved_vertices, NowSeconds() - start);
     callbacks.on_event(line);
   }
-  return CreateReconstruction();
+  // Unchanged when no round improved on the input.
+  return report.faces_after < report.faces_before ? CreateReconstruction() : Status::Ok();
 }
 
 // metrics.json's per-outer entry: cost, time, faces, mesh quality against the baseline and the
