@@ -133,7 +133,8 @@ Status PrepareSchedule(ReconstructCommandOptions* cli, Dataset* dataset,
     if (cli->print_schedule) return PrintSchedule(stages);
     SFT_RETURN_IF_ERROR(CheckViewsHaveLights(*dataset));
     SFT_RETURN_IF_ERROR(CheckOutputDirectory(cli->out, {{cli->dataset}, {}}, "--resume"));
-    return Schedule::Resume(*dataset, cli->out, stages, state.run_info, state.progress, schedule);
+    return Schedule::Resume(*dataset, cli->out, stages, state.run_info, state.progress,
+                            state.view_gains, schedule);
   }
   if (cli->dataset.empty() || (cli->out.empty() && !cli->print_schedule)) {
     return Status::Error("--dataset and --out are required (or --resume OUT)");

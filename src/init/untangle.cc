@@ -75,7 +75,12 @@ Status Untangle(const UntangleOptions& options, TriMesh* mesh, UntangleReport* r
     return Status::Error("untangle: cannot list the self-intersecting faces of the mesh");
   }
   report->faces_before = report->faces_after = static_cast<int>(faces.size());
-  std::set<int> moved;
+  if (faces.empty()) return Status::Ok();
+  // Smoothing can also make things worse (a thin part shrinks until its sides cross): the mesh
+  // ends at the round with the fewest intersecting faces, the input itself if none improved.
+  const TriMesh input = *mesh;
+  TriMesh best = *mesh;
+  std::set<int> moved, best_moved;
   while (!faces.empty() && report->rounds < options.max_rounds) {
     // Each round widens the neighbourhood by one ring: a tangle that the first rounds' smoothing
     // cannot open is given more room.
@@ -85,11 +90,17 @@ Status Untangle(const UntangleOptions& options, TriMesh* mesh, UntangleReport* r
     for (TriMesh::VertexHandle v : vertices) moved.insert(v.idx());
     ++report->rounds;
     if (!SelfIntersectingFaces(*mesh, &faces)) {
+      *mesh = input;
       return Status::Error("untangle: cannot list the self-intersecting faces of the mesh");
     }
-    report->faces_after = static_cast<int>(faces.size());
+    if (static_cast<int>(faces.size()) < report->faces_after) {
+      report->faces_after = static_cast<int>(faces.size());
+      best = *mesh;
+      best_moved = moved;
+    }
   }
-  report->moved_vertices = static_cast<int>(moved.size());
+  *mesh = std::move(best);
+  report->moved_vertices = static_cast<int>(best_moved.size());
   return Status::Ok();
 }
 

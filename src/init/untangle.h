@@ -24,12 +24,14 @@ struct UntangleOptions {
 
 struct UntangleReport {
   int faces_before = 0;    // self-intersecting faces before the repair.
-  int faces_after = 0;     // and after it (0 = repaired).
+  int faces_after = 0;     // and after it (0 = repaired; never more than before).
   int rounds = 0;          // smoothing rounds run.
-  int moved_vertices = 0;  // distinct vertices moved over all rounds.
+  int moved_vertices = 0;  // distinct vertices moved up to the round kept.
 };
 
-// Repairs `mesh` in place (vertex positions only; faces and their order are kept). Errors: the
+// Repairs `mesh` in place (vertex positions only; faces and their order are kept). The result is
+// the round with the fewest self-intersecting faces; when no round has fewer than the input, the
+// input is kept unchanged (faces_after == faces_before, moved_vertices 0). Errors: the
 // options are invalid, or the intersecting faces cannot be named (SelfIntersectingFaces false: no
 // faces, a CGAL failure, degenerate or repeated faces). A mesh without self-intersections is
 // returned unchanged.

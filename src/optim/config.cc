@@ -264,6 +264,9 @@ const std::map<std::string, Key>& Keys() {
       {"normal_sliding", Bool([](O* o) -> bool& { return o->cache.edges.normal_sliding; })},
       {"fit_specular", Bool([](O* o) -> bool& { return o->fit_specular; })},
       {"fit_lights", Bool([](O* o) -> bool& { return o->fit_lights; })},
+      {"fit_exposure", Bool([](O* o) -> bool& { return o->fit_exposure; })},
+      {"exposure_prior",
+       Real([](O* o) -> double& { return o->regularizers.exposure_prior; }, 0, 1e12)},
       {"seed",
        {[](const json& v, O* o) -> std::string {
           if (!v.is_number_integer() || (!v.is_number_unsigned() && v.get<int64_t>() < 0)) {

@@ -105,7 +105,7 @@ class Measurer {
   Status Gradients(const EffectPlan& plan, Sample (&out)[2]) {
     const int n = 3 * cache_->params().layout().num_vertices;
     for (int k = 0; k < 2; ++k) {
-      std::vector<double> gradient(cache_->params().layout().size(), 0.0);
+      std::vector<double> gradient(cache_->params().size(), 0.0);
       for (size_t i = 0; i < views_.size(); ++i) {
         if (!cache_->AddAdjointGradientWith(views_[i], weights_[i], plan, seeds_[k], &gradient)) {
           return Status::Error("effect planner: a gradient was not finite (" + plan.Summary() +

@@ -18,6 +18,10 @@ bool ParameterBounds::Check(std::string* why) const {
     *why = "light_scale_min/light_scale_max: need 0 < min < max < infinity";
     return false;
   }
+  if (!(gain_min > 0.0 && gain_min < 1.0 && gain_max > 1.0 && std::isfinite(gain_max))) {
+    *why = "gain_min/gain_max: need 0 < min < 1 < max < infinity";
+    return false;
+  }
   return true;
 }
 
@@ -34,12 +38,14 @@ ParameterSelection ActiveParameters::ToSelection() const {
 bool ActiveParameters::Includes(ParameterKind kind) const { return ToSelection().Selected(kind); }
 
 SceneParameters::SceneParameters(const std::vector<Eigen::Vector3d>& positions,
-                                 const Material& material, int num_lights) {
+                                 const Material& material, int num_lights, int num_gain_views) {
+  CHECK_GE(num_gain_views, 0);
   layout_.num_vertices = static_cast<int>(positions.size());
   layout_.num_albedo_texels = material.albedo.num_texels();
   layout_.num_roughness_texels = material.roughness.num_texels();
   layout_.num_lights = num_lights;
-  values_.assign(layout_.size(), 0.0);
+  num_gain_views_ = num_gain_views;
+  values_.assign(layout_.size() + 3 * num_gain_views, 0.0);
   for (size_t v = 0; v < positions.size(); ++v) {
     for (int k = 0; k < 3; ++k) values_[3 * v + k] = positions[v][k];
   }
@@ -49,12 +55,19 @@ SceneParameters::SceneParameters(const std::vector<Eigen::Vector3d>& positions,
             values_.begin() + layout_.RoughnessOffset());
   values_[layout_.SpecularIndex()] = material.specular;
   for (int l = 0; l < num_lights; ++l) values_[layout_.LightOffset() + l] = 1.0;
+  std::fill(values_.begin() + ExposureOffset(), values_.end(), 1.0);
+}
+
+Eigen::Vector3d SceneParameters::Gains(int view) const {
+  if (view < 0 || view >= num_gain_views_) return Eigen::Vector3d::Ones();
+  return Eigen::Vector3d(values_[GainIndex(view, 0)], values_[GainIndex(view, 1)],
+                         values_[GainIndex(view, 2)]);
 }
 
 std::vector<BlockSpan> SceneParameters::Blocks() const {
   std::vector<BlockSpan> blocks;
   blocks.reserve(layout_.num_vertices + layout_.num_albedo_texels + layout_.num_roughness_texels +
-                 1 + layout_.num_lights);
+                 1 + layout_.num_lights + num_gain_views_);
   for (int v = 0; v < layout_.num_vertices; ++v) {
     blocks.push_back({3 * v, 3, ParameterKind::kVertex});
   }
@@ -68,11 +81,18 @@ std::vector<BlockSpan> SceneParameters::Blocks() const {
   for (int l = 0; l < layout_.num_lights; ++l) {
     blocks.push_back({layout_.LightOffset() + l, 1, ParameterKind::kLight});
   }
+  for (int v = 0; v < num_gain_views_; ++v) {
+    blocks.push_back({GainIndex(v, 0), 3, ParameterKind::kLight, /*exposure=*/true});
+  }
   return blocks;
 }
 
 BlockSpan SceneParameters::BlockOf(int index) const {
-  DCHECK(index >= 0 && index < layout_.size());
+  DCHECK(index >= 0 && index < size());
+  if (IsExposure(index)) {
+    const int local = index - ExposureOffset();
+    return {index - local % 3, 3, ParameterKind::kLight, /*exposure=*/true};
+  }
   switch (layout_.KindOf(index)) {
     case ParameterKind::kVertex:
       return {index - index % 3, 3, ParameterKind::kVertex};
@@ -108,10 +128,12 @@ void SceneParameters::WriteMaterial(Material* material) const {
 }
 
 std::vector<double> SceneParameters::LightScales() const {
-  return std::vector<double>(values_.begin() + layout_.LightOffset(), values_.end());
+  return std::vector<double>(values_.begin() + layout_.LightOffset(),
+                             values_.begin() + layout_.size());
 }
 
 double SceneParameters::Lower(int index, const ParameterBounds& bounds) const {
+  if (IsExposure(index)) return bounds.gain_min;
   switch (layout_.KindOf(index)) {
     case ParameterKind::kVertex:
       return -std::numeric_limits<double>::infinity();
@@ -127,6 +149,7 @@ double SceneParameters::Lower(int index, const ParameterBounds& bounds) const {
 }
 
 double SceneParameters::Upper(int index, const ParameterBounds& bounds) const {
+  if (IsExposure(index)) return bounds.gain_max;
   switch (layout_.KindOf(index)) {
     case ParameterKind::kVertex:
       return std::numeric_limits<double>::infinity();
@@ -138,7 +161,7 @@ double SceneParameters::Upper(int index, const ParameterBounds& bounds) const {
 }
 
 void SceneParameters::Project(const ParameterBounds& bounds, std::vector<double>* values) const {
-  for (int i = layout_.AlbedoOffset(); i < layout_.size(); ++i) {
+  for (int i = layout_.AlbedoOffset(); i < size(); ++i) {
     (*values)[i] = std::clamp((*values)[i], Lower(i, bounds), Upper(i, bounds));
   }
 }

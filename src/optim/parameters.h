@@ -1,9 +1,12 @@
 // The reconstruction's state as one flat vector in the renderer's parameter layout
 // (ParameterLayout, src/render/derivatives.h): x[i] is parameter i — vertex coordinates, albedo
-// texels (RGB), roughness texels, the specular weight, one intensity scale per dataset light. Ceres
-// parameter blocks point into this vector: one block per vertex (3), per albedo texel (3), per
-// roughness texel (1), the specular weight (1) and each light scale (1), so the mapping between
-// Ceres blocks and layout indices is the block's offset in the vector.
+// texels (RGB), roughness texels, the specular weight, one intensity scale per dataset light —
+// followed by the fit-only exposure gains: 3 per fitted view (R, G, B), which multiply that view's
+// rendered image before the residual (the renderer never sees them; docs/reconstruct.md,
+// "Exposure and white balance"). Ceres parameter blocks point into this vector: one block per
+// vertex (3), per albedo texel (3), per roughness texel (1), the specular weight (1), each light
+// scale (1) and each view's gains (3), so the mapping between Ceres blocks and indices is the
+// block's offset in the vector.
 #ifndef SFT_OPTIM_PARAMETERS_H_
 #define SFT_OPTIM_PARAMETERS_H_
 
@@ -26,6 +29,11 @@ struct ParameterBounds {
   double light_scale_min = 1e-6;
   // Light scales above this are treated as a runaway fit.
   double light_scale_max = 1e6;
+  // Exposure gains stay in [gain_min, gain_max]: a gain is a camera's exposure × white-balance
+  // factor relative to the gauge view, so factors beyond 20× (over 4 stops) mean a runaway fit
+  // and a gain of 0 would erase the view.
+  double gain_min = 0.05;
+  double gain_max = 20.0;
 
   bool Check(std::string* why) const;
 };
@@ -37,32 +45,55 @@ struct ActiveParameters {
   bool roughness = true;
   bool specular = false;
   bool lights = false;
+  bool exposure = false;  // the per-view exposure gains (all views but the gauge view).
 
+  // The renderer's kinds (exposure gains are applied by the render cache, not the renderer).
   ParameterSelection ToSelection() const;
   bool Includes(ParameterKind kind) const;
-  bool Any() const { return vertices || albedo || roughness || specular || lights; }
+  bool Any() const { return vertices || albedo || roughness || specular || lights || exposure; }
 };
+
+// The gauge of the exposure gains: albedo × light intensity × gain is otherwise ambiguous (any
+// common factor moves between them), so the gains of fitted view 0 — the lowest dataset index
+// fitted — stay 1 and are never a parameter. Every other gain is relative to that view.
+constexpr int kExposureGaugeView = 0;
 
 // One Ceres parameter block: [offset, offset + size) of the flat vector.
 struct BlockSpan {
   int offset = 0;
   int size = 0;
-  ParameterKind kind = ParameterKind::kVertex;
+  ParameterKind kind = ParameterKind::kVertex;  // meaningless when `exposure`.
+  bool exposure = false;                        // one view's 3 exposure gains.
 };
 
 class SceneParameters {
  public:
   SceneParameters() = default;
-  // Packs positions, the material's texels and specular weight, and `num_lights` scales of 1.
+  // Packs positions, the material's texels and specular weight, `num_lights` scales of 1 and
+  // `num_gain_views` × 3 exposure gains of 1.
   SceneParameters(const std::vector<Eigen::Vector3d>& positions, const Material& material,
-                  int num_lights);
+                  int num_lights, int num_gain_views = 0);
 
+  // The renderer's part of the vector (every index below layout().size()).
   const ParameterLayout& layout() const { return layout_; }
+  // All parameters: the layout's, then the exposure gains.
+  int size() const { return static_cast<int>(values_.size()); }
+  int ExposureOffset() const { return layout_.size(); }
+  int num_gain_views() const { return num_gain_views_; }
+  bool IsExposure(int index) const { return index >= layout_.size(); }
+  // Index of fitted view v's gain of channel c.
+  int GainIndex(int view, int c) const { return ExposureOffset() + 3 * view + c; }
+  // Fitted view v's gains (1, 1, 1 when the vector has none).
+  Eigen::Vector3d Gains(int view) const;
+  // Whether fitted view v's gains are parameters of an exposure fit (not the gauge view).
+  bool GainFitted(int view) const {
+    return view != kExposureGaugeView && view >= 0 && view < num_gain_views_;
+  }
   std::vector<double>& values() { return values_; }
   const std::vector<double>& values() const { return values_; }
   double* data() { return values_.data(); }
 
-  // Every block in layout order: vertices, albedo texels, roughness texels, specular, lights.
+  // Every block in order: vertices, albedo texels, roughness texels, specular, lights, gains.
   std::vector<BlockSpan> Blocks() const;
   // The block holding parameter `index`.
   BlockSpan BlockOf(int index) const;
@@ -82,6 +113,7 @@ class SceneParameters {
 
  private:
   ParameterLayout layout_;
+  int num_gain_views_ = 0;
   std::vector<double> values_;
 };
 

@@ -20,8 +20,8 @@ void ExpandBlock(const SceneParameters& params, const Material& material, int pa
                  std::vector<int>* out) {
   const BlockSpan span = params.BlockOf(param);
   const ParameterLayout& layout = params.layout();
-  const bool albedo = span.kind == ParameterKind::kAlbedo;
-  if (!albedo && span.kind != ParameterKind::kRoughness) {
+  const bool albedo = !span.exposure && span.kind == ParameterKind::kAlbedo;
+  if (!albedo && (span.exposure || span.kind != ParameterKind::kRoughness)) {
     out->push_back(span.offset);
     return;
   }
@@ -113,7 +113,7 @@ Status ReconstructionProblem::Build(RenderCache* cache, SceneParameters* params,
   problem_options.evaluation_callback = cache;
   result->problem_ = std::make_unique<ceres::Problem>(problem_options);
   ceres::Problem* problem = result->problem_.get();
-  std::vector<bool> added(params->layout().size(), false);
+  std::vector<bool> added(params->size(), false);
   ProblemStats& stats = result->stats_;
   std::vector<double*> blocks;
   std::vector<int> sizes;

@@ -23,6 +23,7 @@ ActiveParameters TexturePhase(const ReconstructOptions& options) {
   active.roughness = true;
   active.specular = options.fit_specular;
   active.lights = options.fit_lights;
+  active.exposure = options.fit_exposure;
   return active;
 }
 
@@ -111,7 +112,8 @@ double PsnrFromMse(double mse) {
 Status Reconstruction::Create(const Dataset& dataset, const TriMesh& mesh, const Material& material,
                               const std::vector<double>& light_scales,
                               const ReconstructOptions& options,
-                              std::unique_ptr<Reconstruction>* out) {
+                              std::unique_ptr<Reconstruction>* out,
+                              const std::vector<Eigen::Vector3d>& view_gains) {
   std::string why;
   if (!options.Check(&why)) return Status::Error(why);
   std::unique_ptr<Reconstruction> r(new Reconstruction());
@@ -126,7 +128,22 @@ Status Reconstruction::Create(const Dataset& dataset, const TriMesh& mesh, const
   std::vector<int> views;
   SFT_RETURN_IF_ERROR(SelectViews(options.views, static_cast<int>(dataset.views.size()), &views));
   const int num_lights = static_cast<int>(dataset.lights.size());
-  r->params_ = SceneParameters(positions, material, num_lights);
+  const size_t num_dataset_views = dataset.views.size();
+  if (!view_gains.empty() && view_gains.size() != num_dataset_views) {
+    return Status::Error("exposure gains: " + std::to_string(view_gains.size()) +
+                         " views given, the dataset has " + std::to_string(num_dataset_views));
+  }
+  r->view_gains_ = view_gains;
+  if (r->view_gains_.empty()) r->view_gains_.assign(num_dataset_views, Eigen::Vector3d::Ones());
+  // Gains are parameters whenever some are not 1 (earlier fits) or this fit fits them.
+  bool gains = options.fit_exposure;
+  for (int v : views) gains = gains || r->view_gains_[v] != Eigen::Vector3d::Ones();
+  r->params_ =
+      SceneParameters(positions, material, num_lights, gains ? static_cast<int>(views.size()) : 0);
+  for (int k = 0; gains && k < static_cast<int>(views.size()); ++k) {
+    for (int c = 0; c < 3; ++c)
+      r->params_.values()[r->params_.GainIndex(k, c)] = r->view_gains_[views[k]][c];
+  }
   if (!light_scales.empty()) {
     if (static_cast<int>(light_scales.size()) != num_lights) {
       return Status::Error("light scales: " + std::to_string(light_scales.size()) +
@@ -192,9 +209,13 @@ Status Reconstruction::RunOuter(int outer,
     cache_->SetSeed(options_.seed * 7919ull + 2ull * static_cast<uint64_t>(outer) + k);
     const TriMesh rest = Mesh();
     SolverHooks hooks;
+    std::vector<Eigen::Vector3d> gain_curvature;
+    for (int v = 0; active.exposure && v < params_.num_gain_views(); ++v) {
+      gain_curvature.push_back(cache_->GainCurvature(v));
+    }
     hooks.add_regularizers = [&](ceres::Problem* problem) {
       AddRegularizers(rest, active, options_.regularizers, options_.problem.bounds, material_,
-                      &params_, problem);
+                      &params_, problem, gain_curvature);
     };
     std::vector<double> last_psnr;
     hooks.on_iteration = [&](const IterationInfo& info) {
@@ -272,6 +293,13 @@ std::vector<Image> Reconstruction::RenderViews(uint64_t seed) {
   for (int v = 0; v < cache_->num_views(); ++v) images.push_back(cache_->Rendered(v));
   cache_->SetSeed(saved);
   return images;
+}
+
+std::vector<Eigen::Vector3d> Reconstruction::ViewGains() const {
+  std::vector<Eigen::Vector3d> gains = view_gains_;
+  const std::vector<int>& views = cache_->view_indices();
+  for (int k = 0; k < params_.num_gain_views(); ++k) gains[views[k]] = params_.Gains(k);
+  return gains;
 }
 
 Image Reconstruction::RenderNormals(int v) {

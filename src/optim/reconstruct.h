@@ -37,8 +37,11 @@ struct ReconstructOptions {
   int outer_iterations = 4;   // outer iterations (fresh seeds each), [1, 10000].
   bool fit_specular = false;  // the texture phase also fits the specular weight.
   bool fit_lights = false;    // the texture phase also fits the light intensity scales.
-  uint64_t seed = 1;          // base seed of the renders.
-  std::vector<int> views;     // dataset views to fit; empty = all.
+  // The texture phase also fits per-view exposure gains (3 per fitted view, the first fitted view
+  // the fixed gauge; src/optim/parameters.h, kExposureGaugeView).
+  bool fit_exposure = false;
+  uint64_t seed = 1;       // base seed of the renders.
+  std::vector<int> views;  // dataset views to fit; empty = all.
   // Shading of the fit's renders: "auto" (the dataset's, DatasetShading in src/io/scene_setup.h:
   // its ground_truth.shading, else smooth), "flat" or "smooth". Create resolves it into
   // cache.render.shading.
@@ -72,9 +75,12 @@ struct PhaseRecord {
 class Reconstruction {
  public:
   // `mesh` and `material` are the initial state (copied). `light_scales` may be empty (all 1).
+  // `view_gains` are the exposure gains per dataset view (empty = all 1; otherwise one per
+  // dataset view): the fitted views' gains start from them.
   static Status Create(const Dataset& dataset, const TriMesh& mesh, const Material& material,
                        const std::vector<double>& light_scales, const ReconstructOptions& options,
-                       std::unique_ptr<Reconstruction>* out);
+                       std::unique_ptr<Reconstruction>* out,
+                       const std::vector<Eigen::Vector3d>& view_gains = {});
 
   // Runs the effect planner for outer iteration `outer` (its renders use the chosen plan from
   // now on). The ceiling is the configured effects and budgets; `image_signal_scale` and
@@ -90,6 +96,9 @@ class Reconstruction {
   TriMesh Mesh() const;
   Material CurrentMaterial() const;  // unsampled texels filled from their neighbours.
   std::vector<double> LightScales() const { return params_.LightScales(); }
+  // The exposure gains per dataset view: the fitted views' current ones, the others' as given to
+  // Create (1 when none were given).
+  std::vector<Eigen::Vector3d> ViewGains() const;
   // Renders every fitted view at the current state (seed `seed`) and returns level-0 images.
   std::vector<Image> RenderViews(uint64_t seed);
   // The normal pass of fitted view `v` at the current state (RGB: world-space geometric normals
@@ -118,6 +127,7 @@ class Reconstruction {
   std::unique_ptr<RenderCache> cache_;
   AdamState adam_;
   std::vector<PhaseRecord> phase_records_;
+  std::vector<Eigen::Vector3d> view_gains_;  // per dataset view, as given to Create.
   double start_time_ = 0.0;
 };
 

@@ -1,7 +1,10 @@
 #include "src/optim/regularizers.h"
 
+#include <glog/logging.h>
+
 #include <cmath>
 
+#include "cost_functions/exposure_prior.h"
 #include "cost_functions/face_orientation.h"
 #include "cost_functions/proximal_smoothing.h"
 #include "cost_functions/texel_smoothness.h"
@@ -41,6 +44,10 @@ bool RegularizerOptions::Check(std::string* why) const {
       return false;
     }
   }
+  if (!(exposure_prior >= 0.0 && std::isfinite(exposure_prior))) {
+    *why = "exposure_prior: must be finite and >= 0";
+    return false;
+  }
   if (!(orientation_weight >= 0.0 && std::isfinite(orientation_weight) &&
         orientation_min_fraction > 0.0 && orientation_min_fraction < 1.0)) {
     *why = "orientation_weight must be finite and >= 0, orientation_min_fraction in (0, 1)";
@@ -56,7 +63,8 @@ bool RegularizerOptions::Check(std::string* why) const {
 
 void AddRegularizers(const TriMesh& rest, const ActiveParameters& active,
                      const RegularizerOptions& options, const ParameterBounds& bounds,
-                     const Material& material, SceneParameters* params, ceres::Problem* problem) {
+                     const Material& material, SceneParameters* params, ceres::Problem* problem,
+                     const std::vector<Eigen::Vector3d>& gain_curvature) {
   const ParameterLayout& layout = params->layout();
   if (active.vertices && options.laplacian_weight > 0.0) {
     VertexLaplacianOptions laplacian;
@@ -90,6 +98,19 @@ void AddRegularizers(const TriMesh& rest, const ActiveParameters& active,
   if (active.roughness && options.roughness_smoothness > 0.0) {
     AddSmoothness(rest, material.roughness.resolution(), 1, layout.RoughnessOffset(),
                   options.roughness_smoothness, bounds, params, problem);
+  }
+  if (active.exposure && options.exposure_prior > 0.0) {
+    CHECK_EQ(static_cast<int>(gain_curvature.size()), params->num_gain_views());
+    for (int v = 0; v < params->num_gain_views(); ++v) {
+      if (!params->GainFitted(v)) continue;
+      double* block = params->data() + params->GainIndex(v, 0);
+      const Eigen::Vector3d w = (options.exposure_prior * gain_curvature[v]).cwiseSqrt();
+      problem->AddResidualBlock(new ExposurePriorCost(w[0], w[1], w[2]), nullptr, block);
+      for (int c = 0; c < 3; ++c) {
+        problem->SetParameterLowerBound(block, c, params->Lower(params->GainIndex(v, c), bounds));
+        problem->SetParameterUpperBound(block, c, params->Upper(params->GainIndex(v, c), bounds));
+      }
+    }
   }
 }
 

@@ -1,6 +1,7 @@
 // Regularizer residual blocks of the reconstruction (cost_functions/vertex_laplacian.h,
 // cost_functions/face_orientation.h, cost_functions/proximal_smoothing.h,
-// cost_functions/texel_smoothness.h), added for the parameter kinds a phase varies.
+// cost_functions/texel_smoothness.h, cost_functions/exposure_prior.h), added for the parameter
+// kinds a phase varies.
 #ifndef SFT_OPTIM_REGULARIZERS_H_
 #define SFT_OPTIM_REGULARIZERS_H_
 
@@ -44,6 +45,11 @@ struct RegularizerOptions {
   double proximal_lambda = 25.0;
   double albedo_smoothness = 0.0;     // weight of albedo differences of neighbouring texels, ≥ 0.
   double roughness_smoothness = 0.0;  // the same for roughness, ≥ 0.
+  // Relative weight λ of the exposure gains' prior towards 1 (cost_functions/exposure_prior.h:
+  // ½·λ·E_vc·(g_vc − 1)² per gain, E_vc the view's photograph energy, the image term's curvature
+  // in the gain), finite, ≥ 0: the prior counts λ times as much as the view's photograph; 0 = no
+  // prior (the gauge view alone fixes the scale). The default pulls a gain by 1e-3 of its offset.
+  double exposure_prior = 1e-3;
 
   bool Check(std::string* why) const;
 };
@@ -51,10 +57,12 @@ struct RegularizerOptions {
 // Adds the regularizers of the active kinds to `problem`. Their parameter blocks point into
 // `params`; blocks new to the problem get the bounds of `bounds`. `rest` is the mesh whose
 // positions the Laplacian measures displacements from and the proximal term is anchored at (and
-// whose connectivity they use).
+// whose connectivity they use). `gain_curvature` holds E_v per fitted view for the exposure prior
+// (RenderCache::GainCurvature); needed only when `active.exposure`.
 void AddRegularizers(const TriMesh& rest, const ActiveParameters& active,
                      const RegularizerOptions& options, const ParameterBounds& bounds,
-                     const Material& material, SceneParameters* params, ceres::Problem* problem);
+                     const Material& material, SceneParameters* params, ceres::Problem* problem,
+                     const std::vector<Eigen::Vector3d>& gain_curvature = {});
 
 }  // namespace sft
 

@@ -66,6 +66,45 @@ void SetRelativeWeights(const std::vector<uint8_t>& active0,
   }
 }
 
+// Multiplies channel c of every pixel of an RGB image by gain[c].
+void ApplyGains(const Eigen::Vector3d& gain, Image* rgb) {
+  for (size_t i = 0; i < rgb->data.size(); ++i) rgb->data[i] *= static_cast<float>(gain[i % 3]);
+}
+
+// The rows of the gained image g ⊙ I of one view (render_cache.h, "Exposure gains"): every entry
+// ∂I_c/∂θ becomes g_c·∂I_c/∂θ and, when `gain_offset` ≥ 0, each pixel gets the three entries
+// ∂(g_c I_c)/∂g_c = I_c (channel c only) at gain_offset + c — after the pixel's other entries,
+// since the gains have the highest indices. `ungained` is I (RGB, level 0); zero entries are left
+// out.
+LevelRows GainedRows(const LevelRows& rows, const Image& ungained, const Eigen::Vector3d& gain,
+                     int gain_offset) {
+  LevelRows out;
+  out.width = rows.width;
+  out.height = rows.height;
+  const size_t pixels = static_cast<size_t>(rows.width) * rows.height;
+  out.offsets.reserve(pixels + 1);
+  out.entries.reserve(rows.entries.size() + (gain_offset >= 0 ? 3 * pixels : 0));
+  out.offsets.push_back(0);
+  for (size_t p = 0; p < pixels; ++p) {
+    for (uint64_t i = rows.offsets[p]; i < rows.offsets[p + 1]; ++i) {
+      RowEntry e = rows.entries[i];
+      for (int c = 0; c < 3; ++c) e.d[c] *= gain[c];
+      out.entries.push_back(e);
+    }
+    if (gain_offset >= 0) {
+      for (int c = 0; c < 3; ++c) {
+        const double value = ungained.data[3 * p + c];
+        if (value == 0.0) continue;
+        RowEntry e{gain_offset + c, {0.0, 0.0, 0.0}};
+        e.d[c] = value;
+        out.entries.push_back(e);
+      }
+    }
+    out.offsets.push_back(out.entries.size());
+  }
+  return out;
+}
+
 }  // namespace
 
 bool ImageLossFromName(const std::string& name, ImageLoss* loss) {
@@ -267,7 +306,12 @@ bool RenderCache::RenderSome(const std::vector<int>& views) {
 
 void RenderCache::StoreRender(int v, const Image& image, const JacobianRows* rows) {
   const auto start = std::chrono::steady_clock::now();
-  std::vector<Image> pyramid = BuildPyramid(ToRgb(image), num_levels(v), options_.pyramid_filter);
+  Image rgb = ToRgb(image);
+  const Eigen::Vector3d gain = params_->Gains(v);
+  const bool fit_gains = active_.exposure && params_->GainFitted(v);
+  const Image ungained = fit_gains ? rgb : Image();
+  if (gain != Eigen::Vector3d::Ones()) ApplyGains(gain, &rgb);
+  std::vector<Image> pyramid = BuildPyramid(rgb, num_levels(v), options_.pyramid_filter);
   LevelRows level_rows;
   if (rows != nullptr) {
     level_rows = RowsFromRenderer(*rows);
@@ -280,6 +324,10 @@ void RenderCache::StoreRender(int v, const Image& image, const JacobianRows* row
         for (double& d : e.d) d /= scale;
       }
       for (double d : e.d) non_finite_ += !std::isfinite(d);  // a light-scale division.
+    }
+    if (fit_gains || gain != Eigen::Vector3d::Ones()) {
+      level_rows =
+          GainedRows(level_rows, ungained, gain, fit_gains ? params_->GainIndex(v, 0) : -1);
     }
   }
   for (int l = 0; l < num_levels(v); ++l) {
@@ -333,6 +381,24 @@ double RenderCache::ViewImageCost(int v) const {
     cost += 0.5 * level.sqrt_weight * level.sqrt_weight * sum;
   }
   return cost;
+}
+
+Eigen::Vector3d RenderCache::GainCurvature(int v) const {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  for (int l = 0; l < num_levels(v); ++l) {
+    const LevelCache& level = *levels_[v][l];
+    const std::vector<uint8_t>& active = targets_[v].active[l];
+    for (size_t p = 0; p < active.size(); ++p) {
+      if (!active[p]) continue;
+      const double w =
+          level.SqrtWeight(static_cast<int>(p)) * level.SqrtWeight(static_cast<int>(p));
+      for (int c = 0; c < 3; ++c) {
+        const double t = level.target.data[3 * p + c];
+        sum[c] += w * t * t;
+      }
+    }
+  }
+  return sum;
 }
 
 double RenderCache::ImageCost() const {
@@ -401,7 +467,14 @@ bool RenderCache::AddAdjointGradientWith(int v, const Image& weights, const Effe
   plan.ApplyTo(&render, &request);
   render.seed = seed;
   request.params = active_.ToSelection();
-  request.adjoint_weights = &weights;
+  // The residual is of g ⊙ I: the renderer's Jᵀw needs the weights times the gains.
+  const Eigen::Vector3d gain = params_->Gains(v);
+  Image gained_weights;
+  if (gain != Eigen::Vector3d::Ones()) {
+    gained_weights = ToRgb(weights);
+    ApplyGains(gain, &gained_weights);
+  }
+  request.adjoint_weights = gained_weights.empty() ? &weights : &gained_weights;
   const auto start = std::chrono::steady_clock::now();
   Image image;
   DerivativeOutput output;
@@ -417,6 +490,20 @@ bool RenderCache::AddAdjointGradientWith(int v, const Image& weights, const Effe
     if (i >= layout.LightOffset()) g /= params_->LightScale(i - layout.LightOffset());
     finite = finite && std::isfinite(g);
     (*gradient)[i] += g;
+  }
+  if (active_.exposure && params_->GainFitted(v)) {
+    // ∂/∂g_c Σ_p w_pc g_c I_pc = Σ_p w_pc I_pc, with I this pass's own (ungained) render, so that
+    // with independent_gradient the gains' gradient is as independent of the residual as the rest.
+    const Image rgb = ToRgb(image);
+    const Image w = ToRgb(weights);
+    double sum[3] = {0.0, 0.0, 0.0};
+    for (size_t i = 0; i < rgb.data.size(); ++i) {
+      sum[i % 3] += static_cast<double>(w.data[i]) * rgb.data[i];
+    }
+    for (int c = 0; c < 3; ++c) {
+      finite = finite && std::isfinite(sum[c]);
+      (*gradient)[params_->GainIndex(v, c)] += sum[c];
+    }
   }
   return finite;
 }
@@ -434,6 +521,8 @@ bool RenderCache::RenderWith(int v, const EffectPlan& plan, uint64_t seed, Image
   render_seconds_ += Seconds(start);
   ++renders_;
   *image = ToRgb(rendered);
+  const Eigen::Vector3d gain = params_->Gains(v);
+  if (gain != Eigen::Vector3d::Ones()) ApplyGains(gain, image);
   return stats.NonFinite() == 0;
 }
 

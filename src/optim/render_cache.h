@@ -9,6 +9,14 @@
 // rows once costs less than rendering twice. All renders of one outer iteration use the same seed
 // (common random numbers: a cost decrease between a trial and the linearization point is not
 // sampling noise); SetSeed starts a new outer iteration.
+//
+// Exposure gains: when the parameters hold gains (SceneParameters::Gains), fitted view v's stored
+// render is g_v ⊙ I_v (channel c times g_vc) on every level — the pyramid is linear, so level l is
+// g ⊙ P_l(I) — and its rows are those of g ⊙ I: every entry is scaled by g_c, and when the phase
+// fits exposure (ActiveParameters::exposure) and v is not the gauge view, each pixel gains the
+// entries ∂(g_c I_c)/∂g_c = I_c. The adjoint pass likewise hands the renderer the weights times
+// g and adds Σ_p w_pc I_pc to the gains' gradient. The gains are exact (linear); I_c is the Monte
+// Carlo render of the same pass.
 #ifndef SFT_OPTIM_RENDER_CACHE_H_
 #define SFT_OPTIM_RENDER_CACHE_H_
 
@@ -133,6 +141,10 @@ class RenderCache : public ceres::EvaluationCallback {
 
   // ½ Σ r² of the image residuals over the active pixels of every level, at the last render.
   double ImageCost() const;
+  // The image term's curvature in view v's gains at a render equal to the photograph: per channel
+  // c, Σ_l Σ_p w_l w_lp T_lpc² over the active pixels of every level (the exposure prior's scale,
+  // cost_functions/exposure_prior.h). Depends on the targets only.
+  Eigen::Vector3d GainCurvature(int v) const;
   // The part of ImageCost from view v.
   double ViewImageCost(int v) const;
   // Mean squared error of level 0 over its active pixels and RGB, per view, at the last render.

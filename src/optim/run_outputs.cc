@@ -1,5 +1,6 @@
 #include "src/optim/run_outputs.h"
 
+#include <cmath>
 #include <cstdio>
 
 #include "src/core/file_util.h"
@@ -34,6 +35,11 @@ Status WriteRunState(const std::string& out, const RunState& state) {
             {"stage_outers_done", p.stage_outers_done},
             {"seconds", p.seconds},
             {"finished", state.finished}};
+  if (!state.view_gains.empty()) {
+    json gains = json::array();
+    for (const Eigen::Vector3d& g : state.view_gains) gains.push_back({g[0], g[1], g[2]});
+    j["exposure_gains"] = gains;
+  }
   return WriteTextFile(JoinPath(out, "state.json"), j.dump(1) + "\n");
 }
 
@@ -75,6 +81,25 @@ Status ReadRunState(const std::string& out, RunState* state) {
   }
   p.seconds = j.value("seconds", 0.0);
   state->finished = j.value("finished", false);
+  state->view_gains.clear();
+  if (j.contains("exposure_gains")) {
+    const json& gains = j["exposure_gains"];
+    bool ok = gains.is_array();
+    for (size_t v = 0; ok && v < gains.size(); ++v) {
+      const json& g = gains[v];
+      ok = g.is_array() && g.size() == 3;
+      Eigen::Vector3d gain;
+      for (int c = 0; ok && c < 3; ++c) {
+        ok = g[c].is_number() && std::isfinite(g[c].get<double>()) && g[c].get<double>() > 0.0;
+        if (ok) gain[c] = g[c].get<double>();
+      }
+      if (ok) state->view_gains.push_back(gain);
+    }
+    if (!ok) {
+      return Status::Error(path + ": exposure_gains: expected one [R, G, B] of positive numbers " +
+                           "per dataset view");
+    }
+  }
   if (p.stage > static_cast<int>(state->stages.size())) {
     return Status::Error(path + ": stage " + std::to_string(p.stage) + " of " +
                          std::to_string(state->stages.size()));
@@ -97,6 +122,19 @@ Status ReadRunSnapshot(const std::string& out, const Dataset& dataset, TriMesh* 
   SFT_RETURN_IF_ERROR(ReadMesh(JoinPath(out, "mesh.ply"), mesh));
   SFT_RETURN_IF_ERROR(LoadMaterial(JoinPath(out, "material.json"), *mesh, material));
   return ReadLightScales(JoinPath(out, "lights.json"), dataset, light_scales);
+}
+
+Status WriteExposure(const std::string& out, const Dataset& dataset,
+                     const std::vector<Eigen::Vector3d>& view_gains, int gauge_view) {
+  json views = json::array();
+  for (size_t v = 0; v < view_gains.size(); ++v) {
+    const Eigen::Vector3d& g = view_gains[v];
+    views.push_back({{"view", v},
+                     {"image", v < dataset.views.size() ? dataset.views[v].image : ""},
+                     {"gains", {g[0], g[1], g[2]}}});
+  }
+  const json j = {{"format", "sft-exposure/1"}, {"gauge_view", gauge_view}, {"views", views}};
+  return WriteTextFile(JoinPath(out, "exposure.json"), j.dump(1) + "\n");
 }
 
 Status WriteMetrics(const std::string& out, const std::vector<IterationRecord>& records,

@@ -13,7 +13,9 @@
 //   initial_mesh.ply            the run's starting mesh;
 //   baseline_mesh.ply           the mesh after the last topology change: folded faces are
 //                               counted against it;
-//   stages/NN_NAME_normals.png  the normals of the first fitted view after each stage.
+//   stages/NN_NAME_normals.png  the normals of the first fitted view after each stage;
+//   exposure.json               when a stage fits exposure: the gains per dataset view (format
+//                               sft-exposure/1, WriteExposure).
 // A checkpoint is written after every outer iteration and when the run is interrupted.
 #ifndef SFT_OPTIM_RUN_OUTPUTS_H_
 #define SFT_OPTIM_RUN_OUTPUTS_H_
@@ -35,6 +37,8 @@ struct RunState {
   nlohmann::json stages = nlohmann::json::array();  // StageJson of every stage.
   ScheduleProgress progress;
   bool finished = false;  // every stage done.
+  // Exposure gains per dataset view ("exposure_gains"); empty when no stage fits them (all 1).
+  std::vector<Eigen::Vector3d> view_gains;
 
   std::string dataset() const { return run_info.value("dataset", ""); }
 };
@@ -48,6 +52,13 @@ Status WriteRunSnapshot(const std::string& out, const Dataset& dataset, const Tr
                         const Material& material, const std::vector<double>& light_scales);
 Status ReadRunSnapshot(const std::string& out, const Dataset& dataset, TriMesh* mesh,
                        Material* material, std::vector<double>* light_scales);
+
+// exposure.json: {"format": "sft-exposure/1", "gauge_view": G, "views": [{"view": i, "image":
+// its image path in the dataset, "gains": [R, G, B]}, ...]} for every dataset view; gains
+// multiply the rendered image to match the photograph, relative to the gauge view G (fixed; -1
+// when unknown). Views that were not fitted keep 1.
+Status WriteExposure(const std::string& out, const Dataset& dataset,
+                     const std::vector<Eigen::Vector3d>& view_gains, int gauge_view);
 
 // metrics.csv and metrics.json. `records` are all iterations so far (resumed runs included),
 // `extra` is merged into metrics.json's top level.

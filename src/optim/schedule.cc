@@ -123,7 +123,9 @@ Status Schedule::Start(const Dataset& dataset, const std::string& out,
 
 Status Schedule::Resume(const Dataset& dataset, const std::string& out,
                         const std::vector<StageOptions>& stages, const json& run_info,
-                        const ScheduleProgress& progress, std::unique_ptr<Schedule>* schedule) {
+                        const ScheduleProgress& progress,
+                        const std::vector<Eigen::Vector3d>& view_gains,
+                        std::unique_ptr<Schedule>* schedule) {
   std::unique_ptr<Schedule> s(new Schedule());
   s->dataset_ = &dataset;
   s->out_ = out;
@@ -142,6 +144,12 @@ Status Schedule::Resume(const Dataset& dataset, const std::string& out,
   }
   SFT_RETURN_IF_ERROR(ReadRunSnapshot(out, dataset, &s->current_.mesh, &s->current_.material,
                                       &s->current_.light_scales));
+  if (!view_gains.empty() && view_gains.size() != dataset.views.size()) {
+    return Status::Error(JoinPath(out, "state.json") +
+                         ": exposure_gains: " + std::to_string(view_gains.size()) +
+                         " views, the dataset has " + std::to_string(dataset.views.size()));
+  }
+  s->current_.view_gains = view_gains;
   const std::string baseline = JoinPath(out, kBaselineMesh);
   SFT_RETURN_IF_ERROR(
       ReadMesh(FileExists(baseline) ? baseline : JoinPath(out, "mesh.ply"), &s->baseline_));
@@ -175,7 +183,8 @@ double Schedule::Elapsed() const { return seconds_at_start_ + NowSeconds() - ses
 Status Schedule::CreateReconstruction() {
   const StageOptions& stage = stages_[progress_.stage];
   SFT_RETURN_IF_ERROR(Reconstruction::Create(*dataset_, current_.mesh, current_.material,
-                                             current_.light_scales, stage.fit, &reconstruction_));
+                                             current_.light_scales, stage.fit, &reconstruction_,
+                                             current_.view_gains));
   reconstruction_->elapsed_offset = Elapsed();
   reconstruction_stage_ = progress_.stage;
   phases_seen_ = 0;
@@ -210,6 +219,7 @@ void Schedule::SyncCurrent() {
   current_.mesh = reconstruction_->Mesh();
   current_.material = reconstruction_->CurrentMaterial();
   current_.light_scales = reconstruction_->LightScales();
+  current_.view_gains = reconstruction_->ViewGains();
 }
 
 Status Schedule::ChangeTopology(TopologyChange change, const ScheduleCallbacks& callbacks) {
@@ -321,7 +331,8 @@ Status Schedule::UntangleCurrent(const ScheduleCallbacks& callbacks, json* recor
                   report.moved_vertices, NowSeconds() - start);
     callbacks.on_event(line);
   }
-  return CreateReconstruction();
+  // Unchanged when no round improved on the input.
+  return report.faces_after < report.faces_before ? CreateReconstruction() : Status::Ok();
 }
 
 // metrics.json's per-outer entry: cost, time, faces, mesh quality against the baseline and the
@@ -456,6 +467,17 @@ Status Schedule::Checkpoint() {
   info["stages"] = stage_records_;
   SFT_RETURN_IF_ERROR(WriteMetrics(out_, records_, phase_records_, info));
   RunState state;
+  // Gains are part of the state once a stage fits them (or a resumed run brought some).
+  bool exposure = false;
+  for (const StageOptions& s : stages_) exposure = exposure || s.fit.fit_exposure;
+  for (const Eigen::Vector3d& g : current_.view_gains) {
+    exposure = exposure || g != Eigen::Vector3d::Ones();
+  }
+  if (exposure && !current_.view_gains.empty()) {
+    state.view_gains = current_.view_gains;
+    const int gauge = reconstruction_ ? reconstruction_->view_indices()[kExposureGaugeView] : -1;
+    SFT_RETURN_IF_ERROR(WriteExposure(out_, *dataset_, current_.view_gains, gauge));
+  }
   state.run_info = run_info_;
   for (const StageOptions& s : stages_) state.stages.push_back(StageJson(s));
   state.progress = progress_;

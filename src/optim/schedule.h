@@ -68,6 +68,8 @@ struct ScheduleStart {
   TriMesh mesh;
   Material material;
   std::vector<double> light_scales;  // empty = all 1.
+  // Exposure gains per dataset view (src/optim/parameters.h); empty = all 1.
+  std::vector<Eigen::Vector3d> view_gains;
 };
 
 struct ScheduleCallbacks {
@@ -88,10 +90,13 @@ class Schedule {
                       const std::vector<StageOptions>& stages, const ScheduleStart& start,
                       const nlohmann::json& run_info, std::unique_ptr<Schedule>* schedule);
   // Continues the run in `out` from its checkpoint. `stages` are the run's stages (as state.json
-  // records them, with any overrides applied; their count must match).
+  // records them, with any overrides applied; their count must match); `view_gains` the
+  // checkpoint's exposure gains (RunState::view_gains; empty = all 1).
   static Status Resume(const Dataset& dataset, const std::string& out,
                        const std::vector<StageOptions>& stages, const nlohmann::json& run_info,
-                       const ScheduleProgress& progress, std::unique_ptr<Schedule>* schedule);
+                       const ScheduleProgress& progress,
+                       const std::vector<Eigen::Vector3d>& view_gains,
+                       std::unique_ptr<Schedule>* schedule);
 
   // Runs the remaining stages; writes a checkpoint after every outer iteration and when stopped.
   Status Run(const ScheduleCallbacks& callbacks);
@@ -143,7 +148,7 @@ class Schedule {
   std::vector<StageOptions> stages_;
   nlohmann::json run_info_;
   ScheduleProgress progress_;
-  ScheduleStart current_;  // the state at the last sync (mesh, material, light scales).
+  ScheduleStart current_;  // the state at the last sync (mesh, material, light scales, gains).
   TriMesh baseline_;       // folded faces are counted against it (reset at topology changes).
   std::unique_ptr<Reconstruction> reconstruction_;
   int reconstruction_stage_ = 0;  // the stage reconstruction_ was created for.

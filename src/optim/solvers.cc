@@ -185,6 +185,12 @@ AdjointObjective::AdjointObjective(RenderCache* cache, SceneParameters* params,
   for (int i = 0; i < layout.size(); ++i) {
     if (cache->active().Includes(layout.KindOf(i))) active_.push_back(i);
   }
+  if (cache->active().exposure) {
+    for (int v = 0; v < params->num_gain_views(); ++v) {
+      if (!params->GainFitted(v)) continue;
+      for (int c = 0; c < 3; ++c) active_.push_back(params->GainIndex(v, c));
+    }
+  }
 }
 
 std::vector<double> AdjointObjective::Current() const {
@@ -220,7 +226,7 @@ bool AdjointObjective::EvaluateViews(const double* x, const std::vector<int>& vi
   for (int v : batch) *cost += scale * cache_->ViewImageCost(v);
   std::vector<double> full;
   if (gradient != nullptr) {
-    full.assign(params_->layout().size(), 0.0);
+    full.assign(params_->size(), 0.0);
     for (int v : batch) {
       if (!cache_->AddAdjointGradient(v, cache_->AdjointWeights(v), &full)) return false;
     }
@@ -369,9 +375,9 @@ void AdamUpdate(const AdamOptions& adam, const SceneParameters& params,
   for (size_t k = 0; k < g.size(); ++k) {
     const int i = index[k];
     const double v = static_cast<int>(k) < uniform_count ? uniform_v : state->v[i];
-    const double lr = params.layout().KindOf(i) == ParameterKind::kVertex
-                          ? adam.learning_rate_vertices
-                          : adam.learning_rate_material;
+    const bool vertex =
+        !params.IsExposure(i) && params.layout().KindOf(i) == ParameterKind::kVertex;
+    const double lr = vertex ? adam.learning_rate_vertices : adam.learning_rate_material;
     (*x)[k] -= lr * (state->m[i] / c1) / (std::sqrt(v / c2) + adam.epsilon);
   }
 }
@@ -416,8 +422,8 @@ Status RunAdam(const SolverOptions& options, const ProblemOptions& problem_optio
     SFT_RETURN_IF_ERROR(
         LargeSteps::Create(vertex_neighbours, adam.large_steps_lambda, &large_steps));
   }
-  PrepareAdamState(params->layout().size(), vertex_count,
-                   large_steps ? adam.large_steps_lambda : 0.0, state);
+  PrepareAdamState(params->size(), vertex_count, large_steps ? adam.large_steps_lambda : 0.0,
+                   state);
   std::vector<double> x = objective.Current(), gradient(n), y(n);
   const std::vector<int>& index = objective.active_indices();
   const int uniform_count = adam.uniform_vertices ? vertex_count : 0;

@@ -1,6 +1,7 @@
 // Local untangling (src/init/untangle.h): a vertex pushed through a sphere's far side comes back
 // to a surface without self-intersections, moving only the vertices near the tangle; a clean
-// surface is left exactly as it was; the two spheres that cross broadly are beyond its reach.
+// surface is left exactly as it was; two spheres that cross broadly are beyond its reach, and
+// the repair never leaves more intersections than it found.
 #include "src/init/untangle.h"
 
 #include <gtest/gtest.h>
@@ -59,6 +60,31 @@ TEST(UntangleTest, CleanSurfaceIsUnchanged) {
   for (int v = 0; v < static_cast<int>(mesh.n_vertices()); ++v) {
     const TriMesh::Point q = mesh.point(mesh.vertex_handle(v));
     EXPECT_EQ(Eigen::Vector3d(q[0], q[1], q[2]), triangles.positions[v]);
+  }
+}
+
+// Two spheres that cross along a whole circle: smoothing cannot separate them. The result is
+// never worse than the input, and when no round improves on it the input comes back unchanged.
+TEST(UntangleTest, BroadCrossingIsNeverMadeWorse) {
+  testing::Triangles one = testing::ReadTestMesh("icosphere_r1_320f.obj");
+  testing::Triangles two = one;
+  for (Eigen::Vector3d& p : two.positions) p += Eigen::Vector3d(1.0, 0.0, 0.0);
+  testing::Triangles both = one;
+  both.Append(two);
+  TriMesh mesh;
+  ASSERT_TRUE(ArraysToTriMesh(both.positions, both.faces, &mesh).ok());
+  UntangleReport report;
+  ASSERT_TRUE(Untangle(UntangleOptions(), &mesh, &report).ok());
+  EXPECT_GT(report.faces_before, 20);
+  EXPECT_GT(report.faces_after, 0);
+  EXPECT_LE(report.faces_after, report.faces_before);
+  EXPECT_EQ(CountSelfIntersectingFaces(mesh), report.faces_after);
+  if (report.faces_after == report.faces_before) {
+    EXPECT_EQ(report.moved_vertices, 0);
+    for (int v = 0; v < static_cast<int>(mesh.n_vertices()); ++v) {
+      const TriMesh::Point q = mesh.point(mesh.vertex_handle(v));
+      EXPECT_EQ(Eigen::Vector3d(q[0], q[1], q[2]), both.positions[v]);
+    }
   }
 }
 

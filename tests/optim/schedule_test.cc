@@ -379,9 +379,9 @@ TEST_F(ScheduleRunTest, StagesRunInOrderWithCheckpoints) {
 
   // Resuming a finished run runs nothing and keeps the records.
   std::unique_ptr<Schedule> resumed;
-  ASSERT_TRUE(
-      Schedule::Resume(dataset_, out.Join("r"), stages, state.run_info, state.progress, &resumed)
-          .ok());
+  ASSERT_TRUE(Schedule::Resume(dataset_, out.Join("r"), stages, state.run_info, state.progress,
+                               state.view_gains, &resumed)
+                  .ok());
   int iterations = 0;
   callbacks.on_iteration = [&](const IterationRecord&) { return ++iterations > 0; };
   ASSERT_TRUE(resumed->Run(callbacks).ok());
@@ -417,9 +417,9 @@ TEST_F(ScheduleRunTest, StopAndResumeMidStage) {
   EXPECT_FALSE(state.finished);
 
   std::unique_ptr<Schedule> resumed;
-  ASSERT_TRUE(
-      Schedule::Resume(dataset_, out.Join("r"), stages, state.run_info, state.progress, &resumed)
-          .ok());
+  ASSERT_TRUE(Schedule::Resume(dataset_, out.Join("r"), stages, state.run_info, state.progress,
+                               state.view_gains, &resumed)
+                  .ok());
   std::vector<int> outers;
   callbacks.on_iteration = [&](const IterationRecord& r) {
     outers.push_back(r.outer);
