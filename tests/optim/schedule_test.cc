@@ -488,8 +488,9 @@ TEST_F(ScheduleRunTest, AdamMomentsSurviveResume) {
     EXPECT_TRUE(ReadRunState(run, &state).ok());
     EXPECT_EQ(state.progress.outer_done, 1);
     std::unique_ptr<Schedule> resumed;
-    EXPECT_TRUE(
-        Schedule::Resume(dataset_, run, stages, state.run_info, state.progress, &resumed).ok());
+    EXPECT_TRUE(Schedule::Resume(dataset_, run, stages, state.run_info, state.progress,
+                                 state.view_gains, &resumed)
+                    .ok());
     ScheduleCallbacks callbacks;
     callbacks.on_event = [&](const std::string& line) { events->push_back(line); };
     EXPECT_TRUE(resumed->Run(callbacks).ok());
@@ -533,24 +534,24 @@ TEST_F(ScheduleRunTest, BrokenAdamStateIsReported) {
   ASSERT_TRUE(found);
 
   std::filesystem::resize_file(file, size - 8);
-  Status status =
-      Schedule::Resume(dataset_, out.Join("r"), more, state.run_info, state.progress, &resumed);
+  Status status = Schedule::Resume(dataset_, out.Join("r"), more, state.run_info, state.progress,
+                                   state.view_gains, &resumed);
   ASSERT_FALSE(status.ok());
   EXPECT_THAT(status.message(), HasSubstr(file + ": truncated or corrupt"));
   EXPECT_THAT(status.message(), HasSubstr("need " + std::to_string(size) + ")"));
   EXPECT_EQ(status.message().find('\n'), std::string::npos);
   std::filesystem::resize_file(file, 20);
-  status =
-      Schedule::Resume(dataset_, out.Join("r"), more, state.run_info, state.progress, &resumed);
+  status = Schedule::Resume(dataset_, out.Join("r"), more, state.run_info, state.progress,
+                            state.view_gains, &resumed);
   ASSERT_FALSE(status.ok());
   EXPECT_THAT(status.message(), HasSubstr(file + ": not an sft Adam state"));
 
   saved.state.m.pop_back();
   saved.state.v.pop_back();
   ASSERT_TRUE(WriteAdamCheckpoint(out.Join("r"), saved).ok());
-  ASSERT_TRUE(
-      Schedule::Resume(dataset_, out.Join("r"), more, state.run_info, state.progress, &resumed)
-          .ok());
+  ASSERT_TRUE(Schedule::Resume(dataset_, out.Join("r"), more, state.run_info, state.progress,
+                               state.view_gains, &resumed)
+                  .ok());
   std::vector<std::string> events;
   ScheduleCallbacks callbacks;
   callbacks.on_event = [&](const std::string& line) { events.push_back(line); };
