@@ -10,7 +10,8 @@ ParameterKind ParameterLayout::KindOf(int index) const {
   if (index < RoughnessOffset()) return ParameterKind::kAlbedo;
   if (index < SpecularIndex()) return ParameterKind::kRoughness;
   if (index == SpecularIndex()) return ParameterKind::kSpecular;
-  return ParameterKind::kLight;
+  if (index < EnvironmentOffset()) return ParameterKind::kLight;
+  return ParameterKind::kEnvironment;
 }
 
 std::string ParameterLayout::Describe(int index) const {
@@ -29,6 +30,10 @@ std::string ParameterLayout::Describe(int index) const {
       return "specular";
     case ParameterKind::kLight:
       return "light[" + std::to_string(index - LightOffset()) + "]";
+    case ParameterKind::kEnvironment: {
+      const int local = index - EnvironmentOffset();
+      return "environment[" + std::to_string(local / 3) + "]." + kChannel[local % 3];
+    }
   }
   return "?";
 }
@@ -44,6 +49,8 @@ bool ParameterKindFromName(const std::string& name, ParameterKind* kind) {
     *kind = ParameterKind::kSpecular;
   else if (name == "light")
     *kind = ParameterKind::kLight;
+  else if (name == "environment")
+    *kind = ParameterKind::kEnvironment;
   else
     return false;
   return true;
@@ -61,6 +68,8 @@ const char* ParameterKindName(ParameterKind kind) {
       return "specular";
     case ParameterKind::kLight:
       return "light";
+    case ParameterKind::kEnvironment:
+      return "environment";
   }
   return "?";
 }
@@ -72,6 +81,7 @@ ParameterSelection ParameterSelection::Only(ParameterKind kind) {
   s.roughness = kind == ParameterKind::kRoughness;
   s.specular = kind == ParameterKind::kSpecular;
   s.lights = kind == ParameterKind::kLight;
+  s.environment = kind == ParameterKind::kEnvironment;
   return s;
 }
 
@@ -87,6 +97,8 @@ bool ParameterSelection::Selected(ParameterKind kind) const {
       return specular;
     case ParameterKind::kLight:
       return lights;
+    case ParameterKind::kEnvironment:
+      return environment;
   }
   return false;
 }

@@ -69,29 +69,39 @@
 
 namespace sft {
 
-enum class ParameterKind { kVertex, kAlbedo, kRoughness, kSpecular, kLight };
+enum class ParameterKind { kVertex, kAlbedo, kRoughness, kSpecular, kLight, kEnvironment };
 
 struct ParameterLayout {
   int num_vertices = 0;
   int num_albedo_texels = 0;
   int num_roughness_texels = 0;
   int num_lights = 0;
+  // A fitted environment (lighting as parameters): the texels (RGB, linear radiance before the
+  // map's scale and the light's scale parameter) of dataset light `environment_light`'s map, in
+  // the map's order y·width + x. 0 texels: no environment parameters.
+  int num_environment_texels = 0;
+  int environment_light = -1;
 
   // Index ranges, in this order: vertex v coordinate k at 3v + k; albedo texel t channel c;
-  // roughness texel t; the specular weight; light l's scale.
+  // roughness texel t; the specular weight; light l's scale; environment texel t channel c.
   int VertexOffset() const { return 0; }
   int AlbedoOffset() const { return 3 * num_vertices; }
   int RoughnessOffset() const { return AlbedoOffset() + 3 * num_albedo_texels; }
   int SpecularIndex() const { return RoughnessOffset() + num_roughness_texels; }
   int LightOffset() const { return SpecularIndex() + 1; }
-  int size() const { return LightOffset() + num_lights; }
+  int EnvironmentOffset() const { return LightOffset() + num_lights; }
+  int size() const { return EnvironmentOffset() + 3 * num_environment_texels; }
+  // Whether dataset light `light`'s environment texels are parameters.
+  bool FitsEnvironment(int light) const {
+    return num_environment_texels > 0 && light >= 0 && light == environment_light;
+  }
 
   ParameterKind KindOf(int index) const;
-  // "vertex[12].y", "albedo[40].g", "roughness[3]", "specular", "light[0]".
+  // "vertex[12].y", "albedo[40].g", "roughness[3]", "specular", "light[0]", "environment[7].b".
   std::string Describe(int index) const;
 };
 
-// "vertices", "albedo", "roughness", "specular", "light" (the names of `--param`).
+// "vertices", "albedo", "roughness", "specular", "light", "environment" (the names of `--param`).
 bool ParameterKindFromName(const std::string& name, ParameterKind* kind);
 const char* ParameterKindName(ParameterKind kind);
 
@@ -102,6 +112,7 @@ struct ParameterSelection {
   bool roughness = true;
   bool specular = true;
   bool lights = true;
+  bool environment = true;  // fitted environment texels (when the layout has them).
 
   static ParameterSelection Only(ParameterKind kind);
   bool Selected(ParameterKind kind) const;

@@ -27,7 +27,7 @@ double InvertLinear(double a, double b, double u) {
 
 EnvironmentMap::EnvironmentMap(const Image& rgb, const Eigen::Matrix3d& world_from_env,
                                double scale)
-    : width_(rgb.width), height_(rgb.height), world_from_env_(world_from_env) {
+    : width_(rgb.width), height_(rgb.height), world_from_env_(world_from_env), scale_(scale) {
   texels_.resize(static_cast<size_t>(width_) * height_);
   value_.resize(texels_.size());
   for (int y = 0; y < height_; ++y) {
@@ -134,6 +134,25 @@ Eigen::Vector3d EnvironmentMap::Radiance(const Eigen::Vector3d& dir) const {
   // A zero or non-finite direction is no ray (Camera::CamFromImage past a distortion's fold).
   if (!(dir.squaredNorm() > 0.0) || !dir.allFinite()) return Eigen::Vector3d::Zero();
   return Interpolate(CellOfDirection(dir));
+}
+
+void EnvironmentMap::TexelWeights(const Eigen::Vector3d& dir, int texel[4],
+                                  double weight[4]) const {
+  if (!(dir.squaredNorm() > 0.0) || !dir.allFinite()) {
+    for (int k = 0; k < 4; ++k) texel[k] = 0, weight[k] = 0.0;
+    return;
+  }
+  const CellPoint p = CellOfDirection(dir);
+  const Band& band = bands_[p.j];
+  const int i1 = p.i + 1 == width_ ? 0 : p.i + 1;
+  texel[0] = band.row0 * width_ + p.i;
+  texel[1] = band.row0 * width_ + i1;
+  texel[2] = band.row1 * width_ + p.i;
+  texel[3] = band.row1 * width_ + i1;
+  weight[0] = (1.0 - p.t) * (1.0 - p.s);
+  weight[1] = (1.0 - p.t) * p.s;
+  weight[2] = p.t * (1.0 - p.s);
+  weight[3] = p.t * p.s;
 }
 
 bool EnvironmentMap::Sample(double u1, double u2, Eigen::Vector3d* dir, Eigen::Vector3d* radiance,

@@ -41,6 +41,15 @@ class EnvironmentMap {
   // Solid-angle pdf of Sample() producing world direction `dir`.
   double Pdf(const Eigen::Vector3d& dir) const;
 
+  // The texels whose bilinear blend is the radiance along world direction `dir` (unit), and their
+  // weights: Radiance(dir) = scale · Σ_k weight[k] · max(0, texel[k]'s value), texel index
+  // y·width + x. Always 4 entries (at the poles the top or bottom pair repeats one row, weights
+  // summing to 1); all weights 0 for a zero or non-finite `dir`. The derivative of the radiance
+  // with respect to a non-negative texel value is scale · weight (fitted environments,
+  // ParameterKind::kEnvironment).
+  void TexelWeights(const Eigen::Vector3d& dir, int texel[4], double weight[4]) const;
+  double scale() const { return scale_; }
+
   // Mean radiance over the sphere (solid-angle weighted, of the interpolated map), for tests and
   // planning.
   Eigen::Vector3d MeanRadiance() const;
@@ -80,6 +89,7 @@ class EnvironmentMap {
   std::vector<double> value_;            // f = mean of RGB per texel.
   std::vector<Band> bands_;              // H + 1 bands.
   Eigen::Matrix3d world_from_env_;
+  double scale_ = 1.0;
   std::vector<double> band_cdf_;    // H + 2 entries, normalized.
   std::vector<double> column_cdf_;  // H + 1 bands of W + 1 entries, normalized per band.
   double total_weight_ = 0.0;       // Σ CellWeight.

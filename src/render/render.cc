@@ -214,6 +214,9 @@ void RenderImpl(const RenderScene& scene, const Material& material, const ViewSe
                     view,
                     options,
                     environment,
+                    environment != nullptr && options.sampling_environment != nullptr
+                        ? options.sampling_environment
+                        : environment,
                     max_segments,
                     options.effects.specular ? 1.0 : 0.0,
                     request,
@@ -302,9 +305,24 @@ void RenderViewWithDerivatives(const RenderScene& scene, const Material& materia
                                const ViewSetup& view, const RenderOptions& options,
                                const DerivativeRequest& request, int num_lights, Image* image,
                                DerivativeOutput* output, RenderStats* stats) {
+  RenderViewWithDerivatives(scene, material, view, options, request,
+                            MakeParameterLayout(scene, material, num_lights), image, output, stats);
+}
+
+void RenderViewWithDerivatives(const RenderScene& scene, const Material& material,
+                               const ViewSetup& view, const RenderOptions& options,
+                               const DerivativeRequest& request, const ParameterLayout& layout,
+                               Image* image, DerivativeOutput* output, RenderStats* stats) {
   std::string why;
   CHECK(request.Check(&why)) << why;
-  const ParameterLayout layout = MakeParameterLayout(scene, material, num_lights);
+  const ParameterLayout base = MakeParameterLayout(scene, material, layout.num_lights);
+  CHECK(base.num_vertices == layout.num_vertices &&
+        base.num_albedo_texels == layout.num_albedo_texels &&
+        base.num_roughness_texels == layout.num_roughness_texels)
+      << "parameter layout does not match the scene and material";
+  if (layout.FitsEnvironment(view.environment_light_index) && view.environment != nullptr) {
+    CHECK_EQ(view.environment->width() * view.environment->height(), layout.num_environment_texels);
+  }
   RenderImpl(scene, material, view, options, &request, &layout, image, output, stats);
 }
 

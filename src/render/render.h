@@ -67,6 +67,11 @@ struct RenderOptions {
   // materials then follow identical paths, as finite differences and linearizations need. Must
   // have the rendered material's mesh-colors layout.
   const Material* sampling_material = nullptr;
+  // Not owned. The same for the environment: when set (and the view has an environment), light-
+  // sampled directions and the environment's pdfs (MIS weights) come from this map while radiance
+  // comes from the view's, so renders of nearby fitted environments follow identical paths. Must
+  // have the view environment's frame; its size may differ.
+  const EnvironmentMap* sampling_environment = nullptr;
   // Called once per finished tile of camera samples (RenderTileCount per view), from the worker
   // threads (so it must be thread-safe), e.g. to advance a progress line within a long view. It
   // does not change the image.
@@ -169,6 +174,14 @@ void RenderViewWithDerivatives(const RenderScene& scene, const Material& materia
                                const ViewSetup& view, const RenderOptions& options,
                                const DerivativeRequest& request, int num_lights, Image* image,
                                DerivativeOutput* output, RenderStats* stats = nullptr);
+// The same with the index space given: MakeParameterLayout's plus, for a fitted environment,
+// `num_environment_texels` and `environment_light` (the view's environment must then be that
+// light's map, of that many texels, wherever the view uses it).
+void RenderViewWithDerivatives(const RenderScene& scene, const Material& material,
+                               const ViewSetup& view, const RenderOptions& options,
+                               const DerivativeRequest& request, const ParameterLayout& layout,
+                               Image* image, DerivativeOutput* output,
+                               RenderStats* stats = nullptr);
 
 }  // namespace sft
 

@@ -1,5 +1,6 @@
 // Derivatives of rendered images with respect to albedo texels, roughness texels, the specular
-// weight and light intensity scales, against central finite differences (issue 3).
+// weight, light intensity scales and fitted environment texels, against central finite
+// differences (issue 3; environment texels issue 22).
 //
 // The finite differences render θ ± h·δ with the same seeds and with detached sampling
 // (RenderOptions::sampling_material = the material at θ), so both renders follow exactly the same
@@ -7,7 +8,8 @@
 // differentiates. These parameters move no geometry, so there are no visibility discontinuities,
 // and the estimator is a smooth function of them: the only errors are the O(h²) truncation of the
 // central difference and float32 storage (images and Jacobian entries, ~6e-8 relative, divided by
-// 2h). Tolerance: 2e-3 relative L2 error over the image. Measured: ≲ 1.2e-4 for albedo,
+// 2h); environment texels enter linearly too, their importance sampling detached like the
+// material's. Tolerance: 2e-3 relative L2 error over the image. Measured: ≲ 1.2e-4 for albedo,
 // specular and light scales (h = 1e-3); up to ~1e-3 for roughness, whose small steps (h = 1e-3·r,
 // needed at r = 0.05 where D changes on the scale of α = r²) make float32 rounding of the images
 // the dominant error.
@@ -97,6 +99,10 @@ TEST_P(DerivativesTest, MatchesCentralDifferences) {
   const Material base = RandomMaterial(faces, c.roughness, c.specular, c.fresnel);
   const double light_scale_base = 1.0;
   std::unique_ptr<EnvironmentMap> env;
+  // Environment texels: the perturbed renders sample directions from the map at θ (detached
+  // sampling, RenderOptions::sampling_environment), as the material's.
+  const EnvironmentMap sampling_env(fx.env_image, Eigen::Matrix3d::Identity(), 1.0);
+  Image env_image = fx.env_image;
   auto make_view = [&](double point_scale, double env_scale) {
     ViewSetup view = fx.view;
     if (c.point_light) {
@@ -107,9 +113,10 @@ TEST_P(DerivativesTest, MatchesCentralDifferences) {
       view.point_lights.push_back(light);
     }
     if (c.environment) {
-      env = std::make_unique<EnvironmentMap>(fx.env_image, Eigen::Matrix3d::Identity(), env_scale);
+      env = std::make_unique<EnvironmentMap>(env_image, Eigen::Matrix3d::Identity(), env_scale);
       view.environment = env.get();
       view.environment_light_index = 1;
+      view.environment_background = c.kind == ParameterKind::kEnvironment;
     }
     return view;
   };
@@ -120,6 +127,7 @@ TEST_P(DerivativesTest, MatchesCentralDifferences) {
   options.effects.shadows = c.shadows;
   options.seed = 3;
   options.sampling_material = &base;
+  if (c.environment) options.sampling_environment = &sampling_env;
 
   // Direction δ: random over the selected kind.
   std::mt19937 rng(11);
@@ -129,6 +137,10 @@ TEST_P(DerivativesTest, MatchesCentralDifferences) {
   layout.num_albedo_texels = base.albedo.num_texels();
   layout.num_roughness_texels = base.roughness.num_texels();
   layout.num_lights = 2;
+  if (c.kind == ParameterKind::kEnvironment) {
+    layout.num_environment_texels = fx.env_image.width * fx.env_image.height;
+    layout.environment_light = 1;
+  }
   std::vector<double> delta(layout.size(), 0.0);
   for (int i = 0; i < layout.size(); ++i) {
     if (layout.KindOf(i) == c.kind) delta[i] = u(rng);
@@ -146,6 +158,13 @@ TEST_P(DerivativesTest, MatchesCentralDifferences) {
       m.roughness.values()[t] += sign * h * delta[layout.RoughnessOffset() + t];
     }
     m.specular += sign * h * delta[layout.SpecularIndex()];
+    env_image = fx.env_image;
+    for (int t = 0; t < layout.num_environment_texels; ++t) {
+      for (int k = 0; k < 3; ++k) {
+        env_image.at(t % env_image.width, t / env_image.width, k) +=
+            static_cast<float>(sign * h * delta[layout.EnvironmentOffset() + 3 * t + k]);
+      }
+    }
     const ViewSetup view = make_view(light_scale_base + sign * h * delta[layout.LightOffset()],
                                      light_scale_base + sign * h * delta[layout.LightOffset() + 1]);
     Image image;
@@ -154,6 +173,7 @@ TEST_P(DerivativesTest, MatchesCentralDifferences) {
   };
   const Image plus = perturbed_render(+1.0);
   const Image minus = perturbed_render(-1.0);
+  env_image = fx.env_image;
 
   // Analytic: rows and adjoint from one render at θ.
   const ViewSetup view = make_view(1.0, 1.0);
@@ -165,7 +185,7 @@ TEST_P(DerivativesTest, MatchesCentralDifferences) {
   request.adjoint_weights = &weights;
   Image image, reference;
   DerivativeOutput out;
-  RenderViewWithDerivatives(*fx.scene, base, view, options, request, 2, &image, &out);
+  RenderViewWithDerivatives(*fx.scene, base, view, options, request, layout, &image, &out);
   RenderView(*fx.scene, base, view, options, &reference);
   EXPECT_EQ(image.data, reference.data) << "derivative pass changed the image";
 
@@ -213,7 +233,12 @@ INSTANTIATE_TEST_SUITE_P(
         Case{"specular_schlick", ParameterKind::kSpecular, 2, true, true, false, 0.3, 0.4,
              FresnelMode::kSchlick},
         Case{"light_point_2_bounces", ParameterKind::kLight, 2, true, true, false, 0.3, 0.3},
-        Case{"light_env_and_point", ParameterKind::kLight, 2, true, true, true, 0.3, 0.3}),
+        Case{"light_env_and_point", ParameterKind::kLight, 2, true, true, true, 0.3, 0.3},
+        // Environment texels: light- and BSDF-sampled (MIS), through two bounces, and the
+        // background the camera sees; without shadows light sampling alone.
+        Case{"environment_2_bounces", ParameterKind::kEnvironment, 2, true, true, true, 0.3, 0.4},
+        Case{"environment_no_shadows", ParameterKind::kEnvironment, 1, false, false, true, 0.5,
+             0.3}),
     [](const ::testing::TestParamInfo<Case>& info) {
       std::string name = info.param.name;
       for (char& ch : name) {

@@ -75,8 +75,9 @@ struct JumpScene {
   }
 
   Context MakeContext() const {
-    return Context{scene,           material, material, view,    options, &environment,
-                   options.bounces, 1.0,      nullptr,  nullptr, nullptr};
+    return Context{scene,        material,     material,        view, options,
+                   &environment, &environment, options.bounces, 1.0,  nullptr,
+                   nullptr,      nullptr,      nullptr};
   }
 
   Eigen::Vector3d Eye() const { return view.cam_from_world.Inverse().translation; }

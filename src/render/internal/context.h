@@ -27,6 +27,9 @@ struct Context {
   const ViewSetup& view;
   const RenderOptions& options;
   const EnvironmentMap* environment;  // null when absent or disabled.
+  // Directions and pdfs of environment sampling: `environment`, or RenderOptions'
+  // sampling_environment (detached sampling); null exactly when `environment` is.
+  const EnvironmentMap* sampling_environment;
   int max_segments;
   double specular_scale;
   // Derivatives (null request: none).

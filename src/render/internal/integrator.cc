@@ -95,6 +95,19 @@ void AddPointLights(const Context& ctx, const PathVertex& v, PathState* state) {
   }
 }
 
+// Fills `term`'s fitted-environment texels along wi when the path takes derivatives of them:
+// `factor` multiplies the map's radiance in term.q (light scale, MIS weight, 1/pdf).
+void SetEnvironmentTexels(const Context& ctx, const Eigen::Vector3d& wi, double factor,
+                          const PathState& state, LightTerm* term) {
+  if (state.path == nullptr || !ctx.request->params.environment ||
+      !ctx.layout->FitsEnvironment(ctx.view.environment_light_index)) {
+    return;
+  }
+  ctx.environment->TexelWeights(wi, term->env_texel, term->env_weight);
+  for (double& w : term->env_weight) w *= factor * ctx.environment->scale();
+  term->env_count = 4;
+}
+
 // Light-sampled environment term (MIS against BSDF sampling when shadows are on).
 void AddEnvironmentLight(const Context& ctx, const PathVertex& v, Sampler* sampler,
                          PathState* state) {
@@ -102,7 +115,8 @@ void AddEnvironmentLight(const Context& ctx, const PathVertex& v, Sampler* sampl
   double pdf_light = 0.0;
   double u1, u2;
   sampler->Next2D(&u1, &u2);
-  if (!ctx.environment->Sample(u1, u2, &wi, &le, &pdf_light)) return;
+  if (!ctx.sampling_environment->Sample(u1, u2, &wi, &le, &pdf_light)) return;
+  if (ctx.sampling_environment != ctx.environment) le = ctx.environment->Radiance(wi);
   const Eigen::Vector3d& n = v.sp.n;
   const double cos_i = n.dot(wi);
   if (!(cos_i > 0.0)) return;
@@ -119,9 +133,11 @@ void AddEnvironmentLight(const Context& ctx, const PathVertex& v, Sampler* sampl
                             ? PowerHeuristic(pdf_light, BsdfPdf(v.sampling, n, v.sp.wo, wi))
                             : 1.0;
   LightTerm term;
-  term.q = le * (ctx.view.environment_scale * weight / pdf_light);
+  const double factor = ctx.view.environment_scale * weight / pdf_light;
+  term.q = le * factor;
   term.c = cos_i;
   term.dc_dn = wi;
+  SetEnvironmentTexels(ctx, wi, factor, *state, &term);
   Contribute(v, wi, f, term, ctx.view.environment_light_index, state);
 }
 
@@ -172,11 +188,13 @@ bool ApplyScatter(const Context& ctx, const PathVertex& v, const ScatterSample& 
   const Eigen::Vector3d f = v.detached ? EvalBsdf(v.surface.params, n, v.sp.wo, wi) : s.bsdf.f;
   if (!s.next.hit) {
     if (BsdfLightsEnvironment(ctx, v)) {
-      const double weight = PowerHeuristic(s.bsdf.pdf, ctx.environment->Pdf(wi));
+      const double weight = PowerHeuristic(s.bsdf.pdf, ctx.sampling_environment->Pdf(wi));
       LightTerm term;
-      term.q = ctx.environment->Radiance(wi) * (ctx.view.environment_scale * weight / s.bsdf.pdf);
+      const double factor = ctx.view.environment_scale * weight / s.bsdf.pdf;
+      term.q = ctx.environment->Radiance(wi) * factor;
       term.c = n.dot(wi);
       term.dc_dn = wi;
+      SetEnvironmentTexels(ctx, wi, factor, *state, &term);
       Contribute(v, wi, f, term, ctx.view.environment_light_index, state);
     }
     return false;
@@ -227,6 +245,14 @@ Eigen::Vector3d Background(const Context& ctx, const Eigen::Vector3d& dir, PathD
   const Eigen::Vector3d radiance = ctx.view.environment_scale * ctx.environment->Radiance(dir);
   if (path != nullptr && ctx.request->params.lights && ctx.view.environment_light_index >= 0) {
     path->Add(ctx.layout->LightOffset() + ctx.view.environment_light_index, radiance);
+  }
+  if (path != nullptr && ctx.request->params.environment &&
+      ctx.layout->FitsEnvironment(ctx.view.environment_light_index)) {
+    int texel[4];
+    double weight[4];
+    ctx.environment->TexelWeights(dir, texel, weight);
+    const double factor = ctx.view.environment_scale * ctx.environment->scale();
+    path->AddEnvironmentTexels(texel, weight, 4, Eigen::Vector3d::Constant(factor));
   }
   return radiance;
 }

@@ -41,6 +41,11 @@ void PathDerivatives::AddContribution(const Eigen::Vector3d& prefix, const Surfa
   if (ctx_.request->params.lights && light_index >= 0) {
     Add(ctx_.layout->LightOffset() + light_index, contribution);
   }
+  if (light.env_count > 0) {
+    // ∂C_c/∂T_kc = prefix_c·f_c·c·env_weight[k]: each texel channel reaches its own channel.
+    const Eigen::Vector3d base = prefix.cwiseProduct(f) * light.c;
+    AddEnvironmentTexels(light.env_texel, light.env_weight, light.env_count, base);
+  }
   if (!vertices_) return;
   // ∂(f ⊙ q·c) = (f ⊙ q)·∂c + c·q·∂g, g the glossy term (the diffuse term is constant).
   Eigen::Vector3d dg_dn, dg_dwi;
@@ -67,6 +72,19 @@ void PathDerivatives::AddContribution(const Eigen::Vector3d& prefix, const Surfa
     scratch_.clear();
     MapSlide(prefix.cwiseProduct(q).asDiagonal() * MaterialSlide(surface, d), &scratch_);
     AddVertices(scratch_);
+  }
+}
+
+void PathDerivatives::AddEnvironmentTexels(const int* texel, const double* weight, int count,
+                                           const Eigen::Vector3d& base) {
+  const int offset = ctx_.layout->EnvironmentOffset();
+  for (int k = 0; k < count; ++k) {
+    if (weight[k] == 0.0) continue;
+    for (int c = 0; c < 3; ++c) {
+      Eigen::Vector3d v = Eigen::Vector3d::Zero();
+      v[c] = base[c] * weight[k];
+      Add(offset + 3 * texel[k] + c, v);
+    }
   }
 }
 

@@ -125,6 +125,12 @@ struct LightTerm {
   bool follows_point = false;                        // point light: the next three are set.
   Eigen::Vector3d dc_dx = Eigen::Vector3d::Zero();   // ∂c/∂x = (3(n·wi)wi − n)/d³.
   Eigen::Matrix3d dwi_dx = Eigen::Matrix3d::Zero();  // ∂wi/∂x = −(I − wi wiᵀ)/d.
+  // A fitted environment's term (ParameterLayout::FitsEnvironment): q's channel c is
+  // Σ_k env_weight[k]·T_kc over the env_count texels T_k it blends, so ∂q_c/∂T_kc = env_weight[k]
+  // (the bilinear weight times the map's and the light's scales, the MIS weight and 1/pdf).
+  int env_count = 0;
+  int env_texel[4] = {0, 0, 0, 0};
+  double env_weight[4] = {0.0, 0.0, 0.0, 0.0};
 };
 
 // Bookkeeping of one path's derivatives. A path's light contributions have the form
@@ -155,6 +161,11 @@ class PathDerivatives {
 
   // Adds one derivative term of the path: ∂(path's radiance)/∂(parameter `param`).
   void Add(int param, const Eigen::Vector3d& d) { pending_.emplace_back(param, d); }
+
+  // Adds base_c·weight[k] to environment texel texel[k]'s channel c, for each k < count: the
+  // terms of a fitted environment's radiance Σ_k weight[k]·T_k seen with factor `base`.
+  void AddEnvironmentTexels(const int* texel, const double* weight, int count,
+                            const Eigen::Vector3d& base);
 
   // Whether every term added since Reset is finite.
   bool Finite() const {
