@@ -16,6 +16,7 @@
 #include "src/geometry/material.h"
 #include "src/geometry/mesh.h"
 #include "src/io/dataset.h"
+#include "src/optim/fitted_environment.h"
 #include "src/optim/run_outputs.h"
 #include "src/optim/schedule.h"
 #include "src/optim/schedule_config.h"
@@ -112,6 +113,19 @@ Status PrintSchedule(const std::vector<StageOptions>& stages) {
   return Status::Ok();
 }
 
+// Unknown lighting (no view lists lights) is estimated as a fitted environment
+// (src/optim/fitted_environment.h), said in one line; `run` is the resumed folder ("" fresh).
+Status UnknownLighting(const std::string& run, const ReconstructCommandOptions& cli,
+                       Dataset* dataset) {
+  std::string note;
+  SFT_RETURN_IF_ERROR(PrepareUnknownLighting(run, EnvironmentEstimateOptions(), dataset, &note));
+  if (!note.empty() && !cli.quiet) {
+    std::printf("%s\n", note.c_str());
+    std::fflush(stdout);  // before the progress lines on stderr.
+  }
+  return CheckViewsHaveLights(*dataset);
+}
+
 // Settles folders, stages and the schedule (fresh or resumed). Returns with *schedule null after
 // --print-schedule.
 Status PrepareSchedule(ReconstructCommandOptions* cli, Dataset* dataset,
@@ -131,8 +145,8 @@ Status PrepareSchedule(ReconstructCommandOptions* cli, Dataset* dataset,
     SFT_RETURN_IF_ERROR(ReadDataset(cli->dataset, dataset));
     SFT_RETURN_IF_ERROR(ResumedStages(*cli, state, &stages));
     if (cli->print_schedule) return PrintSchedule(stages);
-    SFT_RETURN_IF_ERROR(CheckViewsHaveLights(*dataset));
     SFT_RETURN_IF_ERROR(CheckOutputDirectory(cli->out, {{cli->dataset}, {}}, "--resume"));
+    SFT_RETURN_IF_ERROR(UnknownLighting(cli->resume, *cli, dataset));
     return Schedule::Resume(*dataset, cli->out, stages, state.run_info, state.progress,
                             state.view_gains, schedule);
   }
@@ -145,7 +159,6 @@ Status PrepareSchedule(ReconstructCommandOptions* cli, Dataset* dataset,
   ScheduleConfig config;
   SFT_RETURN_IF_ERROR(FreshStages(*cli, start, &config, &stages));
   if (cli->print_schedule) return PrintSchedule(stages);
-  SFT_RETURN_IF_ERROR(CheckViewsHaveLights(*dataset));
   const RunInputs inputs{{cli->dataset},
                          {start.path, MaterialFile(cli->material), cli->config, cli->reference}};
   SFT_RETURN_IF_ERROR(CheckOutputDirectory(cli->out, inputs, "--out"));
@@ -154,6 +167,7 @@ Status PrepareSchedule(ReconstructCommandOptions* cli, Dataset* dataset,
                          ": holds an earlier reconstruction (continue it with --resume " +
                          cli->out + ", or choose another folder)");
   }
+  SFT_RETURN_IF_ERROR(UnknownLighting("", *cli, dataset));
   ScheduleStart state;
   SFT_RETURN_IF_ERROR(LoadStartMesh(*dataset, start, InitialMeshOptions(), &state.mesh));
   SFT_RETURN_IF_ERROR(LoadMaterial(cli->material.empty() ? kInitialMaterial : cli->material,

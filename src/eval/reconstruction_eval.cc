@@ -15,6 +15,7 @@
 #include "src/io/image_io.h"
 #include "src/io/light_scales.h"
 #include "src/io/scene_setup.h"
+#include "src/optim/fitted_environment.h"
 #include "src/render/render.h"
 
 namespace sft {
@@ -130,6 +131,36 @@ Status PrepareRelight(const Dataset& dataset, const Truth& truth,
   return MakeRelightConditions(options.relight, dataset, BoundingBoxCentre(truth.mesh), conditions);
 }
 
+// One view's albedo pass, ours and the truth, kept until the gauge is known.
+struct AlbedoPair {
+  int view = 0;
+  Image ours, truth, mask;
+};
+
+// The per-channel factor s_c minimising Σ (s_c·o − t)² over the masked pixels (all pixels of a
+// view without a mask) of every view: the albedo's gauge when the lighting was estimated
+// (src/optim/fitted_environment.h). 1 for a channel that is black in ours.
+Eigen::Vector3d BestChannelScale(const std::vector<AlbedoPair>& pairs) {
+  Eigen::Vector3d to = Eigen::Vector3d::Zero(), oo = Eigen::Vector3d::Zero();
+  for (const AlbedoPair& p : pairs) {
+    for (int y = 0; y < p.ours.height; ++y) {
+      for (int x = 0; x < p.ours.width; ++x) {
+        if (!p.mask.empty() && !(p.mask.at(x, y, 0) > 0.5f)) continue;
+        for (int c = 0; c < 3; ++c) {
+          const double o = p.ours.at(x, y, c), t = p.truth.at(x, y, c);
+          to[c] += t * o;
+          oo[c] += o * o;
+        }
+      }
+    }
+  }
+  Eigen::Vector3d scale = Eigen::Vector3d::Ones();
+  for (int c = 0; c < 3; ++c) {
+    if (oo[c] > 0.0) scale[c] = to[c] / oo[c];
+  }
+  return scale;
+}
+
 }  // namespace
 
 Status EvaluateReconstruction(const std::string& dataset_dir, const std::string& reconstruction,
@@ -142,6 +173,19 @@ Status EvaluateReconstruction(const std::string& dataset_dir, const std::string&
   TriMesh mesh;
   Material material;
   SFT_RETURN_IF_ERROR(LoadReconstruction(reconstruction, options, &mesh, &material));
+  // Unknown lighting: the run's fitted environment (its environment.exr), before its light
+  // scales, which count that light.
+  const bool lighting_estimated = LightingUnknown(dataset);
+  if (lighting_estimated) {
+    if (!FileExists(JoinPath(reconstruction, kFittedEnvironmentFile))) {
+      return Status::Error(JoinPath(reconstruction, kFittedEnvironmentFile) +
+                           ": missing; the dataset's lighting is unknown and the run's fitted "
+                           "environment is needed to render it");
+    }
+    std::string note;
+    SFT_RETURN_IF_ERROR(
+        PrepareUnknownLighting(reconstruction, EnvironmentEstimateOptions(), &dataset, &note));
+  }
   const std::string lights = JoinPath(reconstruction, "lights.json");
   if (FileExists(lights)) {
     std::vector<double> scales;
@@ -171,6 +215,7 @@ Status EvaluateReconstruction(const std::string& dataset_dir, const std::string&
   RenderOptions roughness_pass = render;
   roughness_pass.pass = RenderPass::kRoughness;
   ViewScores full, albedo, roughness;
+  std::vector<AlbedoPair> albedo_pairs;
   for (int v : selected) {
     Image target, mask, ours;
     SFT_RETURN_IF_ERROR(LoadViewImage(dataset, v, &target));
@@ -182,7 +227,7 @@ Status EvaluateReconstruction(const std::string& dataset_dir, const std::string&
       SFT_RETURN_IF_ERROR(TruePass(dataset, v, albedo_folder, truth.scene.get(), &truth.material,
                                    views.views[v], albedo_pass, &true_pass));
       RenderView(scene, material, views.views[v], albedo_pass, &ours);
-      SFT_RETURN_IF_ERROR(albedo.Add(v, ToRgb(ours), true_pass, mask));
+      albedo_pairs.push_back({v, ToRgb(ours), ToRgb(true_pass), mask});
     }
     if (!roughness_folder.empty() || can_render_truth) {
       Image true_pass;
@@ -191,6 +236,16 @@ Status EvaluateReconstruction(const std::string& dataset_dir, const std::string&
       RenderView(scene, material, views.views[v], roughness_pass, &ours);
       SFT_RETURN_IF_ERROR(roughness.Add(v, ToRgb(ours), true_pass, mask));
     }
+  }
+  // With estimated lighting the albedo is known up to one factor per channel: scored after the
+  // best one.
+  const Eigen::Vector3d albedo_scale =
+      lighting_estimated ? BestChannelScale(albedo_pairs) : Eigen::Vector3d::Ones();
+  for (AlbedoPair& p : albedo_pairs) {
+    for (size_t i = 0; i < p.ours.data.size(); ++i) {
+      p.ours.data[i] *= static_cast<float>(albedo_scale[i % 3]);
+    }
+    SFT_RETURN_IF_ERROR(albedo.Add(p.view, p.ours, p.truth, p.mask));
   }
   json relight = nullptr;
   if (!conditions.empty()) {
@@ -218,6 +273,8 @@ Status EvaluateReconstruction(const std::string& dataset_dir, const std::string&
              {"definitions", ViewScoreDefinitions()},
              {"full", full.ToJson()},
              {"albedo", albedo.ToJson()},
+             {"lighting", lighting_estimated ? "estimated" : "given"},
+             {"albedo_scale", {albedo_scale[0], albedo_scale[1], albedo_scale[2]}},
              {"roughness", roughness.ToJson()},
              {"relight", relight}};
   return Status::Ok();

@@ -707,6 +707,10 @@ Status LoadProbe(const Dataset& dataset, int light_index, Image* rgb) {
   CHECK_LT(light_index, static_cast<int>(dataset.lights.size()));
   const LightSpec& light = dataset.lights[light_index];
   CHECK(light.type == LightType::kEnvironment) << "light " << light.id << " is not a probe";
+  if (!light.pixels.empty()) {
+    *rgb = ToRgb(light.pixels);
+    return Status::Ok();
+  }
   const std::string path = JoinPath(dataset.root, light.image);
   Image image;
   SFT_RETURN_IF_ERROR(ReadImage(path, &image));

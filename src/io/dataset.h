@@ -53,6 +53,9 @@ struct LightSpec {
   std::string image;  // relative to the dataset root: an equirectangular linear EXR.
   Eigen::Matrix3d world_from_env = Eigen::Matrix3d::Identity();
   double scale = 1.0;  // radiance = scale * texel value.
+  // An environment map held in memory instead of `image` (RGB, linear): the fitted environment of
+  // unknown lighting (src/optim/fitted_environment.h). Never read from or written to scene.json.
+  Image pixels;
   // Keys of this light's JSON object that this version does not interpret for its type, kept
   // verbatim (an object; null when there are none).
   nlohmann::json extra;

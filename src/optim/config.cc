@@ -267,6 +267,9 @@ const std::map<std::string, Key>& Keys() {
       {"fit_exposure", Bool([](O* o) -> bool& { return o->fit_exposure; })},
       {"exposure_prior",
        Real([](O* o) -> double& { return o->regularizers.exposure_prior; }, 0, 1e12)},
+      {"fit_environment", Bool([](O* o) -> bool& { return o->fit_environment; })},
+      {"environment_smoothness",
+       Real([](O* o) -> double& { return o->regularizers.environment_smoothness; }, 0, 1e12)},
       {"seed",
        {[](const json& v, O* o) -> std::string {
           if (!v.is_number_integer() || (!v.is_number_unsigned() && v.get<int64_t>() < 0)) {

@@ -18,6 +18,10 @@ bool ParameterBounds::Check(std::string* why) const {
     *why = "light_scale_min/light_scale_max: need 0 < min < max < infinity";
     return false;
   }
+  if (!(environment_max > 0.0 && std::isfinite(environment_max))) {
+    *why = "environment_max: must be finite and > 0";
+    return false;
+  }
   if (!(gain_min > 0.0 && gain_min < 1.0 && gain_max > 1.0 && std::isfinite(gain_max))) {
     *why = "gain_min/gain_max: need 0 < min < 1 < max < infinity";
     return false;
@@ -32,6 +36,7 @@ ParameterSelection ActiveParameters::ToSelection() const {
   selection.roughness = roughness;
   selection.specular = specular;
   selection.lights = lights;
+  selection.environment = environment;
   return selection;
 }
 
@@ -58,6 +63,44 @@ SceneParameters::SceneParameters(const std::vector<Eigen::Vector3d>& positions,
   std::fill(values_.begin() + ExposureOffset(), values_.end(), 1.0);
 }
 
+SceneParameters::SceneParameters(const std::vector<Eigen::Vector3d>& positions,
+                                 const Material& material, int num_lights, int num_gain_views,
+                                 int environment_light, const Image& texels) {
+  CHECK(environment_light >= 0 && environment_light < num_lights);
+  CHECK(texels.width > 0 && texels.height > 0 && texels.channels >= 3);
+  layout_.num_environment_texels = texels.width * texels.height;
+  layout_.environment_light = environment_light;
+  environment_width_ = texels.width;
+  environment_height_ = texels.height;
+  // The base layout, then the texels between the light scales and the gains.
+  SceneParameters base(positions, material, num_lights, num_gain_views);
+  ParameterLayout layout = base.layout_;
+  layout.num_environment_texels = layout_.num_environment_texels;
+  layout.environment_light = environment_light;
+  layout_ = layout;
+  num_gain_views_ = num_gain_views;
+  values_.assign(layout_.size() + 3 * num_gain_views, 1.0);
+  std::copy(base.values_.begin(), base.values_.begin() + base.layout_.size(), values_.begin());
+  for (int t = 0; t < layout_.num_environment_texels; ++t) {
+    for (int c = 0; c < 3; ++c) {
+      const float v = texels.at(t % texels.width, t / texels.width, c);
+      values_[layout_.EnvironmentOffset() + 3 * t + c] = std::isfinite(v) && v > 0.0f ? v : 0.0;
+    }
+  }
+}
+
+Image SceneParameters::EnvironmentTexels() const {
+  if (!has_environment()) return Image();
+  Image texels(environment_width_, environment_height_, 3);
+  for (int t = 0; t < layout_.num_environment_texels; ++t) {
+    for (int c = 0; c < 3; ++c) {
+      texels.at(t % environment_width_, t / environment_width_, c) =
+          static_cast<float>(values_[layout_.EnvironmentOffset() + 3 * t + c]);
+    }
+  }
+  return texels;
+}
+
 Eigen::Vector3d SceneParameters::Gains(int view) const {
   if (view < 0 || view >= num_gain_views_) return Eigen::Vector3d::Ones();
   return Eigen::Vector3d(values_[GainIndex(view, 0)], values_[GainIndex(view, 1)],
@@ -67,7 +110,7 @@ Eigen::Vector3d SceneParameters::Gains(int view) const {
 std::vector<BlockSpan> SceneParameters::Blocks() const {
   std::vector<BlockSpan> blocks;
   blocks.reserve(layout_.num_vertices + layout_.num_albedo_texels + layout_.num_roughness_texels +
-                 1 + layout_.num_lights + num_gain_views_);
+                 1 + layout_.num_lights + layout_.num_environment_texels + num_gain_views_);
   for (int v = 0; v < layout_.num_vertices; ++v) {
     blocks.push_back({3 * v, 3, ParameterKind::kVertex});
   }
@@ -80,6 +123,9 @@ std::vector<BlockSpan> SceneParameters::Blocks() const {
   blocks.push_back({layout_.SpecularIndex(), 1, ParameterKind::kSpecular});
   for (int l = 0; l < layout_.num_lights; ++l) {
     blocks.push_back({layout_.LightOffset() + l, 1, ParameterKind::kLight});
+  }
+  for (int t = 0; t < layout_.num_environment_texels; ++t) {
+    blocks.push_back({layout_.EnvironmentOffset() + 3 * t, 3, ParameterKind::kEnvironment});
   }
   for (int v = 0; v < num_gain_views_; ++v) {
     blocks.push_back({GainIndex(v, 0), 3, ParameterKind::kLight, /*exposure=*/true});
@@ -106,6 +152,10 @@ BlockSpan SceneParameters::BlockOf(int index) const {
       return {index, 1, ParameterKind::kSpecular};
     case ParameterKind::kLight:
       return {index, 1, ParameterKind::kLight};
+    case ParameterKind::kEnvironment: {
+      const int local = index - layout_.EnvironmentOffset();
+      return {index - local % 3, 3, ParameterKind::kEnvironment};
+    }
   }
   return {index, 1, ParameterKind::kLight};
 }
@@ -129,7 +179,7 @@ void SceneParameters::WriteMaterial(Material* material) const {
 
 std::vector<double> SceneParameters::LightScales() const {
   return std::vector<double>(values_.begin() + layout_.LightOffset(),
-                             values_.begin() + layout_.size());
+                             values_.begin() + layout_.EnvironmentOffset());
 }
 
 double SceneParameters::Lower(int index, const ParameterBounds& bounds) const {
@@ -144,6 +194,8 @@ double SceneParameters::Lower(int index, const ParameterBounds& bounds) const {
       return bounds.roughness_min;
     case ParameterKind::kLight:
       return bounds.light_scale_min;
+    case ParameterKind::kEnvironment:
+      return 0.0;
   }
   return 0.0;
 }
@@ -155,6 +207,8 @@ double SceneParameters::Upper(int index, const ParameterBounds& bounds) const {
       return std::numeric_limits<double>::infinity();
     case ParameterKind::kLight:
       return bounds.light_scale_max;
+    case ParameterKind::kEnvironment:
+      return bounds.environment_max;
     default:
       return 1.0;
   }

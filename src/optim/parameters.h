@@ -1,12 +1,13 @@
 // The reconstruction's state as one flat vector in the renderer's parameter layout
 // (ParameterLayout, src/render/derivatives.h): x[i] is parameter i — vertex coordinates, albedo
-// texels (RGB), roughness texels, the specular weight, one intensity scale per dataset light —
+// texels (RGB), roughness texels, the specular weight, one intensity scale per dataset light, the
+// texels of a fitted environment (RGB radiance; src/optim/fitted_environment.h) —
 // followed by the fit-only exposure gains: 3 per fitted view (R, G, B), which multiply that view's
 // rendered image before the residual (the renderer never sees them; docs/reconstruct.md,
 // "Exposure and white balance"). Ceres parameter blocks point into this vector: one block per
 // vertex (3), per albedo texel (3), per roughness texel (1), the specular weight (1), each light
-// scale (1) and each view's gains (3), so the mapping between Ceres blocks and indices is the
-// block's offset in the vector.
+// scale (1), each environment texel (3) and each view's gains (3), so the mapping between Ceres
+// blocks and indices is the block's offset in the vector.
 #ifndef SFT_OPTIM_PARAMETERS_H_
 #define SFT_OPTIM_PARAMETERS_H_
 
@@ -14,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "src/core/image.h"
 #include "src/geometry/material.h"
 #include "src/render/derivatives.h"
 
@@ -34,6 +36,9 @@ struct ParameterBounds {
   // and a gain of 0 would erase the view.
   double gain_min = 0.05;
   double gain_max = 20.0;
+  // Fitted environment texels (linear radiance) stay in [0, environment_max]: the renderer
+  // clamps negative texels to 0, and a texel beyond the bound means a runaway fit.
+  double environment_max = 1e6;
 
   bool Check(std::string* why) const;
 };
@@ -45,12 +50,15 @@ struct ActiveParameters {
   bool roughness = true;
   bool specular = false;
   bool lights = false;
-  bool exposure = false;  // the per-view exposure gains (all views but the gauge view).
+  bool exposure = false;     // the per-view exposure gains (all views but the gauge view).
+  bool environment = false;  // the fitted environment's texels (when the parameters have them).
 
   // The renderer's kinds (exposure gains are applied by the render cache, not the renderer).
   ParameterSelection ToSelection() const;
   bool Includes(ParameterKind kind) const;
-  bool Any() const { return vertices || albedo || roughness || specular || lights || exposure; }
+  bool Any() const {
+    return vertices || albedo || roughness || specular || lights || exposure || environment;
+  }
 };
 
 // The gauge of the exposure gains: albedo × light intensity × gain is otherwise ambiguous (any
@@ -73,6 +81,10 @@ class SceneParameters {
   // `num_gain_views` × 3 exposure gains of 1.
   SceneParameters(const std::vector<Eigen::Vector3d>& positions, const Material& material,
                   int num_lights, int num_gain_views = 0);
+  // The same with dataset light `environment_light`'s map as parameters, starting at `texels`
+  // (W × H, ≥ 3 channels; negative or non-finite values start at 0).
+  SceneParameters(const std::vector<Eigen::Vector3d>& positions, const Material& material,
+                  int num_lights, int num_gain_views, int environment_light, const Image& texels);
 
   // The renderer's part of the vector (every index below layout().size()).
   const ParameterLayout& layout() const { return layout_; }
@@ -104,6 +116,11 @@ class SceneParameters {
   void WriteMaterial(Material* material) const;
   double LightScale(int light) const { return values_[layout_.LightOffset() + light]; }
   std::vector<double> LightScales() const;
+  // The fitted environment's texels as a W × H RGB image (empty when there are none).
+  bool has_environment() const { return layout_.num_environment_texels > 0; }
+  Image EnvironmentTexels() const;
+  int environment_width() const { return environment_width_; }
+  int environment_height() const { return environment_height_; }
 
   // Lower/upper bound of parameter `index` (±infinity for vertices).
   double Lower(int index, const ParameterBounds& bounds) const;
@@ -114,6 +131,8 @@ class SceneParameters {
  private:
   ParameterLayout layout_;
   int num_gain_views_ = 0;
+  int environment_width_ = 0;
+  int environment_height_ = 0;
   std::vector<double> values_;
 };
 

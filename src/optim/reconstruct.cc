@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "cost_functions/proximal_smoothing.h"
+#include "src/optim/fitted_environment.h"
 #include "src/optim/problem.h"
 
 namespace sft {
@@ -24,6 +25,7 @@ ActiveParameters TexturePhase(const ReconstructOptions& options) {
   active.specular = options.fit_specular;
   active.lights = options.fit_lights;
   active.exposure = options.fit_exposure;
+  active.environment = options.fit_environment;
   return active;
 }
 
@@ -113,7 +115,8 @@ Status Reconstruction::Create(const Dataset& dataset, const TriMesh& mesh, const
                               const std::vector<double>& light_scales,
                               const ReconstructOptions& options,
                               std::unique_ptr<Reconstruction>* out,
-                              const std::vector<Eigen::Vector3d>& view_gains) {
+                              const std::vector<Eigen::Vector3d>& view_gains,
+                              const Image& environment) {
   std::string why;
   if (!options.Check(&why)) return Status::Error(why);
   std::unique_ptr<Reconstruction> r(new Reconstruction());
@@ -138,8 +141,15 @@ Status Reconstruction::Create(const Dataset& dataset, const TriMesh& mesh, const
   // Gains are parameters whenever some are not 1 (earlier fits) or this fit fits them.
   bool gains = options.fit_exposure;
   for (int v : views) gains = gains || r->view_gains_[v] != Eigen::Vector3d::Ones();
-  r->params_ =
-      SceneParameters(positions, material, num_lights, gains ? static_cast<int>(views.size()) : 0);
+  const int num_gain_views = gains ? static_cast<int>(views.size()) : 0;
+  const int fitted_light = FittedEnvironmentLight(dataset);
+  if (fitted_light >= 0) {
+    const Image& texels = environment.empty() ? dataset.lights[fitted_light].pixels : environment;
+    r->params_ =
+        SceneParameters(positions, material, num_lights, num_gain_views, fitted_light, texels);
+  } else {
+    r->params_ = SceneParameters(positions, material, num_lights, num_gain_views);
+  }
   for (int k = 0; gains && k < static_cast<int>(views.size()); ++k) {
     for (int c = 0; c < 3; ++c)
       r->params_.values()[r->params_.GainIndex(k, c)] = r->view_gains_[views[k]][c];

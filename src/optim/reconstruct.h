@@ -40,6 +40,9 @@ struct ReconstructOptions {
   // The texture phase also fits per-view exposure gains (3 per fitted view, the first fitted view
   // the fixed gauge; src/optim/parameters.h, kExposureGaugeView).
   bool fit_exposure = false;
+  // The texture phase also fits the fitted environment's texels (unknown lighting,
+  // src/optim/fitted_environment.h); without a fitted environment it changes nothing.
+  bool fit_environment = true;
   uint64_t seed = 1;       // base seed of the renders.
   std::vector<int> views;  // dataset views to fit; empty = all.
   // Shading of the fit's renders: "auto" (the dataset's, DatasetShading in src/io/scene_setup.h:
@@ -80,7 +83,8 @@ class Reconstruction {
   static Status Create(const Dataset& dataset, const TriMesh& mesh, const Material& material,
                        const std::vector<double>& light_scales, const ReconstructOptions& options,
                        std::unique_ptr<Reconstruction>* out,
-                       const std::vector<Eigen::Vector3d>& view_gains = {});
+                       const std::vector<Eigen::Vector3d>& view_gains = {},
+                       const Image& environment = Image());
 
   // Runs the effect planner for outer iteration `outer` (its renders use the chosen plan from
   // now on). The ceiling is the configured effects and budgets; `image_signal_scale` and
@@ -96,6 +100,8 @@ class Reconstruction {
   TriMesh Mesh() const;
   Material CurrentMaterial() const;  // unsampled texels filled from their neighbours.
   std::vector<double> LightScales() const { return params_.LightScales(); }
+  // The fitted environment's texels (empty without one).
+  Image EnvironmentTexels() const { return params_.EnvironmentTexels(); }
   // The exposure gains per dataset view: the fitted views' current ones, the others' as given to
   // Create (1 when none were given).
   std::vector<Eigen::Vector3d> ViewGains() const;

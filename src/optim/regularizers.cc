@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "cost_functions/environment_smoothness.h"
 #include "cost_functions/exposure_prior.h"
 #include "cost_functions/face_orientation.h"
 #include "cost_functions/proximal_smoothing.h"
@@ -43,6 +44,10 @@ bool RegularizerOptions::Check(std::string* why) const {
       *why = "regularizer weights must be finite and >= 0";
       return false;
     }
+  }
+  if (!(environment_smoothness >= 0.0 && std::isfinite(environment_smoothness))) {
+    *why = "environment_smoothness: must be finite and >= 0";
+    return false;
   }
   if (!(exposure_prior >= 0.0 && std::isfinite(exposure_prior))) {
     *why = "exposure_prior: must be finite and >= 0";
@@ -98,6 +103,25 @@ void AddRegularizers(const TriMesh& rest, const ActiveParameters& active,
   if (active.roughness && options.roughness_smoothness > 0.0) {
     AddSmoothness(rest, material.roughness.resolution(), 1, layout.RoughnessOffset(),
                   options.roughness_smoothness, bounds, params, problem);
+  }
+  if (active.environment && params->has_environment() && options.environment_smoothness > 0.0) {
+    const int num_texels = layout.num_environment_texels;
+    std::vector<double*> blocks(num_texels);
+    for (int t = 0; t < num_texels; ++t)
+      blocks[t] = params->data() + layout.EnvironmentOffset() + 3 * t;
+    TexelSmoothnessOptions smoothness;
+    smoothness.weight = std::sqrt(options.environment_smoothness);
+    AddTexelSmoothness(
+        EnvironmentNeighbourPairs(params->environment_width(), params->environment_height()), 3,
+        smoothness, blocks, problem);
+    for (int t = 0; t < num_texels; ++t) {
+      if (!problem->HasParameterBlock(blocks[t])) continue;
+      for (int c = 0; c < 3; ++c) {
+        const int index = layout.EnvironmentOffset() + 3 * t + c;
+        problem->SetParameterLowerBound(blocks[t], c, params->Lower(index, bounds));
+        problem->SetParameterUpperBound(blocks[t], c, params->Upper(index, bounds));
+      }
+    }
   }
   if (active.exposure && options.exposure_prior > 0.0) {
     CHECK_EQ(static_cast<int>(gain_curvature.size()), params->num_gain_views());

@@ -1,6 +1,7 @@
 // Regularizer residual blocks of the reconstruction (cost_functions/vertex_laplacian.h,
 // cost_functions/face_orientation.h, cost_functions/proximal_smoothing.h,
-// cost_functions/texel_smoothness.h, cost_functions/exposure_prior.h), added for the parameter
+// cost_functions/texel_smoothness.h, cost_functions/exposure_prior.h,
+// cost_functions/environment_smoothness.h), added for the parameter
 // kinds a phase varies.
 #ifndef SFT_OPTIM_REGULARIZERS_H_
 #define SFT_OPTIM_REGULARIZERS_H_
@@ -50,6 +51,12 @@ struct RegularizerOptions {
   // in the gain), finite, ≥ 0: the prior counts λ times as much as the view's photograph; 0 = no
   // prior (the gauge view alone fixes the scale). The default pulls a gain by 1e-3 of its offset.
   double exposure_prior = 1e-3;
+  // Weight of differences between neighbouring texels of a fitted environment
+  // (cost_functions/environment_smoothness.h; unknown lighting), finite, ≥ 0; 0 = off. Residuals
+  // are radiance differences, weighed against image residuals of radiance: 1 lets a few pixels'
+  // evidence outweigh the prior, so texels seen through many pixels follow the images and
+  // texels seen by none take their neighbours' values.
+  double environment_smoothness = 1.0;
 
   bool Check(std::string* why) const;
 };

@@ -219,6 +219,15 @@ void RenderCache::UpdateScene() {
     scene_positions_ = std::move(positions);
   }
   params_->WriteMaterial(&material_);
+  if (params_->has_environment()) {
+    Image texels = params_->EnvironmentTexels();
+    if (!fitted_environment_ || texels.data != fitted_texels_) {
+      const LightSpec& light = dataset_->lights.at(params_->layout().environment_light);
+      fitted_environment_ =
+          std::make_unique<EnvironmentMap>(texels, light.world_from_env, light.scale);
+      fitted_texels_ = std::move(texels.data);
+    }
+  }
 }
 
 ViewSetup RenderCache::ScaledView(int v) const {
@@ -229,6 +238,9 @@ ViewSetup RenderCache::ScaledView(int v) const {
   }
   if (view.environment_light_index >= 0) {
     view.environment_scale *= params_->LightScale(view.environment_light_index);
+    if (params_->layout().FitsEnvironment(view.environment_light_index)) {
+      view.environment = fitted_environment_.get();
+    }
   }
   return view;
 }
@@ -257,7 +269,6 @@ void RenderCache::Render(bool rows) {
   DerivativeRequest request = options_.edges;
   request.params = active_.ToSelection();
   request.jacobian_rows = true;
-  const int num_lights = params_->layout().num_lights;
   for (int v = 0; v < num_views(); ++v) {
     const auto start = std::chrono::steady_clock::now();
     Image image;
@@ -267,8 +278,8 @@ void RenderCache::Render(bool rows) {
     RenderStats stats;
     if (rows && active_.Any()) {
       DerivativeOutput output;
-      RenderViewWithDerivatives(*scene_, material_, view, render, request, num_lights, &image,
-                                &output, &stats);
+      RenderViewWithDerivatives(*scene_, material_, view, render, request, params_->layout(),
+                                &image, &output, &stats);
       render_seconds_ += Seconds(start);
       non_finite_ += stats.NonFinite();
       StoreRender(v, image, &output.rows);
@@ -319,7 +330,7 @@ void RenderCache::StoreRender(int v, const Image& image, const JacobianRows* row
     for (RowEntry& e : level_rows.entries) {
       // The renderer differentiates light l at the rendered intensity I·s_l, i.e. it returns
       // s_l·∂I/∂s_l; the fit's parameter is s_l itself.
-      if (e.param >= layout.LightOffset()) {
+      if (layout.KindOf(e.param) == ParameterKind::kLight) {
         const double scale = params_->LightScale(e.param - layout.LightOffset());
         for (double& d : e.d) d /= scale;
       }
@@ -479,15 +490,17 @@ bool RenderCache::AddAdjointGradientWith(int v, const Image& weights, const Effe
   Image image;
   DerivativeOutput output;
   RenderStats stats;
-  RenderViewWithDerivatives(*scene_, material_, ScaledView(v), render, request,
-                            params_->layout().num_lights, &image, &output, &stats);
+  RenderViewWithDerivatives(*scene_, material_, ScaledView(v), render, request, params_->layout(),
+                            &image, &output, &stats);
   render_seconds_ += Seconds(start);
   ++renders_;
   const ParameterLayout& layout = params_->layout();
   bool finite = stats.NonFinite() == 0;
   for (int i = 0; i < layout.size(); ++i) {
     double g = output.gradient[i];
-    if (i >= layout.LightOffset()) g /= params_->LightScale(i - layout.LightOffset());
+    if (layout.KindOf(i) == ParameterKind::kLight) {
+      g /= params_->LightScale(i - layout.LightOffset());
+    }
     finite = finite && std::isfinite(g);
     (*gradient)[i] += g;
   }

@@ -187,6 +187,10 @@ class RenderCache : public ceres::EvaluationCallback {
   Material material_;
   std::unique_ptr<RenderScene> scene_;
   std::vector<Eigen::Vector3d> scene_positions_;
+  // The fitted environment at the current parameters (SceneParameters::has_environment): the map
+  // views of that light render with instead of the dataset's, rebuilt when its texels change.
+  std::unique_ptr<EnvironmentMap> fitted_environment_;
+  std::vector<float> fitted_texels_;
   std::vector<ViewTargets> targets_;
   std::vector<std::vector<std::unique_ptr<LevelCache>>> levels_;
   uint64_t seed_ = 0;

@@ -10,6 +10,7 @@
 #include "src/init/untangle.h"
 #include "src/io/image_io.h"
 #include "src/io/scene_setup.h"
+#include "src/optim/fitted_environment.h"
 #include "src/optim/run_outputs.h"
 #include "src/optim/schedule_config.h"
 
@@ -113,6 +114,10 @@ Status Schedule::Start(const Dataset& dataset, const std::string& out,
   s->stages_ = stages;
   s->run_info_ = run_info;
   s->current_ = start;
+  const int fitted_light = FittedEnvironmentLight(dataset);
+  if (s->current_.environment.empty() && fitted_light >= 0) {
+    s->current_.environment = dataset.lights[fitted_light].pixels;
+  }
   s->baseline_ = start.mesh;
   SFT_RETURN_IF_ERROR(MakeDirectories(out));
   SFT_RETURN_IF_ERROR(WriteMesh(JoinPath(out, "initial_mesh.ply"), start.mesh));
@@ -150,6 +155,10 @@ Status Schedule::Resume(const Dataset& dataset, const std::string& out,
                          " views, the dataset has " + std::to_string(dataset.views.size()));
   }
   s->current_.view_gains = view_gains;
+  // The caller gave the fitted light the checkpoint's map (kFittedEnvironmentFile).
+  if (FittedEnvironmentLight(dataset) >= 0) {
+    s->current_.environment = dataset.lights[FittedEnvironmentLight(dataset)].pixels;
+  }
   const std::string baseline = JoinPath(out, kBaselineMesh);
   SFT_RETURN_IF_ERROR(
       ReadMesh(FileExists(baseline) ? baseline : JoinPath(out, "mesh.ply"), &s->baseline_));
@@ -184,7 +193,7 @@ Status Schedule::CreateReconstruction() {
   const StageOptions& stage = stages_[progress_.stage];
   SFT_RETURN_IF_ERROR(Reconstruction::Create(*dataset_, current_.mesh, current_.material,
                                              current_.light_scales, stage.fit, &reconstruction_,
-                                             current_.view_gains));
+                                             current_.view_gains, current_.environment));
   reconstruction_->elapsed_offset = Elapsed();
   reconstruction_stage_ = progress_.stage;
   phases_seen_ = 0;
@@ -220,6 +229,8 @@ void Schedule::SyncCurrent() {
   current_.material = reconstruction_->CurrentMaterial();
   current_.light_scales = reconstruction_->LightScales();
   current_.view_gains = reconstruction_->ViewGains();
+  Image environment = reconstruction_->EnvironmentTexels();
+  if (!environment.empty()) current_.environment = std::move(environment);
 }
 
 Status Schedule::ChangeTopology(TopologyChange change, const ScheduleCallbacks& callbacks) {
@@ -451,6 +462,9 @@ Status Schedule::Checkpoint() {
   progress_.seconds = Elapsed();
   SFT_RETURN_IF_ERROR(
       WriteRunSnapshot(out_, *dataset_, current_.mesh, current_.material, current_.light_scales));
+  if (!current_.environment.empty()) {
+    SFT_RETURN_IF_ERROR(WriteExr(JoinPath(out_, kFittedEnvironmentFile), current_.environment));
+  }
   // Before state.json (the commit point): see src/optim/adam_checkpoint.h.
   if (reconstruction_ && !reconstruction_->adam_state().m.empty()) {
     AdamCheckpoint adam;

@@ -70,6 +70,9 @@ struct ScheduleStart {
   std::vector<double> light_scales;  // empty = all 1.
   // Exposure gains per dataset view (src/optim/parameters.h); empty = all 1.
   std::vector<Eigen::Vector3d> view_gains;
+  // The fitted environment's texels (unknown lighting, src/optim/fitted_environment.h); empty =
+  // the dataset's fitted light's own (or no fitted environment).
+  Image environment;
 };
 
 struct ScheduleCallbacks {

@@ -1,0 +1,120 @@
+#include "src/optim/fitted_environment.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "src/core/file_util.h"
+#include "src/io/image_io.h"
+
+namespace sft {
+
+bool EnvironmentEstimateOptions::Check(std::string* why) const {
+  if (width < 2 || width > 512 || height < 1 || height > 256) {
+    *why = "environment size: width must be in [2, 512] and height in [1, 256]";
+    return false;
+  }
+  if (!(assumed_albedo > 0.0 && assumed_albedo <= 1.0)) {
+    *why = "assumed_albedo: must be in (0, 1]";
+    return false;
+  }
+  return true;
+}
+
+bool LightingUnknown(const Dataset& dataset) {
+  if (dataset.views.empty()) return false;
+  for (const ViewSpec& view : dataset.views) {
+    if (!view.lights.empty()) return false;
+  }
+  return true;
+}
+
+Status InitialEnvironment(const Dataset& dataset, const EnvironmentEstimateOptions& options,
+                          Image* texels) {
+  std::string why;
+  if (!options.Check(&why)) return Status::Error(why);
+  double sum[3] = {0.0, 0.0, 0.0};
+  double count = 0.0;
+  for (size_t v = 0; v < dataset.views.size(); ++v) {
+    Image rgb, mask;
+    SFT_RETURN_IF_ERROR(LoadViewImage(dataset, static_cast<int>(v), &rgb));
+    const bool masked = !dataset.views[v].mask.empty();
+    if (masked) SFT_RETURN_IF_ERROR(LoadViewMask(dataset, static_cast<int>(v), &mask));
+    for (int y = 0; y < rgb.height; ++y) {
+      for (int x = 0; x < rgb.width; ++x) {
+        if (masked && !(mask.at(x, y, 0) > 0.5f)) continue;
+        for (int c = 0; c < 3; ++c) {
+          const float value = rgb.at(x, y, std::min(c, rgb.channels - 1));
+          if (std::isfinite(value)) sum[c] += value;
+        }
+        count += 1.0;
+      }
+    }
+  }
+  *texels = Image(options.width, options.height, 3);
+  for (int c = 0; c < 3; ++c) {
+    // A black or empty capture still gets a map light sampling can use.
+    const double mean = count > 0.0 ? sum[c] / count : 0.0;
+    const float value = static_cast<float>(std::max(mean, 1e-3) / options.assumed_albedo);
+    for (int y = 0; y < options.height; ++y) {
+      for (int x = 0; x < options.width; ++x) texels->at(x, y, c) = value;
+    }
+  }
+  return Status::Ok();
+}
+
+Status AddFittedEnvironment(const Image& texels, Dataset* dataset) {
+  if (!LightingUnknown(*dataset)) {
+    return Status::Error(
+        "a fitted environment replaces unknown lighting only: the dataset's views have lights");
+  }
+  if (texels.width < 2 || texels.height < 1 || texels.channels < 3) {
+    return Status::Error("fitted environment: needs at least 2 × 1 RGB texels");
+  }
+  LightSpec light;
+  light.id = kFittedEnvironmentId;
+  light.type = LightType::kEnvironment;
+  light.pixels = texels;
+  const int index = static_cast<int>(dataset->lights.size());
+  dataset->lights.push_back(std::move(light));
+  for (ViewSpec& view : dataset->views) {
+    view.light_ids = {kFittedEnvironmentId};
+    view.lights = {index};
+  }
+  return Status::Ok();
+}
+
+int FittedEnvironmentLight(const Dataset& dataset) {
+  for (size_t l = 0; l < dataset.lights.size(); ++l) {
+    if (dataset.lights[l].id == kFittedEnvironmentId && !dataset.lights[l].pixels.empty()) {
+      return static_cast<int>(l);
+    }
+  }
+  return -1;
+}
+
+Status PrepareUnknownLighting(const std::string& run, const EnvironmentEstimateOptions& options,
+                              Dataset* dataset, std::string* note) {
+  note->clear();
+  if (!LightingUnknown(*dataset)) return Status::Ok();
+  Image texels;
+  const std::string saved = run.empty() ? "" : JoinPath(run, kFittedEnvironmentFile);
+  if (!saved.empty() && FileExists(saved)) {
+    Image image;
+    SFT_RETURN_IF_ERROR(ReadImage(saved, &image));
+    if (image.width < 2 || image.height < 1 || image.channels < 3) {
+      return Status::Error(saved + ": not a fitted environment (needs at least 2 × 1 RGB texels)");
+    }
+    texels = ToRgb(image);
+    *note = "lighting: unknown in the dataset; continuing the fitted " +
+            std::to_string(texels.width) + "×" + std::to_string(texels.height) +
+            " environment of " + saved;
+  } else {
+    SFT_RETURN_IF_ERROR(InitialEnvironment(*dataset, options, &texels));
+    *note = "lighting: unknown in the dataset (no view lists lights); fitting a world-fixed " +
+            std::to_string(texels.width) + "×" + std::to_string(texels.height) +
+            " environment with the material (albedo is then known up to one scale per channel)";
+  }
+  return AddFittedEnvironment(texels, dataset);
+}
+
+}  // namespace sft

@@ -1,0 +1,62 @@
+// Unknown lighting as parameters (docs/reconstruct.md, "Unknown lighting"): when no view of a
+// dataset records its lights (real captures without a probe), the fit estimates a world-fixed
+// environment — a low-resolution equirectangular map (src/render/environment.h) whose texels are
+// RGB radiance parameters (ParameterKind::kEnvironment) — jointly with the material, under a
+// smoothness prior (cost_functions/environment_smoothness.h).
+//
+// The gauge. Albedo × radiance is ambiguous per channel (exactly so for one bounce: any factor
+// moves between them), so the start fixes it: every texel starts at the mean photograph over the
+// masks divided by `assumed_albedo` (a diffuse surface of albedo a under uniform radiance L
+// reflects a·L), and the solvers, which take no step along an exact null direction, keep it.
+// Albedo is therefore known up to one scale per channel: score it after the best per-channel
+// scale (`sft eval` does when the run estimated its lighting).
+//
+// The map lives in memory as the dataset light kFittedEnvironmentId (LightSpec::pixels); the run
+// folder keeps it as kFittedEnvironmentFile.
+#ifndef SFT_OPTIM_FITTED_ENVIRONMENT_H_
+#define SFT_OPTIM_FITTED_ENVIRONMENT_H_
+
+#include <string>
+
+#include "src/core/image.h"
+#include "src/core/status.h"
+#include "src/io/dataset.h"
+
+namespace sft {
+
+constexpr char kFittedEnvironmentId[] = "fitted_environment";
+constexpr char kFittedEnvironmentFile[] = "environment.exr";
+
+struct EnvironmentEstimateOptions {
+  int width = 32;               // texels around the horizon (u), [2, 512].
+  int height = 16;              // texels from pole to pole (v), [1, 256].
+  double assumed_albedo = 0.5;  // the gauge (above), (0, 1].
+
+  bool Check(std::string* why) const;
+};
+
+// Whether no view records its lights (every `lights` list empty) and there is at least one view.
+bool LightingUnknown(const Dataset& dataset);
+
+// The start map: width × height RGB, every texel the mean of the photographs over their masks
+// (whole images without masks) divided by options.assumed_albedo. Errors name the unreadable file.
+Status InitialEnvironment(const Dataset& dataset, const EnvironmentEstimateOptions& options,
+                          Image* texels);
+
+// Adds the light kFittedEnvironmentId with map `texels` (world frame = env frame, scale 1) to
+// `dataset` and makes it every view's only light. Refuses a dataset whose views have lights.
+Status AddFittedEnvironment(const Image& texels, Dataset* dataset);
+
+// Index of the fitted environment light in dataset.lights, -1 when there is none.
+int FittedEnvironmentLight(const Dataset& dataset);
+
+// What `sft reconstruct` does with a dataset before fitting it: when its lighting is unknown
+// (LightingUnknown), adds the fitted environment — the checkpoint's `run`/kFittedEnvironmentFile
+// when `run` is a run folder holding one (--resume), else InitialEnvironment — and sets *note to
+// the one console line saying so; otherwise changes nothing (*note empty). Errors name the file.
+Status PrepareUnknownLighting(const std::string& run, const EnvironmentEstimateOptions& options,
+                              Dataset* dataset, std::string* note);
+
+}  // namespace sft
+
+#endif  // SFT_OPTIM_FITTED_ENVIRONMENT_H_
