@@ -5,8 +5,8 @@
 #include <atomic>
 #include <climits>
 #include <csignal>
-#include <functional>
 #include <cstdio>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <set>
 
@@ -53,8 +53,8 @@ struct ReconstructCommandOptions {
 
 // Called by PrepareSchedule once the run is settled, just before the schedule starts (and writes
 // into the output folder), with the dataset path and the stages.
-using BeforeStart =
-    std::function<Status(const std::string& dataset, const Dataset&, const std::vector<StageOptions>&)>;
+using BeforeStart = std::function<Status(const std::string& dataset, const Dataset&,
+                                         const std::vector<StageOptions>&)>;
 
 // The flat keys of the command line (flags override the config file's keys in every stage).
 Status FlagKeys(const ReconstructCommandOptions& cli, ScheduleConfig* config) {

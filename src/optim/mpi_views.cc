@@ -76,8 +76,9 @@ enum StatePart { kScenePart = 0, kPositionsPart, kMaterialPart, kSettingsPart, k
 template <typename T>
 struct Plain : std::is_trivially_copyable<T> {};
 template <typename S, int R, int C, int O, int MR, int MC>
-struct Plain<Eigen::Matrix<S, R, C, O, MR, MC>>
-    : std::bool_constant<(R > 0 && C > 0 && std::is_trivially_copyable<S>::value)> {};
+struct Plain<Eigen::Matrix<S, R, C, O, MR, MC> > : std::is_trivially_copyable<S> {
+  static_assert(R != Eigen::Dynamic && C != Eigen::Dynamic, "fixed-size Eigen types only");
+};
 
 // Byte buffers of plain values and vectors of them. A message is only ever read by the same
 // executable that wrote it, so values are copied as they are in memory.
@@ -198,8 +199,8 @@ MeshColors GetMeshColors(ByteReader* r) {
 }
 
 // The serialized parts of a state (StatePart order).
-std::vector<std::vector<char>> StateParts(const RenderState& s) {
-  std::vector<std::vector<char>> parts(kNumParts);
+std::vector<std::vector<char> > StateParts(const RenderState& s) {
+  std::vector<std::vector<char> > parts(kNumParts);
   ByteWriter scene, positions, material, settings;
   scene.Put(s.scene_id);
   scene.PutVector(s.build_positions);
@@ -328,6 +329,26 @@ void WaitBounded(MPI_Request* request, double timeout, int source) {
   }
 }
 
+// Waits for `requests` without spinning: Open MPI's waits poll at full speed, and a worker that
+// waits that way (for rank 0's next evaluation, or for rank 0 to take its results) takes a core
+// from rank 0's renders and Ceres on a shared machine. Polls every 200 µs instead.
+void WaitIdle(std::vector<MPI_Request>* requests) {
+  int done = 0;
+  MPI_Testall(static_cast<int>(requests->size()), requests->data(), &done, MPI_STATUSES_IGNORE);
+  while (!done) {
+    std::this_thread::sleep_for(std::chrono::microseconds(200));
+    MPI_Testall(static_cast<int>(requests->size()), requests->data(), &done, MPI_STATUSES_IGNORE);
+  }
+}
+
+// The evaluation header, broadcast non-blocking on every rank (a blocking and a non-blocking
+// broadcast do not match), so that idle workers wait for it without spinning.
+void BroadcastHeader(int64_t header[]) {
+  std::vector<MPI_Request> request(1);
+  MPI_Ibcast(header, kHeaderSize, MPI_INT64_T, 0, MPI_COMM_WORLD, &request[0]);
+  WaitIdle(&request);
+}
+
 // Receives a message sent by SendBytes (`timeout` > 0 bounds each wait; 0 waits forever).
 std::vector<char> ReceiveBytes(int source, int tag, double timeout) {
   int64_t size = 0;
@@ -391,8 +412,11 @@ MpiSession::~MpiSession() { MPI_Finalize(); }
 Status MpiHandshake(const MpiSession& session, const Status& own, const std::string& dataset_path,
                     int fitted_views, Dataset* dataset) {
   // 1. Rank 0's status and the path.
+  // Non-blocking: workers wait here without spinning while rank 0 prepares (e.g. carves a hull).
   int64_t go = own.ok() ? 1 : 0;
-  MPI_Bcast(&go, 1, MPI_INT64_T, 0, MPI_COMM_WORLD);
+  std::vector<MPI_Request> request(1);
+  MPI_Ibcast(&go, 1, MPI_INT64_T, 0, MPI_COMM_WORLD, &request[0]);
+  WaitIdle(&request);
   if (!go) {
     return session.rank() == 0 ? own : Status::Error("rank 0 stopped before the run");
   }
@@ -439,7 +463,7 @@ Status MpiHandshake(const MpiSession& session, const Status& own, const std::str
 }
 
 MpiViewRunner::MpiViewRunner(const MpiSession& session, double timeout_seconds)
-    : size_(session.size()), timeout_(timeout_seconds) {
+    : size_(session.size()), timeout_(timeout_seconds), speed_(session.size(), 1.0) {
   stats_.ranks = size_;
 }
 
@@ -449,31 +473,42 @@ void MpiViewRunner::Stop() {
   if (stopped_) return;
   stopped_ = true;
   int64_t header[kHeaderSize] = {kStop, 0, 0, 0, 0};
-  MPI_Bcast(header, kHeaderSize, MPI_INT64_T, 0, MPI_COMM_WORLD);
+  BroadcastHeader(header);
 }
 
-std::vector<int> MpiViewRunner::Assign(const RenderState& state,
-                                       const std::vector<ViewJob>& jobs) const {
-  std::vector<double> cost(jobs.size(), 1.0);
+std::vector<int> MpiViewRunner::Assign(const RenderState& state, const std::vector<ViewJob>& jobs,
+                                       std::vector<double>* cost) const {
+  cost->assign(jobs.size(), 1.0);
   double total = 0.0;
   for (size_t k = 0; k < jobs.size(); ++k) {
     const auto it = cost_.find({state.view_indices[jobs[k].view], static_cast<int>(jobs[k].pass)});
-    if (it != cost_.end()) cost[k] = std::max(it->second, 1e-6);
-    total += cost[k];
+    if (it != cost_.end()) (*cost)[k] = std::max(it->second, 1e-6);
+    total += (*cost)[k];
   }
-  // Job k goes to the rank whose share of the total holds the middle of its cost.
+  // Rank r's share of the total cost is proportional to its measured speed; job k goes to the
+  // rank whose share holds the middle of its cost.
+  std::vector<double> end(size_);
+  double speeds = 0.0;
+  for (int r = 0; r < size_; ++r) speeds += speed_[r];
+  double sum = 0.0;
+  for (int r = 0; r < size_; ++r) {
+    sum += speed_[r];
+    end[r] = total * sum / speeds;
+  }
   std::vector<int> rank(jobs.size());
   double before = 0.0;
+  int r = 0;
   for (size_t k = 0; k < jobs.size(); ++k) {
-    const double middle = before + 0.5 * cost[k];
-    rank[k] = std::min(size_ - 1, static_cast<int>(middle / total * size_));
-    before += cost[k];
+    const double middle = before + 0.5 * (*cost)[k];
+    while (r < size_ - 1 && middle > end[r]) ++r;
+    rank[k] = r;
+    before += (*cost)[k];
   }
   return rank;
 }
 
 void MpiViewRunner::BroadcastState(const RenderState& state, int64_t header[]) {
-  std::vector<std::vector<char>> parts = StateParts(state);
+  std::vector<std::vector<char> > parts = StateParts(state);
   if (sent_parts_.size() != parts.size()) sent_parts_.assign(parts.size(), {});
   // A new scene resends the positions too: the workers rebuild from the build positions.
   if (parts[kScenePart] != sent_parts_[kScenePart]) sent_parts_[kPositionsPart].clear();
@@ -489,7 +524,7 @@ void MpiViewRunner::BroadcastState(const RenderState& state, int64_t header[]) {
   }
   header[2] = mask;
   header[3] = static_cast<int64_t>(changed.size());
-  MPI_Bcast(header, kHeaderSize, MPI_INT64_T, 0, MPI_COMM_WORLD);
+  BroadcastHeader(header);
   if (!changed.empty()) BroadcastBytes(&changed, header[3]);
   stats_.broadcast_bytes += header[3];
 }
@@ -498,12 +533,18 @@ void MpiViewRunner::Run(const RenderState& state, const std::vector<ViewJob>& jo
                         const LocalRender& local, const Consume& consume) {
   CHECK(!stopped_);
   const auto start = Clock::now();
-  const std::vector<int> rank = Assign(state, jobs);
+  std::vector<double> cost;
+  const std::vector<int> rank = Assign(state, jobs, &cost);
+  // Per rank: the assigned cost and the seconds it took (rank 0: its own renders and storing
+  // them; a worker: from its header to its last result), for the next evaluation's speeds.
+  std::vector<double> assigned(size_, 0.0), busy(size_, 0.0);
+  for (size_t k = 0; k < jobs.size(); ++k) assigned[rank[k]] += cost[k];
   std::vector<JobEntry> entries(jobs.size());
   for (size_t k = 0; k < jobs.size(); ++k) {
     const Image& w = jobs[k].weights;
-    entries[k] = {jobs[k].view, static_cast<int32_t>(jobs[k].pass), jobs[k].seed, rank[k],
-                  w.width, w.height, w.channels};
+    entries[k] = {
+        jobs[k].view, static_cast<int32_t>(jobs[k].pass), jobs[k].seed, rank[k], w.width, w.height,
+        w.channels};
   }
   ByteWriter job_list;
   job_list.PutVector(entries);
@@ -529,7 +570,8 @@ void MpiViewRunner::Run(const RenderState& state, const std::vector<ViewJob>& jo
   for (size_t r = 0; r < requests.size(); ++r) {
     WaitBounded(&requests[r], timeout_, request_ranks[r]);
   }
-  stats_.broadcast += Since(start);
+  const double broadcast_seconds = Since(start);
+  stats_.broadcast += broadcast_seconds;
   // Rank 0's own jobs (the first run of jobs), consumed as they finish.
   size_t k = 0;
   for (; k < jobs.size() && rank[k] == 0; ++k) {
@@ -541,6 +583,7 @@ void MpiViewRunner::Run(const RenderState& state, const std::vector<ViewJob>& jo
     consume(k, &result);
   }
   const double local_done = Since(start);
+  busy[0] = local_done - broadcast_seconds;
   // The others', in job order. Rank 0 waits whenever it is not storing a result; of that wait,
   // the time the slowest rank was still rendering after rank 0 had finished is imbalance (the
   // workers' clocks start at the header, within a broadcast latency of rank 0's), the rest gather.
@@ -552,6 +595,7 @@ void MpiViewRunner::Run(const RenderState& state, const std::vector<ViewJob>& jo
     double ready = 0.0;
     GetResult(bytes, &result, &ready);
     last_ready = std::max(last_ready, ready);
+    busy[rank[k]] = std::max(busy[rank[k]], ready);
     cost_[{state.view_indices[jobs[k].view], static_cast<int>(jobs[k].pass)}] = result.seconds;
     ++stats_.remote_jobs;
     const auto store_start = Clock::now();
@@ -562,6 +606,9 @@ void MpiViewRunner::Run(const RenderState& state, const std::vector<ViewJob>& jo
   const double imbalance = std::clamp(last_ready - local_done, 0.0, waited);
   stats_.imbalance += imbalance;
   stats_.gather += waited - imbalance;
+  for (int r = 0; r < size_; ++r) {
+    if (assigned[r] > 0.0 && busy[r] > 0.0) speed_[r] = assigned[r] / busy[r];
+  }
   ++stats_.evaluations;
 }
 
@@ -574,7 +621,7 @@ Status ServeViews(const MpiSession& session, const Dataset& dataset) {
   std::vector<Eigen::Vector3d> scene_positions;
   for (;;) {
     int64_t header[kHeaderSize];
-    MPI_Bcast(header, kHeaderSize, MPI_INT64_T, 0, MPI_COMM_WORLD);
+    BroadcastHeader(header);
     const auto start = Clock::now();
     if (header[0] == kStop) return Status::Ok();
     if (header[3] > 0) {
@@ -609,7 +656,7 @@ Status ServeViews(const MpiSession& session, const Dataset& dataset) {
                 WeightsTag(k), MPI_COMM_WORLD, &weight_requests[k]);
     }
     // Results are sent as they are ready; their buffers live until every send completed.
-    std::vector<std::vector<char>> results;
+    std::vector<std::vector<char> > results;
     std::vector<int64_t> sizes(entries.size());
     std::vector<MPI_Request> requests;
     results.reserve(entries.size());
@@ -620,7 +667,8 @@ Status ServeViews(const MpiSession& session, const Dataset& dataset) {
       job.pass = static_cast<ViewPass>(entries[k].pass);
       job.seed = entries[k].seed;
       if (job.pass == ViewPass::kAdjoint) {
-        MPI_Wait(&weight_requests[k], MPI_STATUS_IGNORE);
+        std::vector<MPI_Request> request = {weight_requests[k]};
+        WaitIdle(&request);
         job.weights = std::move(weights[k]);
       }
       ViewResult result;
@@ -633,9 +681,7 @@ Status ServeViews(const MpiSession& session, const Dataset& dataset) {
       results.push_back(std::move(w.bytes()));
       SendBytes(results.back(), 0, ResultTag(k), &sizes[k], &requests);
     }
-    if (!requests.empty()) {
-      MPI_Waitall(static_cast<int>(requests.size()), requests.data(), MPI_STATUSES_IGNORE);
-    }
+    WaitIdle(&requests);
   }
 }
 

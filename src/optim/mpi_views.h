@@ -34,12 +34,12 @@ namespace sft {
 // bytes it moved.
 struct MpiViewStats {
   int ranks = 1;
-  int64_t evaluations = 0;     // runs of jobs spread over the ranks.
-  int64_t remote_jobs = 0;     // jobs rendered on other ranks.
-  double broadcast = 0.0;      // sending the header, state, job list and adjoint weights.
-  double local_render = 0.0;   // rendering rank 0's own jobs (storing them not included).
-  double imbalance = 0.0;      // waiting for a rank that was still rendering when rank 0 was done.
-  double gather = 0.0;         // the rest of the wait: receiving and decoding the results.
+  int64_t evaluations = 0;      // runs of jobs spread over the ranks.
+  int64_t remote_jobs = 0;      // jobs rendered on other ranks.
+  double broadcast = 0.0;       // sending the header, state, job list and adjoint weights.
+  double local_render = 0.0;    // rendering rank 0's own jobs (storing them not included).
+  double imbalance = 0.0;       // waiting for a rank that was still rendering when rank 0 was done.
+  double gather = 0.0;          // the rest of the wait: receiving and decoding the results.
   int64_t broadcast_bytes = 0;  // per receiving rank.
   int64_t gather_bytes = 0;     // results received.
 };
@@ -84,8 +84,10 @@ class MpiViewRunner : public ViewRunner {
   const MpiViewStats& stats() const { return stats_; }
 
  private:
-  // The rank of every job: contiguous runs, rank 0's first, balanced by the measured costs.
-  std::vector<int> Assign(const RenderState& state, const std::vector<ViewJob>& jobs) const;
+  // The rank of every job: contiguous runs, rank 0's first, balanced by the measured costs
+  // (*cost: each job's) and the ranks' measured speeds.
+  std::vector<int> Assign(const RenderState& state, const std::vector<ViewJob>& jobs,
+                          std::vector<double>* cost) const;
   void BroadcastState(const RenderState& state, int64_t header[]);
 
   int size_ = 1;
@@ -96,6 +98,10 @@ class MpiViewRunner : public ViewRunner {
   std::vector<std::vector<char>> sent_parts_;
   // Last render seconds per (dataset view, pass), for the balance.
   std::map<std::pair<int, int>, double> cost_;
+  // Per rank: its share of the last evaluation's cost over the seconds it took (rank 0's
+  // includes storing the results it rendered), so that a rank that stores results or shares its
+  // cores gets less. 1 before any measurement.
+  std::vector<double> speed_;
 };
 
 // A worker's serve loop: renders its jobs of every evaluation until rank 0 stops it.

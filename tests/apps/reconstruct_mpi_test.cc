@@ -65,9 +65,9 @@ class ReconstructMpiTest : public ::testing::Test {
                              solver + " --out ";
     std::string out;
     ASSERT_EQ(testing::RunSft(args + tmp_.Join(solver + "1"), &out), 0) << out;
-    ASSERT_EQ(testing::RunCommand(mpirun_ + " -np 2 " + testing::SftBinary() + " " + args +
-                                      tmp_.Join(solver + "2"),
-                                  &out),
+    ASSERT_EQ(testing::RunCommand(
+                  mpirun_ + " -np 2 " + testing::SftBinary() + " " + args + tmp_.Join(solver + "2"),
+                  &out),
               0)
         << out;
     const std::set<std::string> files = ResultFiles(tmp_.Join(solver + "1"));
