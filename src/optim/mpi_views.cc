@@ -606,8 +606,17 @@ void MpiViewRunner::Run(const RenderState& state, const std::vector<ViewJob>& jo
   const double imbalance = std::clamp(last_ready - local_done, 0.0, waited);
   stats_.imbalance += imbalance;
   stats_.gather += waited - imbalance;
+  // A rank that had no jobs gets the fastest speed measured, so that it is tried again; no rank
+  // drops below a quarter of the fastest (one slow evaluation must not starve it for good).
+  double fastest = 0.0;
   for (int r = 0; r < size_; ++r) {
-    if (assigned[r] > 0.0 && busy[r] > 0.0) speed_[r] = assigned[r] / busy[r];
+    if (assigned[r] > 0.0 && busy[r] > 0.0) {
+      speed_[r] = assigned[r] / busy[r];
+      fastest = std::max(fastest, speed_[r]);
+    }
+  }
+  for (int r = 0; r < size_ && fastest > 0.0; ++r) {
+    speed_[r] = assigned[r] > 0.0 ? std::max(speed_[r], 0.25 * fastest) : fastest;
   }
   ++stats_.evaluations;
 }
