@@ -61,6 +61,7 @@ nlohmann::json MpiJson(const MpiViewStats& s) {
            {{"broadcast", s.broadcast},
             {"local_render", s.local_render},
             {"imbalance", s.imbalance},
+            {"worker_idle", s.worker_idle},
             {"gather", s.gather}}},
           {"broadcast_bytes", s.broadcast_bytes},
           {"gather_bytes", s.gather_bytes}};
@@ -109,9 +110,10 @@ Status RunBenchReconstruct(const BenchReconstructOptions& cli, const MpiSession*
     const MpiViewStats& m = runner->stats();
     std::printf(
         "mpi: %d ranks, %lld spread evaluations, %lld jobs rendered on other ranks; "
-        "rank 0: broadcast %.3f s, own renders %.3f s, imbalance %.3f s, gather %.3f s\n",
+        "rank 0: broadcast %.3f s, own renders %.3f s, imbalance %.3f s (workers idle %.3f s), "
+        "gather %.3f s\n",
         m.ranks, static_cast<long long>(m.evaluations), static_cast<long long>(m.remote_jobs),
-        m.broadcast, m.local_render, m.imbalance, m.gather);
+        m.broadcast, m.local_render, m.imbalance, m.worker_idle, m.gather);
   }
   std::fflush(stdout);
   if (!cli.json.empty()) {

@@ -240,6 +240,7 @@ nlohmann::json MpiMetrics(const MpiViewStats& s) {
              {{"broadcast", s.broadcast},
               {"local_render", s.local_render},
               {"imbalance", s.imbalance},
+              {"worker_idle", s.worker_idle},
               {"gather", s.gather}}},
             {"broadcast_bytes", s.broadcast_bytes},
             {"gather_bytes", s.gather_bytes}}}};

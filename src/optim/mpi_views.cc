@@ -604,6 +604,9 @@ void MpiViewRunner::Run(const RenderState& state, const std::vector<ViewJob>& jo
   }
   const double waited = std::max(0.0, Since(start) - local_done - storing);
   const double imbalance = std::clamp(last_ready - local_done, 0.0, waited);
+  double idle = 0.0;
+  for (int r = 1; r < size_; ++r) idle += std::max(0.0, local_done - busy[r]);
+  stats_.worker_idle += size_ > 1 ? idle / (size_ - 1) : 0.0;
   stats_.imbalance += imbalance;
   stats_.gather += waited - imbalance;
   // A rank that had no jobs gets the fastest speed measured, so that it is tried again; no rank

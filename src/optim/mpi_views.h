@@ -9,7 +9,8 @@
 //      evaluation (scene, positions, material, settings) and the job list with each job's rank;
 //      adjoint weights go to the job's rank alone;
 //   2. every rank renders its jobs in job order (the jobs are cut into contiguous runs, rank 0's
-//      first, balanced by each (view, pass)'s last measured render time);
+//      first, balanced by each (view, pass)'s last measured render time and each rank's last
+//      measured speed);
 //   3. rank 0 consumes its own results, then receives the others' in job order, so the render
 //      cache stores and sums (adjoint gradients) in the order a single process does: results are
 //      identical to the bit for any rank count.
@@ -34,11 +35,14 @@ namespace sft {
 // bytes it moved.
 struct MpiViewStats {
   int ranks = 1;
-  int64_t evaluations = 0;      // runs of jobs spread over the ranks.
-  int64_t remote_jobs = 0;      // jobs rendered on other ranks.
-  double broadcast = 0.0;       // sending the header, state, job list and adjoint weights.
-  double local_render = 0.0;    // rendering rank 0's own jobs (storing them not included).
-  double imbalance = 0.0;       // waiting for a rank that was still rendering when rank 0 was done.
+  int64_t evaluations = 0;    // runs of jobs spread over the ranks.
+  int64_t remote_jobs = 0;    // jobs rendered on other ranks.
+  double broadcast = 0.0;     // sending the header, state, job list and adjoint weights.
+  double local_render = 0.0;  // rendering rank 0's own jobs (storing them not included).
+  double imbalance = 0.0;     // waiting for a rank that was still rendering when rank 0 was done.
+  // The other side of the imbalance: per evaluation, the mean over the other ranks of the time
+  // they sat idle after their last result while rank 0 was still on its own share.
+  double worker_idle = 0.0;
   double gather = 0.0;          // the rest of the wait: receiving and decoding the results.
   int64_t broadcast_bytes = 0;  // per receiving rank.
   int64_t gather_bytes = 0;     // results received.

@@ -255,7 +255,7 @@ RenderState RenderCache::CurrentState() const {
   state.request = ActiveRequest();
   state.num_lights = params_->layout().num_lights;
   state.image_scale_log2 = options_.image_scale_log2;
-  for (int v : view_indices_) state.view_indices.push_back(v);
+  state.view_indices = view_indices_;
   return state;
 }
 
