@@ -9,7 +9,9 @@
 #include "apps/commands.h"
 #include "src/core/file_util.h"
 #include "src/eval/reconstruct_cost.h"
+#include "src/io/scene_setup.h"
 #include "src/optim/config.h"
+#include "src/optim/mpi_views.h"
 
 namespace sft {
 namespace {
@@ -51,7 +53,24 @@ Status MakeOptions(const BenchReconstructOptions& cli, ReconstructOptions* optio
   return Status::Ok();
 }
 
-Status RunBenchReconstruct(const BenchReconstructOptions& cli) {
+nlohmann::json MpiJson(const MpiViewStats& s) {
+  return {{"ranks", s.ranks},
+          {"evaluations", s.evaluations},
+          {"remote_jobs", s.remote_jobs},
+          {"seconds",
+           {{"broadcast", s.broadcast},
+            {"local_render", s.local_render},
+            {"imbalance", s.imbalance},
+            {"worker_idle", s.worker_idle},
+            {"gather", s.gather}}},
+          {"broadcast_bytes", s.broadcast_bytes},
+          {"gather_bytes", s.gather_bytes}};
+}
+
+// Under mpirun (rank 0): the handshake once the inputs are read, the views spread while
+// measuring. Null `session`: one process.
+Status RunBenchReconstruct(const BenchReconstructOptions& cli, const MpiSession* session,
+                           bool* agreed) {
   if (cli.dataset.empty() || cli.init.empty()) {
     return Status::Error("--dataset and --init are required");
   }
@@ -69,13 +88,37 @@ Status RunBenchReconstruct(const BenchReconstructOptions& cli) {
   Material material;
   SFT_RETURN_IF_ERROR(
       LoadMaterial(cli.material.empty() ? kInitialGuess : cli.material, mesh, &material));
+  std::unique_ptr<MpiViewRunner> runner;
+  if (session != nullptr) {
+    std::vector<int> views;
+    SFT_RETURN_IF_ERROR(
+        SelectViews(options.reconstruct.views, static_cast<int>(dataset.views.size()), &views));
+    *agreed = true;
+    SFT_RETURN_IF_ERROR(
+        MpiHandshake(*session, Status::Ok(), cli.dataset, static_cast<int>(views.size()), nullptr));
+    runner = std::make_unique<MpiViewRunner>(*session, 3600.0);
+    SetViewRunner(runner.get());
+  }
   ReconstructCostReport report;
-  SFT_RETURN_IF_ERROR(MeasureReconstructCost(dataset, mesh, material, options, &report));
+  const Status measured = MeasureReconstructCost(dataset, mesh, material, options, &report);
+  SetViewRunner(nullptr);
+  if (runner) runner->Stop();
+  SFT_RETURN_IF_ERROR(measured);
   std::printf("sft bench reconstruct: %s\n%s", cli.dataset.c_str(),
               ReconstructCostTable(report).c_str());
+  if (runner) {
+    const MpiViewStats& m = runner->stats();
+    std::printf(
+        "mpi: %d ranks, %lld spread evaluations, %lld jobs rendered on other ranks; "
+        "rank 0: broadcast %.3f s, own renders %.3f s, imbalance %.3f s (workers idle %.3f s), "
+        "gather %.3f s\n",
+        m.ranks, static_cast<long long>(m.evaluations), static_cast<long long>(m.remote_jobs),
+        m.broadcast, m.local_render, m.imbalance, m.worker_idle, m.gather);
+  }
   std::fflush(stdout);
   if (!cli.json.empty()) {
     nlohmann::json json = ReconstructCostToJson(report);
+    if (runner) json["mpi"] = MpiJson(runner->stats());
     json["dataset"] = cli.dataset;
     json["init"] = cli.init;
     SFT_RETURN_IF_ERROR(WriteTextFile(cli.json, json.dump(1) + "\n"));
@@ -114,7 +157,24 @@ CommandRunner AddBenchReconstructCommand(CLI::App* bench) {
   app->add_flag("--quiet", opts->quiet, "No per-iteration lines");
   return [app, opts]() {
     if (!app->parsed()) return -1;
-    const Status status = RunBenchReconstruct(*opts);
+    if (!MpiSession::Launched()) {
+      const Status status = RunBenchReconstruct(*opts, nullptr, nullptr);
+      return status.ok() ? 0 : PrintError("bench reconstruct", status);
+    }
+    // Under mpirun (src/optim/mpi_views.h): rank 0 measures, the others serve renders.
+    std::unique_ptr<MpiSession> session;
+    Status status = MpiSession::Start(&session);
+    if (!status.ok()) return PrintError("bench reconstruct", status);
+    if (session->rank() != 0) {
+      Dataset dataset;
+      status = MpiHandshake(*session, Status::Ok(), "", 0, &dataset);
+      if (status.ok()) status = ServeViews(*session, dataset);
+      return status.ok() ? 0 : 1;
+    }
+    bool agreed = false;
+    status = RunBenchReconstruct(*opts, session.get(), &agreed);
+    // An error before the handshake releases the workers through it.
+    if (!agreed) MpiHandshake(*session, status, opts->dataset, 0, nullptr);
     return status.ok() ? 0 : PrintError("bench reconstruct", status);
   };
 }

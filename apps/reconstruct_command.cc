@@ -3,8 +3,10 @@
 // file only configures the schedule, shows progress and writes the report. Ctrl-C stops after the
 // current solver iteration, writes a checkpoint and exits 130; `--resume OUT` continues from it.
 #include <atomic>
+#include <climits>
 #include <csignal>
 #include <cstdio>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <set>
 
@@ -17,6 +19,7 @@
 #include "src/geometry/mesh.h"
 #include "src/io/dataset.h"
 #include "src/optim/fitted_environment.h"
+#include "src/optim/mpi_views.h"
 #include "src/optim/run_outputs.h"
 #include "src/optim/schedule.h"
 #include "src/optim/schedule_config.h"
@@ -46,7 +49,13 @@ struct ReconstructCommandOptions {
   bool print_schedule = false;
   bool quiet = false;
   bool no_report = false;
+  double mpi_timeout = 3600.0;  // seconds rank 0 waits for a worker's result under mpirun.
 };
+
+// Called by PrepareSchedule once the run is settled, just before the schedule starts (and writes
+// into the output folder), with the dataset path and the stages.
+using BeforeStart = std::function<Status(const std::string& dataset, const Dataset&,
+                                         const std::vector<StageOptions>&)>;
 
 // The flat keys of the command line (flags override the config file's keys in every stage).
 Status FlagKeys(const ReconstructCommandOptions& cli, ScheduleConfig* config) {
@@ -129,7 +138,7 @@ Status UnknownLighting(const std::string& run, const ReconstructCommandOptions& 
 // Settles folders, stages and the schedule (fresh or resumed). Returns with *schedule null after
 // --print-schedule.
 Status PrepareSchedule(ReconstructCommandOptions* cli, Dataset* dataset,
-                       std::unique_ptr<Schedule>* schedule) {
+                       const BeforeStart& before_start, std::unique_ptr<Schedule>* schedule) {
   if (!(cli->reference_tolerance > 0.0 && cli->reference_tolerance <= 1.0)) {
     return Status::Error("--reference-tolerance: must be in (0, 1]");
   }
@@ -147,6 +156,7 @@ Status PrepareSchedule(ReconstructCommandOptions* cli, Dataset* dataset,
     if (cli->print_schedule) return PrintSchedule(stages);
     SFT_RETURN_IF_ERROR(CheckOutputDirectory(cli->out, {{cli->dataset}, {}}, "--resume"));
     SFT_RETURN_IF_ERROR(UnknownLighting(cli->resume, *cli, dataset));
+    if (before_start) SFT_RETURN_IF_ERROR(before_start(cli->dataset, *dataset, stages));
     return Schedule::Resume(*dataset, cli->out, stages, state.run_info, state.progress,
                             state.view_gains, schedule);
   }
@@ -178,18 +188,21 @@ Status PrepareSchedule(ReconstructCommandOptions* cli, Dataset* dataset,
       {"init", start.path},
       {"config", config.flat},
       {"schedule", config.stages.is_null() ? config.schedule : "explicit"}};
+  if (before_start) SFT_RETURN_IF_ERROR(before_start(cli->dataset, *dataset, stages));
   return Schedule::Start(*dataset, cli->out, stages, state, run_info, schedule);
 }
 
-Status RunReconstruct(const ReconstructCommandOptions& cli_in) {
+Status RunReconstruct(const ReconstructCommandOptions& cli_in, const BeforeStart& before_start = {},
+                      const std::function<nlohmann::json()>& extra_metrics = {}) {
   ReconstructCommandOptions cli = cli_in;
   // The reference first: a bad one must not leave an output folder behind.
   TriMesh reference;
   if (!cli.reference.empty()) SFT_RETURN_IF_ERROR(ReadMesh(cli.reference, &reference));
   Dataset dataset;
   std::unique_ptr<Schedule> schedule;
-  SFT_RETURN_IF_ERROR(PrepareSchedule(&cli, &dataset, &schedule));
+  SFT_RETURN_IF_ERROR(PrepareSchedule(&cli, &dataset, before_start, &schedule));
   if (!schedule) return Status::Ok();  // --print-schedule.
+  if (extra_metrics) schedule->SetExtraMetrics(extra_metrics);
   Progress progress("reconstruct", schedule->RemainingWork(), !cli.quiet);
   ScheduleCallbacks callbacks;
   callbacks.on_iteration = [&](const IterationRecord& record) {
@@ -220,6 +233,77 @@ Status RunReconstruct(const ReconstructCommandOptions& cli_in) {
               p.seconds, JoinPath(cli.out, "mesh.ply").c_str(),
               cli.no_report ? "(none)" : JoinPath(cli.out, "report.html").c_str());
   return Status::Ok();
+}
+
+// The smallest number of views any stage fits.
+int FittedViews(const Dataset& dataset, const std::vector<StageOptions>& stages) {
+  int fitted = INT_MAX;
+  for (const StageOptions& stage : stages) {
+    const size_t n = stage.fit.views.empty() ? dataset.views.size() : stage.fit.views.size();
+    fitted = std::min(fitted, static_cast<int>(n));
+  }
+  return fitted;
+}
+
+nlohmann::json MpiMetrics(const MpiViewStats& s) {
+  return {{"mpi",
+           {{"ranks", s.ranks},
+            {"evaluations", s.evaluations},
+            {"remote_jobs", s.remote_jobs},
+            {"seconds",
+             {{"broadcast", s.broadcast},
+              {"local_render", s.local_render},
+              {"imbalance", s.imbalance},
+              {"worker_idle", s.worker_idle},
+              {"gather", s.gather}}},
+            {"broadcast_bytes", s.broadcast_bytes},
+            {"gather_bytes", s.gather_bytes}}}};
+}
+
+// `sft reconstruct` under mpirun (src/optim/mpi_views.h): rank 0 runs the schedule with its
+// renders spread over the ranks; the others serve renders. Errors print on rank 0 only; every
+// rank exits non-zero when the ranks do not agree to start (the handshake).
+int RunReconstructMpi(const ReconstructCommandOptions& cli) {
+  std::unique_ptr<MpiSession> session;
+  Status status = MpiSession::Start(&session);
+  if (!status.ok()) {
+    PrintError("reconstruct", status);
+    return 1;
+  }
+  if (session->rank() != 0) {
+    Dataset dataset;
+    status = MpiHandshake(*session, Status::Ok(), "", 0, &dataset);
+    if (status.ok()) status = ServeViews(*session, dataset);
+    return status.ok() ? 0 : 1;
+  }
+  std::unique_ptr<MpiViewRunner> runner;
+  bool agreed = false;
+  const BeforeStart before_start = [&](const std::string& path, const Dataset& dataset,
+                                       const std::vector<StageOptions>& stages) {
+    agreed = true;
+    SFT_RETURN_IF_ERROR(
+        MpiHandshake(*session, Status::Ok(), path, FittedViews(dataset, stages), nullptr));
+    runner = std::make_unique<MpiViewRunner>(*session, cli.mpi_timeout);
+    if (session->size() > 1) SetViewRunner(runner.get());
+    return Status::Ok();
+  };
+  const auto metrics = [&]() { return runner ? MpiMetrics(runner->stats()) : nlohmann::json{}; };
+  if (!(cli.mpi_timeout > 0.0)) {
+    status = Status::Error("--mpi-timeout: must be > 0 seconds");
+  } else {
+    status = RunReconstruct(cli, before_start, metrics);
+  }
+  SetViewRunner(nullptr);
+  if (!agreed) {
+    // Stopped before the run (a usage error, or --print-schedule): the workers are released
+    // through the handshake, with rank 0's error.
+    const Status verdict = MpiHandshake(*session, status, cli.dataset, INT_MAX, nullptr);
+    if (verdict.ok()) MpiViewRunner(*session, cli.mpi_timeout).Stop();
+  }
+  if (runner) runner->Stop();
+  if (status.ok()) return 0;
+  PrintError("reconstruct", status);
+  return g_interrupted ? 130 : 1;
 }
 
 }  // namespace
@@ -269,11 +353,20 @@ CommandRunner SetupReconstructCommand(CLI::App* app) {
                 "Print the effective stage list and exit (nothing is written)");
   app->add_flag("--quiet", opts->quiet, "No progress line");
   app->add_flag("--no-report", opts->no_report, "Do not write OUT/report.html");
+  app->add_option("--mpi-timeout", opts->mpi_timeout,
+                  "Under mpirun: seconds rank 0 waits for another rank's renders before it ends "
+                  "the run")
+      ->capture_default_str();
   return [opts]() {
     // First, so that an interrupt at any point stops cleanly (a checkpoint exists only once the
     // first outer iteration has run; the message says so).
     g_interrupted = false;
     std::signal(SIGINT, OnInterrupt);
+    if (MpiSession::Launched()) {
+      const int code = RunReconstructMpi(*opts);
+      std::signal(SIGINT, SIG_DFL);
+      return code;
+    }
     const Status status = RunReconstruct(*opts);
     std::signal(SIGINT, SIG_DFL);
     if (status.ok()) return 0;

@@ -25,6 +25,8 @@ PACKAGES=(
   libcli11-dev nlohmann-json3-dev libzip-dev
   # glTF 2.0 writer (sft export)
   libtinygltf-dev
+  # MPI: `mpirun -np N sft reconstruct` spreads the views over ranks (CMake option SFT_MPI)
+  libopenmpi-dev openmpi-bin
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev
 )

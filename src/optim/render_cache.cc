@@ -2,12 +2,17 @@
 
 #include <glog/logging.h>
 
+#include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <opencv2/imgproc.hpp>
 
 namespace sft {
 namespace {
+
+// Scene identities (RenderState::scene_id), unique within the process.
+std::atomic<int64_t> g_next_scene_id{1};
 
 double Seconds(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -172,6 +177,10 @@ Status RenderCache::Create(const Dataset& dataset, const DatasetViews* views,
   c->material_ = material;
   params->Positions(&c->scene_positions_);
   c->scene_ = std::make_unique<RenderScene>(c->scene_positions_, faces);
+  c->scene_id_ = g_next_scene_id++;
+  c->faces_ = faces;
+  c->scene_build_positions_ = c->scene_positions_;
+  c->runner_ = CurrentViewRunner();
   for (int v : view_indices) {
     Image target;
     SFT_RETURN_IF_ERROR(LoadViewImage(dataset, v, &target));
@@ -231,18 +240,66 @@ void RenderCache::UpdateScene() {
 }
 
 ViewSetup RenderCache::ScaledView(int v) const {
-  ViewSetup view = views_->views[view_indices_[v]];
-  view.camera = DownscaledCamera(view.camera, options_.image_scale_log2);
-  for (PointLight& light : view.point_lights) {
-    if (light.light_index >= 0) light.intensity *= params_->LightScale(light.light_index);
-  }
-  if (view.environment_light_index >= 0) {
-    view.environment_scale *= params_->LightScale(view.environment_light_index);
-    if (params_->layout().FitsEnvironment(view.environment_light_index)) {
-      view.environment = fitted_environment_.get();
-    }
+  ViewSetup view =
+      ScaledViewSetup(*views_, view_indices_[v], options_.image_scale_log2, params_->LightScales());
+  if (params_->layout().FitsEnvironment(view.environment_light_index)) {
+    view.environment = fitted_environment_.get();
   }
   return view;
+}
+
+DerivativeRequest RenderCache::ActiveRequest() const {
+  DerivativeRequest request = options_.edges;
+  request.params = active_.ToSelection();
+  request.jacobian_rows = false;
+  request.adjoint_weights = nullptr;
+  return request;
+}
+
+RenderState RenderCache::CurrentState() const {
+  RenderState state;
+  state.scene_id = scene_id_;
+  state.build_positions = scene_build_positions_;
+  state.faces = faces_;
+  state.positions = scene_positions_;
+  state.material = material_;
+  state.light_scales = params_->LightScales();
+  state.render = options_.render;
+  state.request = ActiveRequest();
+  state.num_lights = params_->layout().num_lights;
+  state.image_scale_log2 = options_.image_scale_log2;
+  state.view_indices = view_indices_;
+  return state;
+}
+
+void RenderCache::RunJobs(const std::vector<ViewJob>& jobs, const ViewRunner::Consume& consume) {
+  UpdateScene();
+  const RenderOptions& render = options_.render;
+  const DerivativeRequest request = ActiveRequest();
+  const ParameterLayout& layout = params_->layout();
+  const auto local = [&](const ViewJob& job, ViewResult* result) {
+    RenderViewJob(*scene_, material_, ScaledView(job.view), render, request, layout, job, result);
+  };
+  double consume_seconds = 0.0;
+  const auto timed_consume = [&](size_t k, ViewResult* result) {
+    const auto start = std::chrono::steady_clock::now();
+    consume(k, result);
+    ++renders_;
+    consume_seconds += Seconds(start);
+  };
+  const auto start = std::chrono::steady_clock::now();
+  // A fitted environment is not sent to other ranks (RenderState has no texels): such fits render
+  // every view here.
+  if (runner_ == nullptr || params_->has_environment()) {
+    for (size_t k = 0; k < jobs.size(); ++k) {
+      ViewResult result;
+      local(jobs[k], &result);
+      timed_consume(k, &result);
+    }
+  } else {
+    runner_->Run(CurrentState(), jobs, local, timed_consume);
+  }
+  render_seconds_ += std::max(0.0, Seconds(start) - consume_seconds);
 }
 
 Image RenderCache::RenderPassImage(int v, RenderPass pass) {
@@ -260,56 +317,37 @@ Image RenderCache::RenderPassImage(int v, RenderPass pass) {
 }
 
 void RenderCache::Render(bool rows) {
-  UpdateScene();
   stale_ = false;
   finite_ = true;
   non_finite_ = 0;
-  RenderOptions render = options_.render;
-  render.seed = seed_;
-  DerivativeRequest request = options_.edges;
-  request.params = active_.ToSelection();
-  request.jacobian_rows = true;
+  const bool with_rows = rows && active_.Any();
+  std::vector<ViewJob> jobs(num_views());
   for (int v = 0; v < num_views(); ++v) {
-    const auto start = std::chrono::steady_clock::now();
-    Image image;
-    const ViewSetup view = ScaledView(v);
-    // Samples or outputs lost to non-finite values make the evaluation fail (finite_), so that
-    // the solver rejects the step instead of fitting to a biased or infinite render.
-    RenderStats stats;
-    if (rows && active_.Any()) {
-      DerivativeOutput output;
-      RenderViewWithDerivatives(*scene_, material_, view, render, request, params_->layout(),
-                                &image, &output, &stats);
-      render_seconds_ += Seconds(start);
-      non_finite_ += stats.NonFinite();
-      StoreRender(v, image, &output.rows);
-    } else {
-      RenderView(*scene_, material_, view, render, &image, &stats);
-      render_seconds_ += Seconds(start);
-      non_finite_ += stats.NonFinite();
-      StoreRender(v, image, nullptr);
-    }
-    ++renders_;
+    jobs[v].view = v;
+    jobs[v].pass = with_rows ? ViewPass::kRows : ViewPass::kImage;
+    jobs[v].seed = seed_;
   }
-  has_rows_ = rows && active_.Any();
+  // Samples or outputs lost to non-finite values make the evaluation fail (finite_), so that
+  // the solver rejects the step instead of fitting to a biased or infinite render.
+  RunJobs(jobs, [&](size_t k, ViewResult* result) {
+    non_finite_ += result->non_finite;
+    StoreRender(jobs[k].view, result->image, with_rows ? &result->rows : nullptr);
+  });
+  has_rows_ = with_rows;
 }
 
 bool RenderCache::RenderSome(const std::vector<int>& views) {
-  UpdateScene();
   finite_ = true;
   non_finite_ = 0;
-  RenderOptions render = options_.render;
-  render.seed = seed_;
-  for (int v : views) {
-    const auto start = std::chrono::steady_clock::now();
-    Image image;
-    RenderStats stats;
-    RenderView(*scene_, material_, ScaledView(v), render, &image, &stats);
-    render_seconds_ += Seconds(start);
-    non_finite_ += stats.NonFinite();
-    StoreRender(v, image, nullptr);
-    ++renders_;
+  std::vector<ViewJob> jobs(views.size());
+  for (size_t k = 0; k < views.size(); ++k) {
+    jobs[k].view = views[k];
+    jobs[k].seed = seed_;
   }
+  RunJobs(jobs, [&](size_t k, ViewResult* result) {
+    non_finite_ += result->non_finite;
+    StoreRender(jobs[k].view, result->image, nullptr);
+  });
   has_rows_ = false;
   stale_ = true;
   return finite_;
@@ -463,41 +501,73 @@ Image RenderCache::AdjointWeights(int v) const {
   return acc;
 }
 
+namespace {
+
+// The seed of the adjoint pass at render seed `seed`: any fixed odd multiplier gives a seed stream
+// disjoint in practice from the renders' seeds.
+uint64_t AdjointSeed(uint64_t seed, bool independent) {
+  return independent ? seed * 0xd1342543de82ef95ull + 1ull : seed;
+}
+
+// The residual is of g ⊙ I: the renderer's Jᵀw needs the weights times the gains.
+Image GainedWeights(const Image& weights, const Eigen::Vector3d& gain) {
+  if (gain == Eigen::Vector3d::Ones()) return weights;
+  Image gained = ToRgb(weights);
+  ApplyGains(gain, &gained);
+  return gained;
+}
+
+}  // namespace
+
 bool RenderCache::AddAdjointGradient(int v, const Image& weights, std::vector<double>* gradient) {
-  // Any fixed odd multiplier gives a seed stream disjoint in practice from the renders' seeds.
-  const uint64_t seed =
-      options_.independent_gradient ? seed_ * 0xd1342543de82ef95ull + 1ull : seed_;
-  return AddAdjointGradientWith(v, weights, plan(), seed, gradient);
+  return AddAdjointGradientWith(v, weights, plan(),
+                                AdjointSeed(seed_, options_.independent_gradient), gradient);
+}
+
+bool RenderCache::AddAdjointGradients(const std::vector<int>& views,
+                                      std::vector<double>* gradient) {
+  std::vector<ViewJob> jobs(views.size());
+  std::vector<Image> weights(views.size());
+  for (size_t k = 0; k < views.size(); ++k) {
+    weights[k] = AdjointWeights(views[k]);
+    jobs[k].view = views[k];
+    jobs[k].pass = ViewPass::kAdjoint;
+    jobs[k].seed = AdjointSeed(seed_, options_.independent_gradient);
+    jobs[k].weights = GainedWeights(weights[k], params_->Gains(views[k]));
+  }
+  bool finite = true;
+  RunJobs(jobs, [&](size_t k, ViewResult* result) {
+    finite = AddGradientResult(views[k], weights[k], *result, gradient) && finite;
+  });
+  return finite;
 }
 
 bool RenderCache::AddAdjointGradientWith(int v, const Image& weights, const EffectPlan& plan,
                                          uint64_t seed, std::vector<double>* gradient) {
   UpdateScene();
   RenderOptions render = options_.render;
-  DerivativeRequest request = options_.edges;
+  DerivativeRequest request = ActiveRequest();
   plan.ApplyTo(&render, &request);
-  render.seed = seed;
-  request.params = active_.ToSelection();
-  // The residual is of g ⊙ I: the renderer's Jᵀw needs the weights times the gains.
-  const Eigen::Vector3d gain = params_->Gains(v);
-  Image gained_weights;
-  if (gain != Eigen::Vector3d::Ones()) {
-    gained_weights = ToRgb(weights);
-    ApplyGains(gain, &gained_weights);
-  }
-  request.adjoint_weights = gained_weights.empty() ? &weights : &gained_weights;
+  ViewJob job;
+  job.view = v;
+  job.pass = ViewPass::kAdjoint;
+  job.seed = seed;
+  job.weights = GainedWeights(weights, params_->Gains(v));
   const auto start = std::chrono::steady_clock::now();
-  Image image;
-  DerivativeOutput output;
-  RenderStats stats;
-  RenderViewWithDerivatives(*scene_, material_, ScaledView(v), render, request, params_->layout(),
-                            &image, &output, &stats);
+  ViewResult result;
+  RenderViewJob(*scene_, material_, ScaledView(v), render, request, params_->layout(), job,
+                &result);
   render_seconds_ += Seconds(start);
   ++renders_;
+  return AddGradientResult(v, weights, result, gradient);
+}
+
+bool RenderCache::AddGradientResult(int v, const Image& weights, const ViewResult& result,
+                                    std::vector<double>* gradient) const {
   const ParameterLayout& layout = params_->layout();
-  bool finite = stats.NonFinite() == 0;
+  bool finite = result.non_finite == 0;
   for (int i = 0; i < layout.size(); ++i) {
-    double g = output.gradient[i];
+    double g = result.gradient[i];
     if (layout.KindOf(i) == ParameterKind::kLight) {
       g /= params_->LightScale(i - layout.LightOffset());
     }
@@ -507,7 +577,7 @@ bool RenderCache::AddAdjointGradientWith(int v, const Image& weights, const Effe
   if (active_.exposure && params_->GainFitted(v)) {
     // ∂/∂g_c Σ_p w_pc g_c I_pc = Σ_p w_pc I_pc, with I this pass's own (ungained) render, so that
     // with independent_gradient the gains' gradient is as independent of the residual as the rest.
-    const Image rgb = ToRgb(image);
+    const Image rgb = ToRgb(result.image);
     const Image w = ToRgb(weights);
     double sum[3] = {0.0, 0.0, 0.0};
     for (size_t i = 0; i < rgb.data.size(); ++i) {

@@ -17,6 +17,11 @@
 // entries ∂(g_c I_c)/∂g_c = I_c. The adjoint pass likewise hands the renderer the weights times
 // g and adds Σ_p w_pc I_pc to the gains' gradient. The gains are exact (linear); I_c is the Monte
 // Carlo render of the same pass.
+//
+// Every render of Render, RenderSome and AddAdjointGradients is a ViewJob (view_jobs.h) run by the
+// ViewRunner installed when the cache was created (CurrentViewRunner): in this process, or spread
+// over MPI ranks (mpi_views.h). Results come back in view order, so the stored renders, rows and
+// gradient sums are the same to the bit either way.
 #ifndef SFT_OPTIM_RENDER_CACHE_H_
 #define SFT_OPTIM_RENDER_CACHE_H_
 
@@ -33,6 +38,7 @@
 #include "src/optim/effect_planner.h"
 #include "src/optim/parameters.h"
 #include "src/optim/pyramid.h"
+#include "src/optim/view_jobs.h"
 #include "src/render/render.h"
 
 namespace sft {
@@ -171,12 +177,25 @@ class RenderCache : public ceres::EvaluationCallback {
   // (no rows stored); adds it to *gradient (layout size). Returns false on non-finite output or
   // samples dropped as not finite (RenderStats::NonFinite).
   bool AddAdjointGradient(int v, const Image& weights, std::vector<double>* gradient);
+  // AddAdjointGradient of every view in `views` with its AdjointWeights, added to *gradient in
+  // the order of `views` (the views' renders may run on other ranks). False when any is not
+  // finite.
+  bool AddAdjointGradients(const std::vector<int>& views, std::vector<double>* gradient);
 
  private:
   RenderCache() = default;
   void UpdateScene();
   ViewSetup ScaledView(int v) const;
   void StoreRender(int v, const Image& image, const JacobianRows* rows);
+  // Runs `jobs` at the current parameters through the runner (or here) and hands each result to
+  // `consume` in job order; render_seconds_ gets the wall time outside `consume`.
+  void RunJobs(const std::vector<ViewJob>& jobs, const ViewRunner::Consume& consume);
+  RenderState CurrentState() const;
+  DerivativeRequest ActiveRequest() const;
+  // Adds view v's adjoint result (of `weights`, ungained) to *gradient: light entries divided by
+  // their scales, the exposure gains' part from the result's image. False when not finite.
+  bool AddGradientResult(int v, const Image& weights, const ViewResult& result,
+                         std::vector<double>* gradient) const;
 
   const Dataset* dataset_ = nullptr;
   const DatasetViews* views_ = nullptr;
@@ -191,6 +210,11 @@ class RenderCache : public ceres::EvaluationCallback {
   // views of that light render with instead of the dataset's, rebuilt when its texels change.
   std::unique_ptr<EnvironmentMap> fitted_environment_;
   std::vector<float> fitted_texels_;
+  // The scene's identity for other ranks (RenderState::scene_id), its faces and first positions.
+  int64_t scene_id_ = 0;
+  std::vector<Eigen::Vector3i> faces_;
+  std::vector<Eigen::Vector3d> scene_build_positions_;
+  ViewRunner* runner_ = nullptr;  // null: every job is rendered here.
   std::vector<ViewTargets> targets_;
   std::vector<std::vector<std::unique_ptr<LevelCache>>> levels_;
   uint64_t seed_ = 0;

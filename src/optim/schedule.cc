@@ -479,6 +479,7 @@ Status Schedule::Checkpoint() {
   info["outer"] = outer_records_;
   info["topology_changes"] = topology_records_;
   info["stages"] = stage_records_;
+  if (extra_metrics_) info.update(extra_metrics_());
   SFT_RETURN_IF_ERROR(WriteMetrics(out_, records_, phase_records_, info));
   RunState state;
   // Gains are part of the state once a stage fits them (or a resumed run brought some).

@@ -104,6 +104,10 @@ class Schedule {
   // Runs the remaining stages; writes a checkpoint after every outer iteration and when stopped.
   Status Run(const ScheduleCallbacks& callbacks);
 
+  // Called at every checkpoint; its object is merged into metrics.json's top level (e.g. the MPI
+  // time split of `mpirun` runs).
+  void SetExtraMetrics(std::function<nlohmann::json()> extra) { extra_metrics_ = std::move(extra); }
+
   bool finished() const { return progress_.stage >= static_cast<int>(stages_.size()); }
   bool stopped() const { return stopped_; }
   const ScheduleProgress& progress() const { return progress_; }
@@ -171,6 +175,7 @@ class Schedule {
   double session_start_ = 0.0;  // steady-clock seconds when this session's Run began.
   double seconds_at_start_ = 0.0;
   bool stopped_ = false;
+  std::function<nlohmann::json()> extra_metrics_;
 };
 
 }  // namespace sft

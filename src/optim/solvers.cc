@@ -227,9 +227,8 @@ bool AdjointObjective::EvaluateViews(const double* x, const std::vector<int>& vi
   std::vector<double> full;
   if (gradient != nullptr) {
     full.assign(params_->size(), 0.0);
-    for (int v : batch) {
-      if (!cache_->AddAdjointGradient(v, cache_->AdjointWeights(v), &full)) return false;
-    }
+    // Summed in view order, wherever the views were rendered (view_jobs.h).
+    if (!cache_->AddAdjointGradients(batch, &full)) return false;
     if (scale != 1.0) {
       for (double& g : full) g *= scale;
     }

@@ -1,0 +1,702 @@
+#include "src/optim/mpi_views.h"
+
+#include <glog/logging.h>
+
+#include <algorithm>
+#include <chrono>
+#include <climits>
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
+#include <thread>
+#include <type_traits>
+
+#ifdef SFT_HAVE_MPI
+#include <mpi.h>
+#endif
+
+#include "src/io/scene_setup.h"
+#include "src/render/scene.h"
+
+namespace sft {
+
+bool MpiSession::Launched() {
+#ifdef SFT_HAVE_MPI
+  // Open MPI's launcher (OMPI_COMM_WORLD_SIZE), PMIx launchers (PMIX_RANK) and MPICH's Hydra
+  // (PMI_SIZE) set these in every process they start.
+  for (const char* name : {"OMPI_COMM_WORLD_SIZE", "PMIX_RANK", "PMI_SIZE"}) {
+    if (std::getenv(name) != nullptr) return true;
+  }
+#endif
+  return false;
+}
+
+#ifndef SFT_HAVE_MPI
+
+Status MpiSession::Start(std::unique_ptr<MpiSession>*) {
+  return Status::Error("sft was built without MPI (CMake option SFT_MPI)");
+}
+MpiSession::~MpiSession() = default;
+Status MpiHandshake(const MpiSession&, const Status& own, const std::string&, int, Dataset*) {
+  return own;
+}
+MpiViewRunner::MpiViewRunner(const MpiSession&, double) {}
+MpiViewRunner::~MpiViewRunner() = default;
+void MpiViewRunner::Run(const RenderState&, const std::vector<ViewJob>&, const LocalRender&,
+                        const Consume&) {
+  LOG(FATAL) << "MpiViewRunner without MPI";
+}
+void MpiViewRunner::Stop() {}
+Status ServeViews(const MpiSession&, const Dataset&) {
+  return Status::Error("sft was built without MPI (CMake option SFT_MPI)");
+}
+
+#else  // SFT_HAVE_MPI
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double Since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// Message tags: the job index k's adjoint weights travel with tag 2k + 1, its result with 2k + 2.
+int WeightsTag(size_t k) { return static_cast<int>(2 * k + 1); }
+int ResultTag(size_t k) { return static_cast<int>(2 * k + 2); }
+
+enum Command : int64_t { kStop = 0, kRun = 1 };
+// The broadcast header: command, job count, state parts' mask, state bytes, job-list bytes.
+constexpr int kHeaderSize = 5;
+// The state's parts, each sent only when it changed.
+enum StatePart { kScenePart = 0, kPositionsPart, kMaterialPart, kSettingsPart, kNumParts };
+
+// Values copied as bytes: trivially copyable types and fixed-size Eigen vectors (plain arrays of
+// their scalars, though their copy constructors are user-provided).
+template <typename T>
+struct Plain : std::is_trivially_copyable<T> {};
+template <typename S, int R, int C, int O, int MR, int MC>
+struct Plain<Eigen::Matrix<S, R, C, O, MR, MC> > : std::is_trivially_copyable<S> {
+  static_assert(R != Eigen::Dynamic && C != Eigen::Dynamic, "fixed-size Eigen types only");
+};
+
+// Byte buffers of plain values and vectors of them. A message is only ever read by the same
+// executable that wrote it, so values are copied as they are in memory.
+class ByteWriter {
+ public:
+  template <typename T>
+  void Put(const T& value) {
+    static_assert(Plain<T>::value, "plain values only");
+    const char* p = reinterpret_cast<const char*>(&value);
+    bytes_.insert(bytes_.end(), p, p + sizeof(T));
+  }
+  template <typename T>
+  void PutVector(const std::vector<T>& values) {
+    static_assert(Plain<T>::value, "plain values only");
+    Put<uint64_t>(values.size());
+    const char* p = reinterpret_cast<const char*>(values.data());
+    bytes_.insert(bytes_.end(), p, p + values.size() * sizeof(T));
+  }
+  std::vector<char>& bytes() { return bytes_; }
+
+ private:
+  std::vector<char> bytes_;
+};
+
+class ByteReader {
+ public:
+  explicit ByteReader(const std::vector<char>& bytes) : bytes_(bytes) {}
+  template <typename T>
+  T Get() {
+    T value;
+    CHECK_LE(at_ + sizeof(T), bytes_.size()) << "MPI message shorter than its contents";
+    std::memcpy(&value, bytes_.data() + at_, sizeof(T));
+    at_ += sizeof(T);
+    return value;
+  }
+  template <typename T>
+  std::vector<T> GetVector() {
+    const uint64_t n = Get<uint64_t>();
+    CHECK_LE(at_ + n * sizeof(T), bytes_.size()) << "MPI message shorter than its contents";
+    std::vector<T> values(n);
+    std::memcpy(static_cast<void*>(values.data()), bytes_.data() + at_, n * sizeof(T));
+    at_ += n * sizeof(T);
+    return values;
+  }
+
+ private:
+  const std::vector<char>& bytes_;
+  size_t at_ = 0;
+};
+
+// The options structs are written field by field; a new field must be added here too, or other
+// ranks would render without it (and results would depend on the rank count). The sizes below
+// are those of the fields written (x86-64, libstdc++).
+#if defined(__x86_64__) && defined(__GLIBCXX__)
+static_assert(sizeof(DerivativeRequest) == 56, "a DerivativeRequest field: write it below");
+static_assert(sizeof(RenderOptions) == 80, "a RenderOptions field: write it below");
+static_assert(sizeof(Effects) == 5, "an Effects field: write it below");
+#endif
+
+void PutRenderOptions(const RenderOptions& r, ByteWriter* w) {
+  CHECK(r.sampling_material == nullptr) << "detached sampling is not sent to other ranks";
+  w->Put(r.spp);
+  w->Put(r.bounces);
+  w->Put(r.effects);
+  w->Put(r.seed);
+  w->Put(r.threads);
+  w->Put(r.pass);
+  w->Put(r.shading);
+}
+
+RenderOptions GetRenderOptions(ByteReader* r) {
+  RenderOptions o;
+  o.spp = r->Get<int>();
+  o.bounces = r->Get<int>();
+  o.effects = r->Get<Effects>();
+  o.seed = r->Get<uint64_t>();
+  o.threads = r->Get<int>();
+  o.pass = r->Get<RenderPass>();
+  o.shading = r->Get<Shading>();
+  return o;
+}
+
+void PutRequest(const DerivativeRequest& d, ByteWriter* w) {
+  w->Put(d.params);
+  w->Put(d.jacobian_rows);
+  w->Put(d.primary_edge_ratio);
+  w->Put(d.shadow_edge_ratio);
+  w->Put(d.secondary_edge_samples);
+  w->Put(d.texel_edge_ratio);
+  w->Put(d.normal_sliding);
+}
+
+DerivativeRequest GetRequest(ByteReader* r) {
+  DerivativeRequest d;
+  d.params = r->Get<ParameterSelection>();
+  d.jacobian_rows = r->Get<bool>();
+  d.primary_edge_ratio = r->Get<double>();
+  d.shadow_edge_ratio = r->Get<double>();
+  d.secondary_edge_samples = r->Get<double>();
+  d.texel_edge_ratio = r->Get<double>();
+  d.normal_sliding = r->Get<bool>();
+  return d;
+}
+
+void PutMeshColors(const MeshColors& colors, ByteWriter* w) {
+  w->Put<int>(colors.num_faces());
+  w->Put<int>(colors.resolution());
+  w->Put<int>(colors.channels());
+  w->PutVector(colors.values());
+}
+
+MeshColors GetMeshColors(ByteReader* r) {
+  const int faces = r->Get<int>(), resolution = r->Get<int>(), channels = r->Get<int>();
+  MeshColors colors(faces, resolution, channels);
+  colors.values() = r->GetVector<double>();
+  CHECK_EQ(colors.values().size(), static_cast<size_t>(colors.num_texels()) * channels);
+  return colors;
+}
+
+// The serialized parts of a state (StatePart order).
+std::vector<std::vector<char> > StateParts(const RenderState& s) {
+  std::vector<std::vector<char> > parts(kNumParts);
+  ByteWriter scene, positions, material, settings;
+  scene.Put(s.scene_id);
+  scene.PutVector(s.build_positions);
+  scene.PutVector(s.faces);
+  positions.PutVector(s.positions);
+  CHECK(!s.material.has_uv_textures()) << "UV-texture materials are not fitted";
+  PutMeshColors(s.material.albedo, &material);
+  PutMeshColors(s.material.roughness, &material);
+  material.Put(s.material.specular);
+  material.Put(s.material.fresnel);
+  settings.PutVector(s.light_scales);
+  PutRenderOptions(s.render, &settings);
+  PutRequest(s.request, &settings);
+  settings.Put(s.num_lights);
+  settings.Put(s.image_scale_log2);
+  settings.PutVector(s.view_indices);
+  parts[kScenePart] = std::move(scene.bytes());
+  parts[kPositionsPart] = std::move(positions.bytes());
+  parts[kMaterialPart] = std::move(material.bytes());
+  parts[kSettingsPart] = std::move(settings.bytes());
+  return parts;
+}
+
+// Applies one serialized part to a worker's state.
+void ApplyStatePart(int part, const std::vector<char>& bytes, RenderState* s) {
+  ByteReader r(bytes);
+  switch (part) {
+    case kScenePart:
+      s->scene_id = r.Get<int64_t>();
+      s->build_positions = r.GetVector<Eigen::Vector3d>();
+      s->faces = r.GetVector<Eigen::Vector3i>();
+      break;
+    case kPositionsPart:
+      s->positions = r.GetVector<Eigen::Vector3d>();
+      break;
+    case kMaterialPart:
+      s->material.albedo = GetMeshColors(&r);
+      s->material.roughness = GetMeshColors(&r);
+      s->material.specular = r.Get<double>();
+      s->material.fresnel = r.Get<FresnelMode>();
+      break;
+    case kSettingsPart:
+      s->light_scales = r.GetVector<double>();
+      s->render = GetRenderOptions(&r);
+      s->request = GetRequest(&r);
+      s->num_lights = r.Get<int>();
+      s->image_scale_log2 = r.Get<int>();
+      s->view_indices = r.GetVector<int>();
+      break;
+  }
+}
+
+void PutImage(const Image& image, ByteWriter* w) {
+  w->Put(image.width);
+  w->Put(image.height);
+  w->Put(image.channels);
+  w->PutVector(image.data);
+}
+
+Image GetImage(ByteReader* r) {
+  Image image;
+  image.width = r->Get<int>();
+  image.height = r->Get<int>();
+  image.channels = r->Get<int>();
+  image.data = r->GetVector<float>();
+  return image;
+}
+
+// A result on the wire: the ViewResult and the worker's seconds from the run's header to the
+// result being ready (the balance's measure of when that rank finished).
+void PutResult(const ViewResult& result, double ready_seconds, ByteWriter* w) {
+  PutImage(result.image, w);
+  w->Put(result.rows.width);
+  w->Put(result.rows.height);
+  w->PutVector(result.rows.offsets);
+  w->PutVector(result.rows.entries);
+  w->PutVector(result.gradient);
+  w->Put(result.non_finite);
+  w->Put(result.seconds);
+  w->Put(ready_seconds);
+}
+
+void GetResult(const std::vector<char>& bytes, ViewResult* result, double* ready_seconds) {
+  ByteReader r(bytes);
+  result->image = GetImage(&r);
+  result->rows.width = r.Get<int>();
+  result->rows.height = r.Get<int>();
+  result->rows.offsets = r.GetVector<uint64_t>();
+  result->rows.entries = r.GetVector<JacobianEntry>();
+  result->gradient = r.GetVector<double>();
+  result->non_finite = r.Get<int64_t>();
+  result->seconds = r.Get<double>();
+  *ready_seconds = r.Get<double>();
+}
+
+// Messages larger than MPI's int count go in pieces of at most kPiece bytes, after their size.
+constexpr int64_t kPiece = int64_t{1} << 30;
+
+// Starts sending `bytes` (which must live until the requests complete) to `dest`.
+void SendBytes(const std::vector<char>& bytes, int dest, int tag, int64_t* size,
+               std::vector<MPI_Request>* requests) {
+  *size = static_cast<int64_t>(bytes.size());
+  requests->emplace_back();
+  MPI_Isend(size, 1, MPI_INT64_T, dest, tag, MPI_COMM_WORLD, &requests->back());
+  for (int64_t at = 0; at < *size; at += kPiece) {
+    const int n = static_cast<int>(std::min(kPiece, *size - at));
+    requests->emplace_back();
+    MPI_Isend(bytes.data() + at, n, MPI_BYTE, dest, tag, MPI_COMM_WORLD, &requests->back());
+  }
+}
+
+// Waits for `request` at most `timeout` seconds (polling; MPI has no timed wait). On timeout the
+// whole job ends: a rank that stopped answering cannot be waited out.
+void WaitBounded(MPI_Request* request, double timeout, int source) {
+  const auto start = Clock::now();
+  int done = 0;
+  MPI_Test(request, &done, MPI_STATUS_IGNORE);
+  while (!done) {
+    if (Since(start) > timeout) {
+      LOG(ERROR) << "rank " << source << " did not answer for " << timeout
+                 << " s (--mpi-timeout): ending the run";
+      MPI_Abort(MPI_COMM_WORLD, 1);
+    }
+    std::this_thread::sleep_for(std::chrono::microseconds(100));
+    MPI_Test(request, &done, MPI_STATUS_IGNORE);
+  }
+}
+
+// Waits for `requests` without spinning: Open MPI's waits poll at full speed, and a worker that
+// waits that way (for rank 0's next evaluation, or for rank 0 to take its results) takes a core
+// from rank 0's renders and Ceres on a shared machine. Polls every 200 µs instead.
+void WaitIdle(std::vector<MPI_Request>* requests) {
+  int done = 0;
+  MPI_Testall(static_cast<int>(requests->size()), requests->data(), &done, MPI_STATUSES_IGNORE);
+  while (!done) {
+    std::this_thread::sleep_for(std::chrono::microseconds(200));
+    MPI_Testall(static_cast<int>(requests->size()), requests->data(), &done, MPI_STATUSES_IGNORE);
+  }
+}
+
+// The evaluation header, broadcast non-blocking on every rank (a blocking and a non-blocking
+// broadcast do not match), so that idle workers wait for it without spinning.
+void BroadcastHeader(int64_t header[]) {
+  std::vector<MPI_Request> request(1);
+  MPI_Ibcast(header, kHeaderSize, MPI_INT64_T, 0, MPI_COMM_WORLD, &request[0]);
+  WaitIdle(&request);
+}
+
+// Receives a message sent by SendBytes (`timeout` > 0 bounds each wait; 0 waits forever).
+std::vector<char> ReceiveBytes(int source, int tag, double timeout) {
+  int64_t size = 0;
+  MPI_Request request;
+  MPI_Irecv(&size, 1, MPI_INT64_T, source, tag, MPI_COMM_WORLD, &request);
+  if (timeout > 0) {
+    WaitBounded(&request, timeout, source);
+  } else {
+    MPI_Wait(&request, MPI_STATUS_IGNORE);
+  }
+  std::vector<char> bytes(static_cast<size_t>(size));
+  for (int64_t at = 0; at < size; at += kPiece) {
+    const int n = static_cast<int>(std::min(kPiece, size - at));
+    MPI_Recv(bytes.data() + at, n, MPI_BYTE, source, tag, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+  }
+  return bytes;
+}
+
+void BroadcastBytes(std::vector<char>* bytes, int64_t size) {
+  bytes->resize(static_cast<size_t>(size));
+  for (int64_t at = 0; at < size; at += kPiece) {
+    const int n = static_cast<int>(std::min(kPiece, size - at));
+    MPI_Bcast(bytes->data() + at, n, MPI_BYTE, 0, MPI_COMM_WORLD);
+  }
+}
+
+void BroadcastString(std::string* s) {
+  int64_t size = static_cast<int64_t>(s->size());
+  MPI_Bcast(&size, 1, MPI_INT64_T, 0, MPI_COMM_WORLD);
+  std::vector<char> bytes(s->begin(), s->end());
+  BroadcastBytes(&bytes, size);
+  s->assign(bytes.begin(), bytes.end());
+}
+
+// The job list as broadcast: view, pass, seed and rank of each job, and the size of its adjoint
+// weights (sent to that rank alone, into a buffer it posts as soon as it has the list).
+struct JobEntry {
+  int32_t view;
+  int32_t pass;
+  uint64_t seed;
+  int32_t rank;
+  int32_t width, height, channels;
+};
+
+}  // namespace
+
+Status MpiSession::Start(std::unique_ptr<MpiSession>* session) {
+  int provided = 0;
+  if (MPI_Init_thread(nullptr, nullptr, MPI_THREAD_FUNNELED, &provided) != MPI_SUCCESS) {
+    return Status::Error("MPI_Init_thread failed");
+  }
+  std::unique_ptr<MpiSession> s(new MpiSession());
+  MPI_Comm_rank(MPI_COMM_WORLD, &s->rank_);
+  MPI_Comm_size(MPI_COMM_WORLD, &s->size_);
+  *session = std::move(s);
+  return Status::Ok();
+}
+
+MpiSession::~MpiSession() { MPI_Finalize(); }
+
+Status MpiHandshake(const MpiSession& session, const Status& own, const std::string& dataset_path,
+                    int fitted_views, Dataset* dataset) {
+  // 1. Rank 0's status and the path.
+  // Non-blocking: workers wait here without spinning while rank 0 prepares (e.g. carves a hull).
+  int64_t go = own.ok() ? 1 : 0;
+  std::vector<MPI_Request> request(1);
+  MPI_Ibcast(&go, 1, MPI_INT64_T, 0, MPI_COMM_WORLD, &request[0]);
+  WaitIdle(&request);
+  if (!go) {
+    return session.rank() == 0 ? own : Status::Error("rank 0 stopped before the run");
+  }
+  std::string path = dataset_path;
+  BroadcastString(&path);
+  // 2. The workers load the dataset and its view setups (environment maps, memory check).
+  std::string error;
+  if (session.rank() != 0) {
+    Status status = ReadDataset(path, dataset);
+    DatasetViews views;
+    if (status.ok()) status = MakeDatasetViews(*dataset, &views);
+    if (!status.ok()) error = status.message();
+  }
+  // 3. Rank 0 collects the errors and decides.
+  int length = static_cast<int>(error.size());
+  std::vector<int> lengths(session.rank() == 0 ? session.size() : 0);
+  MPI_Gather(&length, 1, MPI_INT, lengths.data(), 1, MPI_INT, 0, MPI_COMM_WORLD);
+  std::vector<int> offsets(lengths.size(), 0);
+  int total = 0;
+  for (size_t r = 0; r < lengths.size(); ++r) {
+    offsets[r] = total;
+    total += lengths[r];
+  }
+  std::vector<char> all(static_cast<size_t>(std::max(total, 1)));
+  MPI_Gatherv(error.data(), length, MPI_CHAR, all.data(), lengths.data(), offsets.data(), MPI_CHAR,
+              0, MPI_COMM_WORLD);
+  std::string verdict;
+  if (session.rank() == 0) {
+    for (size_t r = 1; r < lengths.size() && verdict.empty(); ++r) {
+      if (lengths[r] > 0) {
+        verdict = "rank " + std::to_string(r) + ": " +
+                  std::string(all.data() + offsets[r], static_cast<size_t>(lengths[r])) +
+                  " (every rank reads the dataset from the same path: " + path + ")";
+      }
+    }
+    if (verdict.empty() && session.size() > fitted_views) {
+      verdict = "mpirun -np " + std::to_string(session.size()) + ": more ranks than the " +
+                std::to_string(fitted_views) + " views fitted (use at most " +
+                std::to_string(fitted_views) + " ranks)";
+    }
+  }
+  BroadcastString(&verdict);
+  return verdict.empty() ? Status::Ok() : Status::Error(verdict);
+}
+
+MpiViewRunner::MpiViewRunner(const MpiSession& session, double timeout_seconds)
+    : size_(session.size()), timeout_(timeout_seconds), speed_(session.size(), 1.0) {
+  stats_.ranks = size_;
+}
+
+MpiViewRunner::~MpiViewRunner() { Stop(); }
+
+void MpiViewRunner::Stop() {
+  if (stopped_) return;
+  stopped_ = true;
+  int64_t header[kHeaderSize] = {kStop, 0, 0, 0, 0};
+  BroadcastHeader(header);
+}
+
+std::vector<int> MpiViewRunner::Assign(const RenderState& state, const std::vector<ViewJob>& jobs,
+                                       std::vector<double>* cost) const {
+  cost->assign(jobs.size(), 1.0);
+  double total = 0.0;
+  for (size_t k = 0; k < jobs.size(); ++k) {
+    const auto it = cost_.find({state.view_indices[jobs[k].view], static_cast<int>(jobs[k].pass)});
+    if (it != cost_.end()) (*cost)[k] = std::max(it->second, 1e-6);
+    total += (*cost)[k];
+  }
+  // Rank r's share of the total cost is proportional to its measured speed; job k goes to the
+  // rank whose share holds the middle of its cost.
+  std::vector<double> end(size_);
+  double speeds = 0.0;
+  for (int r = 0; r < size_; ++r) speeds += speed_[r];
+  double sum = 0.0;
+  for (int r = 0; r < size_; ++r) {
+    sum += speed_[r];
+    end[r] = total * sum / speeds;
+  }
+  std::vector<int> rank(jobs.size());
+  double before = 0.0;
+  int r = 0;
+  for (size_t k = 0; k < jobs.size(); ++k) {
+    const double middle = before + 0.5 * (*cost)[k];
+    while (r < size_ - 1 && middle > end[r]) ++r;
+    rank[k] = r;
+    before += (*cost)[k];
+  }
+  return rank;
+}
+
+void MpiViewRunner::BroadcastState(const RenderState& state, int64_t header[]) {
+  std::vector<std::vector<char> > parts = StateParts(state);
+  if (sent_parts_.size() != parts.size()) sent_parts_.assign(parts.size(), {});
+  // A new scene resends the positions too: the workers rebuild from the build positions.
+  if (parts[kScenePart] != sent_parts_[kScenePart]) sent_parts_[kPositionsPart].clear();
+  std::vector<char> changed;
+  int64_t mask = 0;
+  for (size_t p = 0; p < parts.size(); ++p) {
+    if (parts[p] == sent_parts_[p]) continue;
+    mask |= int64_t{1} << p;
+    ByteWriter w;
+    w.PutVector(parts[p]);
+    changed.insert(changed.end(), w.bytes().begin(), w.bytes().end());
+    sent_parts_[p] = std::move(parts[p]);
+  }
+  header[2] = mask;
+  header[3] = static_cast<int64_t>(changed.size());
+  BroadcastHeader(header);
+  if (!changed.empty()) BroadcastBytes(&changed, header[3]);
+  stats_.broadcast_bytes += header[3];
+}
+
+void MpiViewRunner::Run(const RenderState& state, const std::vector<ViewJob>& jobs,
+                        const LocalRender& local, const Consume& consume) {
+  CHECK(!stopped_);
+  const auto start = Clock::now();
+  std::vector<double> cost;
+  const std::vector<int> rank = Assign(state, jobs, &cost);
+  // Per rank: the assigned cost and the seconds it took (rank 0: its own renders and storing
+  // them; a worker: from its header to its last result), for the next evaluation's speeds.
+  std::vector<double> assigned(size_, 0.0), busy(size_, 0.0);
+  for (size_t k = 0; k < jobs.size(); ++k) assigned[rank[k]] += cost[k];
+  std::vector<JobEntry> entries(jobs.size());
+  for (size_t k = 0; k < jobs.size(); ++k) {
+    const Image& w = jobs[k].weights;
+    entries[k] = {
+        jobs[k].view, static_cast<int32_t>(jobs[k].pass), jobs[k].seed, rank[k], w.width, w.height,
+        w.channels};
+  }
+  ByteWriter job_list;
+  job_list.PutVector(entries);
+  int64_t header[kHeaderSize] = {kRun, static_cast<int64_t>(jobs.size()), 0, 0,
+                                 static_cast<int64_t>(job_list.bytes().size())};
+  BroadcastState(state, header);
+  BroadcastBytes(&job_list.bytes(), header[4]);
+  stats_.broadcast_bytes += header[4];
+  // Adjoint weights to the ranks that render those jobs. Delivered before rank 0 renders: rank 0
+  // makes no MPI progress while it renders, and the workers' first jobs need them.
+  std::vector<MPI_Request> requests;
+  std::vector<int> request_ranks;
+  for (size_t k = 0; k < jobs.size(); ++k) {
+    if (rank[k] == 0 || jobs[k].pass != ViewPass::kAdjoint) continue;
+    request_ranks.push_back(rank[k]);
+    const std::vector<float>& data = jobs[k].weights.data;
+    CHECK_LT(data.size(), static_cast<size_t>(INT32_MAX));
+    requests.emplace_back();
+    MPI_Isend(data.data(), static_cast<int>(data.size()), MPI_FLOAT, rank[k], WeightsTag(k),
+              MPI_COMM_WORLD, &requests.back());
+    stats_.broadcast_bytes += static_cast<int64_t>(data.size() * sizeof(float));
+  }
+  for (size_t r = 0; r < requests.size(); ++r) {
+    WaitBounded(&requests[r], timeout_, request_ranks[r]);
+  }
+  const double broadcast_seconds = Since(start);
+  stats_.broadcast += broadcast_seconds;
+  // Rank 0's own jobs (the first run of jobs), consumed as they finish.
+  size_t k = 0;
+  for (; k < jobs.size() && rank[k] == 0; ++k) {
+    const auto render_start = Clock::now();
+    ViewResult result;
+    local(jobs[k], &result);
+    stats_.local_render += Since(render_start);
+    cost_[{state.view_indices[jobs[k].view], static_cast<int>(jobs[k].pass)}] = result.seconds;
+    consume(k, &result);
+  }
+  const double local_done = Since(start);
+  busy[0] = local_done - broadcast_seconds;
+  // The others', in job order. Rank 0 waits whenever it is not storing a result; of that wait,
+  // the time the slowest rank was still rendering after rank 0 had finished is imbalance (the
+  // workers' clocks start at the header, within a broadcast latency of rank 0's), the rest gather.
+  double storing = 0.0, last_ready = 0.0;
+  for (; k < jobs.size(); ++k) {
+    const std::vector<char> bytes = ReceiveBytes(rank[k], ResultTag(k), timeout_);
+    stats_.gather_bytes += static_cast<int64_t>(bytes.size());
+    ViewResult result;
+    double ready = 0.0;
+    GetResult(bytes, &result, &ready);
+    last_ready = std::max(last_ready, ready);
+    busy[rank[k]] = std::max(busy[rank[k]], ready);
+    cost_[{state.view_indices[jobs[k].view], static_cast<int>(jobs[k].pass)}] = result.seconds;
+    ++stats_.remote_jobs;
+    const auto store_start = Clock::now();
+    consume(k, &result);
+    storing += Since(store_start);
+  }
+  const double waited = std::max(0.0, Since(start) - local_done - storing);
+  const double imbalance = std::clamp(last_ready - local_done, 0.0, waited);
+  double idle = 0.0;
+  for (int r = 1; r < size_; ++r) idle += std::max(0.0, local_done - busy[r]);
+  stats_.worker_idle += size_ > 1 ? idle / (size_ - 1) : 0.0;
+  stats_.imbalance += imbalance;
+  stats_.gather += waited - imbalance;
+  // A rank that had no jobs gets the fastest speed measured, so that it is tried again; no rank
+  // drops below a quarter of the fastest (one slow evaluation must not starve it for good).
+  double fastest = 0.0;
+  for (int r = 0; r < size_; ++r) {
+    if (assigned[r] > 0.0 && busy[r] > 0.0) {
+      speed_[r] = assigned[r] / busy[r];
+      fastest = std::max(fastest, speed_[r]);
+    }
+  }
+  for (int r = 0; r < size_ && fastest > 0.0; ++r) {
+    speed_[r] = assigned[r] > 0.0 ? std::max(speed_[r], 0.25 * fastest) : fastest;
+  }
+  ++stats_.evaluations;
+}
+
+Status ServeViews(const MpiSession& session, const Dataset& dataset) {
+  DatasetViews views;
+  SFT_RETURN_IF_ERROR(MakeDatasetViews(dataset, &views));
+  RenderState state;
+  std::unique_ptr<RenderScene> scene;
+  int64_t scene_id = -1;
+  std::vector<Eigen::Vector3d> scene_positions;
+  for (;;) {
+    int64_t header[kHeaderSize];
+    BroadcastHeader(header);
+    const auto start = Clock::now();
+    if (header[0] == kStop) return Status::Ok();
+    if (header[3] > 0) {
+      std::vector<char> changed;
+      BroadcastBytes(&changed, header[3]);
+      ByteReader r(changed);
+      for (int p = 0; p < kNumParts; ++p) {
+        if (header[2] & (int64_t{1} << p)) ApplyStatePart(p, r.GetVector<char>(), &state);
+      }
+    }
+    std::vector<char> job_bytes;
+    BroadcastBytes(&job_bytes, header[4]);
+    ByteReader job_reader(job_bytes);
+    const std::vector<JobEntry> entries = job_reader.GetVector<JobEntry>();
+    if (state.scene_id != scene_id) {
+      scene = std::make_unique<RenderScene>(state.build_positions, state.faces);
+      scene_positions = state.build_positions;
+      scene_id = state.scene_id;
+    }
+    if (state.positions != scene_positions) {
+      scene->SetVertices(state.positions);
+      scene_positions = state.positions;
+    }
+    // Receives for this rank's adjoint weights, posted at once (rank 0 waits for their delivery).
+    std::vector<Image> weights(entries.size());
+    std::vector<MPI_Request> weight_requests(entries.size(), MPI_REQUEST_NULL);
+    for (size_t k = 0; k < entries.size(); ++k) {
+      const JobEntry& e = entries[k];
+      if (e.rank != session.rank() || e.pass != static_cast<int32_t>(ViewPass::kAdjoint)) continue;
+      weights[k] = Image(e.width, e.height, e.channels);
+      MPI_Irecv(weights[k].data.data(), static_cast<int>(weights[k].data.size()), MPI_FLOAT, 0,
+                WeightsTag(k), MPI_COMM_WORLD, &weight_requests[k]);
+    }
+    // Results are sent as they are ready; their buffers live until every send completed.
+    std::vector<std::vector<char> > results;
+    std::vector<int64_t> sizes(entries.size());
+    std::vector<MPI_Request> requests;
+    results.reserve(entries.size());
+    for (size_t k = 0; k < entries.size(); ++k) {
+      if (entries[k].rank != session.rank()) continue;
+      ViewJob job;
+      job.view = entries[k].view;
+      job.pass = static_cast<ViewPass>(entries[k].pass);
+      job.seed = entries[k].seed;
+      if (job.pass == ViewPass::kAdjoint) {
+        std::vector<MPI_Request> request = {weight_requests[k]};
+        WaitIdle(&request);
+        job.weights = std::move(weights[k]);
+      }
+      ViewResult result;
+      const ViewSetup view = ScaledViewSetup(views, state.view_indices[job.view],
+                                             state.image_scale_log2, state.light_scales);
+      RenderViewJob(*scene, state.material, view, state.render, state.request, state.num_lights,
+                    job, &result);
+      ByteWriter w;
+      PutResult(result, Since(start), &w);
+      results.push_back(std::move(w.bytes()));
+      SendBytes(results.back(), 0, ResultTag(k), &sizes[k], &requests);
+    }
+    WaitIdle(&requests);
+  }
+}
+
+#endif  // SFT_HAVE_MPI
+
+}  // namespace sft

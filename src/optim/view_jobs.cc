@@ -1,0 +1,57 @@
+#include "src/optim/view_jobs.h"
+
+#include "src/render/camera.h"
+
+namespace sft {
+namespace {
+
+ViewRunner* g_view_runner = nullptr;
+
+}  // namespace
+
+ViewSetup ScaledViewSetup(const DatasetViews& views, int dataset_view, int image_scale_log2,
+                          const std::vector<double>& light_scales) {
+  ViewSetup view = views.views[dataset_view];
+  view.camera = DownscaledCamera(view.camera, image_scale_log2);
+  for (PointLight& light : view.point_lights) {
+    if (light.light_index >= 0) light.intensity *= light_scales[light.light_index];
+  }
+  if (view.environment_light_index >= 0) {
+    view.environment_scale *= light_scales[view.environment_light_index];
+  }
+  return view;
+}
+
+void RenderViewJob(const RenderScene& scene, const Material& material, const ViewSetup& view,
+                   const RenderOptions& render_options, const DerivativeRequest& request_options,
+                   int num_lights, const ViewJob& job, ViewResult* result) {
+  RenderViewJob(scene, material, view, render_options, request_options,
+                MakeParameterLayout(scene, material, num_lights), job, result);
+}
+
+void RenderViewJob(const RenderScene& scene, const Material& material, const ViewSetup& view,
+                   const RenderOptions& render_options, const DerivativeRequest& request_options,
+                   const ParameterLayout& layout, const ViewJob& job, ViewResult* result) {
+  RenderOptions render = render_options;
+  render.seed = job.seed;
+  RenderStats stats;
+  if (job.pass == ViewPass::kImage) {
+    RenderView(scene, material, view, render, &result->image, &stats);
+  } else {
+    DerivativeRequest request = request_options;
+    request.jacobian_rows = job.pass == ViewPass::kRows;
+    request.adjoint_weights = job.pass == ViewPass::kAdjoint ? &job.weights : nullptr;
+    DerivativeOutput output;
+    RenderViewWithDerivatives(scene, material, view, render, request, layout, &result->image,
+                              &output, &stats);
+    result->rows = std::move(output.rows);
+    result->gradient = std::move(output.gradient);
+  }
+  result->non_finite = stats.NonFinite();
+  result->seconds = stats.seconds;
+}
+
+void SetViewRunner(ViewRunner* runner) { g_view_runner = runner; }
+ViewRunner* CurrentViewRunner() { return g_view_runner; }
+
+}  // namespace sft

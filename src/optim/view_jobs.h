@@ -1,0 +1,101 @@
+// The unit of work of the render cache: one fitted view rendered in one pass at one point of the
+// fit. A job's result depends only on the job and the point (scene, material, light scales,
+// render options: the RenderState), never on the process or thread that renders it: each view's
+// samples are seeded by the job's seed and the dataset view index (ViewSetup::view_index), and
+// the renderer reduces in tile order. This is what lets the views of a reconstruction be spread
+// over MPI ranks (src/optim/mpi_views.h) with results identical to a single process.
+//
+// The render cache builds the jobs of one evaluation and hands them to a ViewRunner, which
+// renders them (all locally, or a share on each rank) and gives back each result in job order, so
+// that everything summed over views (the adjoint gradient) is summed in the same order however
+// the views were spread.
+#ifndef SFT_OPTIM_VIEW_JOBS_H_
+#define SFT_OPTIM_VIEW_JOBS_H_
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include "src/core/image.h"
+#include "src/geometry/material.h"
+#include "src/io/scene_setup.h"
+#include "src/render/derivatives.h"
+#include "src/render/render.h"
+#include "src/render/scene.h"
+
+namespace sft {
+
+// What a job renders: the image only, the image with Jacobian rows (LM, dogleg), or the image
+// with the adjoint gradient Jᵀw for the job's weights (L-BFGS, Adam).
+enum class ViewPass : int32_t { kImage = 0, kRows = 1, kAdjoint = 2 };
+
+struct ViewJob {
+  int view = 0;  // the render cache's view index (RenderState::view_indices maps it).
+  ViewPass pass = ViewPass::kImage;
+  uint64_t seed = 0;  // RenderOptions::seed of this render.
+  Image weights;      // kAdjoint: the per-pixel RGB weights w (exposure gains applied).
+};
+
+struct ViewResult {
+  Image image;                   // the render as RenderView returns it (RGBA, ungained).
+  JacobianRows rows;             // kRows: the renderer's rows (light entries at scale 1·s_l).
+  std::vector<double> gradient;  // kAdjoint: layout-size Jᵀw (light entries at scale 1·s_l).
+  int64_t non_finite = 0;        // RenderStats::NonFinite() of the render.
+  double seconds = 0.0;          // the render's wall time on the rank that ran it.
+};
+
+// The point every job of one evaluation is rendered at.
+struct RenderState {
+  // Identifies the RenderScene (its faces and the positions its BVH was built from). The scene
+  // of a new id is built from `build_positions` and then moved to `positions`, as the render
+  // cache's own scene is (an Embree refit keeps the first build's tree, so two scenes agree to
+  // the bit only with the same first positions).
+  int64_t scene_id = 0;
+  std::vector<Eigen::Vector3d> build_positions;
+  std::vector<Eigen::Vector3i> faces;
+  std::vector<Eigen::Vector3d> positions;  // current vertex positions.
+  Material material;                       // mesh colors (no UV textures).
+  std::vector<double> light_scales;        // per dataset light.
+  RenderOptions render;                    // spp, bounces, effects, threads, shading.
+  DerivativeRequest request;               // derivative kinds and edge budgets (no weights).
+  int num_lights = 0;                      // the parameter layout's light count.
+  int image_scale_log2 = 0;                // RenderCacheOptions::image_scale_log2.
+  std::vector<int> view_indices;           // dataset view of each render-cache view.
+};
+
+// View `dataset_view` of `views` as the fit renders it: its camera downscaled by
+// 2^-image_scale_log2, its lights' intensities times their scales.
+ViewSetup ScaledViewSetup(const DatasetViews& views, int dataset_view, int image_scale_log2,
+                          const std::vector<double>& light_scales);
+
+// Renders `job` of `view` (its ScaledViewSetup) on `scene` with `material` and the options; the
+// request's jacobian_rows and adjoint_weights follow the job's pass.
+void RenderViewJob(const RenderScene& scene, const Material& material, const ViewSetup& view,
+                   const RenderOptions& render, const DerivativeRequest& request, int num_lights,
+                   const ViewJob& job, ViewResult* result);
+// The same with the parameter index space given (RenderViewWithDerivatives' layout form: a fitted
+// environment's texels).
+void RenderViewJob(const RenderScene& scene, const Material& material, const ViewSetup& view,
+                   const RenderOptions& render, const DerivativeRequest& request,
+                   const ParameterLayout& layout, const ViewJob& job, ViewResult* result);
+
+// Renders the jobs of one evaluation. `local` renders one job in this process (on the render
+// cache's own scene); `consume` receives every job's result, in job order, exactly once.
+class ViewRunner {
+ public:
+  using LocalRender = std::function<void(const ViewJob&, ViewResult*)>;
+  using Consume = std::function<void(size_t job, ViewResult* result)>;
+  virtual ~ViewRunner() = default;
+  virtual void Run(const RenderState& state, const std::vector<ViewJob>& jobs,
+                   const LocalRender& local, const Consume& consume) = 0;
+};
+
+// The runner render caches created from now on use; null (the default) renders every job in
+// this process. `sft reconstruct` under mpirun installs its MPI runner on rank 0 for the run.
+void SetViewRunner(ViewRunner* runner);
+ViewRunner* CurrentViewRunner();
+
+}  // namespace sft
+
+#endif  // SFT_OPTIM_VIEW_JOBS_H_

@@ -1,0 +1,125 @@
+// `mpirun -np N sft reconstruct` (src/optim/mpi_views.h): the same mesh and material to the last
+// bit as one process, with LM (Jacobian rows) and with Adam (adjoint gradients); wrong usage is
+// one line and a non-zero exit. Skipped when sft was built without MPI or mpirun is absent.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <set>
+#include <string>
+
+#include "tests/testing/synth_dataset.h"
+#include "tests/testing/temp_dir.h"
+
+namespace sft {
+namespace {
+
+namespace fs = std::filesystem;
+using ::testing::HasSubstr;
+
+// "mpirun --oversubscribe [--allow-run-as-root]" (more ranks than this machine's cores; root
+// in containers), or "" when there is none.
+std::string Mpirun() {
+  const std::string mpirun = SFT_MPIEXEC;
+  if (mpirun.empty() || !fs::exists(mpirun)) return "";
+  return mpirun + " --oversubscribe" + (geteuid() == 0 ? " --allow-run-as-root" : "");
+}
+
+// Every output of a run whose bytes are its result (not timings): the meshes, the material and
+// its mesh-colors files, the light scales, the stages' normal images.
+std::set<std::string> ResultFiles(const std::string& dir) {
+  const std::set<std::string> skip = {"metrics.json", "metrics.csv", "state.json", "report.html"};
+  std::set<std::string> files;
+  for (const auto& entry : fs::recursive_directory_iterator(dir)) {
+    const std::string name = fs::relative(entry.path(), dir).string();
+    if (entry.is_regular_file() && skip.count(name) == 0) files.insert(name);
+  }
+  return files;
+}
+
+class ReconstructMpiTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    mpirun_ = Mpirun();
+    if (mpirun_.empty()) GTEST_SKIP() << "no MPI (built without SFT_MPI or mpirun missing)";
+    ASSERT_EQ(testing::SynthIcosphere(tmp_.Join("ds"),
+                                      "--cameras 4 --zooms 1 --res 24 --spp 16 --bounces 1 "
+                                      "--material '{\"albedo\": [0.6, 0.5, 0.4], "
+                                      "\"roughness\": 0.5}'"),
+              "");
+    std::string out;
+    ASSERT_EQ(testing::RunSft("perturb --mesh " + tmp_.Join("ds/gt/mesh.ply") + " --out " +
+                                  tmp_.Join("init.ply") + " --amplitude 0.02 --seed 2",
+                              &out),
+              0)
+        << out;
+  }
+
+  // One process, then 2 ranks: every result file must be identical.
+  void ExpectSameAcrossRanks(const std::string& solver) {
+    const std::string args = "reconstruct --quiet --no-report --dataset " + tmp_.Join("ds") +
+                             " --init " + tmp_.Join("init.ply") +
+                             " --spp 4 --bounces 1 --steps 2 --outer 1 --phases alternate"
+                             " --threads 1 --solver " +
+                             solver + " --out ";
+    std::string out;
+    ASSERT_EQ(testing::RunSft(args + tmp_.Join(solver + "1"), &out), 0) << out;
+    ASSERT_EQ(testing::RunCommand(
+                  mpirun_ + " -np 2 " + testing::SftBinary() + " " + args + tmp_.Join(solver + "2"),
+                  &out),
+              0)
+        << out;
+    const std::set<std::string> files = ResultFiles(tmp_.Join(solver + "1"));
+    EXPECT_EQ(files, ResultFiles(tmp_.Join(solver + "2")));
+    for (const char* file : {"mesh.ply", "material.json"}) EXPECT_EQ(files.count(file), 1u) << file;
+    for (const std::string& file : files) {
+      const std::string one = testing::ReadTestFile(tmp_.Join(solver + "1/" + file));
+      EXPECT_FALSE(one.empty()) << file;
+      EXPECT_TRUE(one == testing::ReadTestFile(tmp_.Join(solver + "2/" + file)))
+          << solver << ": " << file << " differs between 1 and 2 ranks";
+    }
+    // Rank 0 reports where its time went; the other rank rendered views.
+    const std::string metrics = testing::ReadTestFile(tmp_.Join(solver + "2/metrics.json"));
+    EXPECT_THAT(metrics, HasSubstr("\"mpi\""));
+    EXPECT_THAT(metrics, HasSubstr("\"imbalance\""));
+    EXPECT_THAT(metrics, ::testing::Not(HasSubstr("\"remote_jobs\":0")));
+  }
+
+  testing::TempDir tmp_;
+  std::string mpirun_;
+};
+
+TEST_F(ReconstructMpiTest, LevenbergMarquardtIsBitIdenticalOnTwoRanks) {
+  ExpectSameAcrossRanks("lm");
+}
+
+TEST_F(ReconstructMpiTest, AdamIsBitIdenticalOnTwoRanks) { ExpectSameAcrossRanks("adam"); }
+
+// More ranks than views, and a worker that cannot read the dataset (its working directory has
+// no "ds"): one error line on rank 0, a non-zero exit, nothing hangs, nothing is written.
+TEST_F(ReconstructMpiTest, WrongUsageIsOneLine) {
+  const std::string args = " reconstruct --quiet --no-report --dataset ds --init " +
+                           tmp_.Join("init.ply") + " --steps 1 --outer 1 --threads 1 --out ";
+  std::string out;
+  EXPECT_NE(testing::RunCommand("cd " + tmp_.path() + " && " + mpirun_ + " -np 5 " +
+                                    testing::SftBinary() + args + tmp_.Join("five"),
+                                &out),
+            0);
+  EXPECT_THAT(out, HasSubstr("more ranks than the 4 views fitted"));
+  EXPECT_FALSE(fs::exists(tmp_.Join("five/state.json")));
+
+  fs::create_directories(tmp_.Join("elsewhere"));
+  EXPECT_NE(testing::RunCommand(mpirun_ + " -np 1 --wdir " + tmp_.path() + " " +
+                                    testing::SftBinary() + args + tmp_.Join("unshared") +
+                                    " : -np 1 --wdir " + tmp_.Join("elsewhere") + " " +
+                                    testing::SftBinary() + args + tmp_.Join("unshared"),
+                                &out),
+            0);
+  EXPECT_THAT(out, HasSubstr("rank 1: "));
+  EXPECT_THAT(out, HasSubstr("every rank reads the dataset from the same path: ds"));
+  EXPECT_FALSE(fs::exists(tmp_.Join("unshared/state.json")));
+}
+
+}  // namespace
+}  // namespace sft
