@@ -134,12 +134,13 @@ class ByteReader {
 // are those of the fields written (x86-64, libstdc++).
 #if defined(__x86_64__) && defined(__GLIBCXX__)
 static_assert(sizeof(DerivativeRequest) == 56, "a DerivativeRequest field: write it below");
-static_assert(sizeof(RenderOptions) == 80, "a RenderOptions field: write it below");
+static_assert(sizeof(RenderOptions) == 88, "a RenderOptions field: write it below");
 static_assert(sizeof(Effects) == 5, "an Effects field: write it below");
 #endif
 
 void PutRenderOptions(const RenderOptions& r, ByteWriter* w) {
-  CHECK(r.sampling_material == nullptr) << "detached sampling is not sent to other ranks";
+  CHECK(r.sampling_material == nullptr && r.sampling_environment == nullptr)
+      << "detached sampling is not sent to other ranks";
   w->Put(r.spp);
   w->Put(r.bounces);
   w->Put(r.effects);
