@@ -13,8 +13,8 @@
 #include <vector>
 
 #include "src/core/status.h"
-#include "src/export/bake.h"
-#include "src/export/uv_atlas.h"
+#include "src/atlas/bake.h"
+#include "src/atlas/uv_atlas.h"
 #include "src/geometry/material.h"
 
 namespace sft {
