@@ -12,9 +12,9 @@
 #ifndef SFT_ATLAS_BAKE_H_
 #define SFT_ATLAS_BAKE_H_
 
+#include "src/atlas/uv_atlas.h"
 #include "src/core/image.h"
 #include "src/core/status.h"
-#include "src/atlas/uv_atlas.h"
 #include "src/geometry/material.h"
 
 namespace sft {

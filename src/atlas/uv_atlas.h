@@ -16,8 +16,8 @@
 #include <string>
 #include <vector>
 
-#include "src/core/status.h"
 #include "src/atlas/charts.h"
+#include "src/core/status.h"
 
 namespace sft {
 

@@ -4,9 +4,9 @@
 #include <chrono>
 #include <cmath>
 
-#include "src/core/file_util.h"
 #include "src/atlas/bake.h"
 #include "src/atlas/texture_size.h"
+#include "src/core/file_util.h"
 #include "src/export/export_formats.h"
 #include "src/geometry/material.h"
 #include "src/geometry/uv_texel_charts.h"

@@ -2,10 +2,10 @@
 // (docs/export.md): OBJ + MTL + PNG textures, glTF 2.0 binary, PLY with vertex colours.
 //
 // Reads REC/mesh.ply and REC/material.json (+ its .meshcolors files; after a uv stage its PNG
-// textures and mesh.obj's UVs, written as they are instead of re-baked), and the dataset — --dataset,
-// else the one REC/state.json names — for its source frame and cameras; writes only into the
-// output folder (fixed names, export_formats.h), each file atomically, plus export.json (what was
-// written and the atlas's numbers).
+// textures and mesh.obj's UVs, written as they are instead of re-baked), and the dataset —
+// --dataset, else the one REC/state.json names — for its source frame and cameras; writes only into
+// the output folder (fixed names, export_formats.h), each file atomically, plus export.json (what
+// was written and the atlas's numbers).
 //
 // Frames. Positions are exported in the dataset's source frame (p_source = s·R·p + t,
 // "source_from_world" of imported captures) when the dataset records one, else in sft's world
@@ -21,8 +21,8 @@
 #include <string>
 #include <vector>
 
-#include "src/core/status.h"
 #include "src/atlas/uv_atlas.h"
+#include "src/core/status.h"
 #include "src/geometry/mesh.h"
 #include "src/io/dataset.h"
 

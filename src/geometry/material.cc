@@ -99,9 +99,9 @@ void FillConstant(int num_faces, int resolution, const double* value, int channe
 
 const std::set<std::string>& KnownKeys() {
   static const std::set<std::string> keys = {
-      "albedo",      "albedo_texture", "colorspace", "mesh_colors", "roughness_mesh_colors",
-      "procedural",  "colors",         "scale",      "roughness",   "roughness_range",
-      "specular",    "fresnel",        "resolution", "seed",        "uv_albedo",
+      "albedo",       "albedo_texture", "colorspace", "mesh_colors", "roughness_mesh_colors",
+      "procedural",   "colors",         "scale",      "roughness",   "roughness_range",
+      "specular",     "fresnel",        "resolution", "seed",        "uv_albedo",
       "uv_roughness", "uv_mesh"};
   return keys;
 }

@@ -26,7 +26,8 @@ Status SaveUvMaterial(const std::string& json_path, const Material& material,
     return Status::Error(json_path + ": not a UV-texture material");
   }
   if (material.uv.albedo.channels() != 3 || material.uv.roughness.channels() != 1) {
-    return Status::Error(json_path + ": UV textures need 3 albedo channels and 1 roughness channel");
+    return Status::Error(json_path +
+                         ": UV textures need 3 albedo channels and 1 roughness channel");
   }
   const std::filesystem::path path(json_path);
   const std::string stem = path.stem().string();

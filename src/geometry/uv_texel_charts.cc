@@ -90,8 +90,8 @@ UvTexelCharts ComputeUvTexelCharts(const std::vector<Eigen::Vector3i>& faces,
       const Eigen::Vector2d& uv = corner_uvs[3 * f + c];
       p[c] = Eigen::Vector2d(uv.x() * width - 0.5, (1.0 - uv.y()) * height - 0.5);
     }
-    const double area2 = std::abs((p[1] - p[0]).x() * (p[2] - p[0]).y() -
-                                  (p[1] - p[0]).y() * (p[2] - p[0]).x());
+    const double area2 =
+        std::abs((p[1] - p[0]).x() * (p[2] - p[0]).y() - (p[1] - p[0]).y() * (p[2] - p[0]).x());
     if (!(area2 > 1e-9)) continue;
     const double lo_x = std::min({p[0].x(), p[1].x(), p[2].x()});
     const double hi_x = std::max({p[0].x(), p[1].x(), p[2].x()});

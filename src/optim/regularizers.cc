@@ -97,8 +97,8 @@ void AddRegularizers(const TriMesh& rest, const ActiveParameters& active,
     if (!material.has_uv_textures()) return TexelNeighbourPairs(rest, colors.resolution());
     std::vector<Eigen::Vector3i> faces;
     MeshToArrays(rest, nullptr, &faces);
-    return UvTexelNeighbourPairs(ComputeUvTexelCharts(faces, material.uv.corner_uvs,
-                                                      texture.width(), texture.height()));
+    return UvTexelNeighbourPairs(
+        ComputeUvTexelCharts(faces, material.uv.corner_uvs, texture.width(), texture.height()));
   };
   if (active.albedo && options.albedo_smoothness > 0.0) {
     AddSmoothness(pairs(material.albedo, material.uv.albedo), material.NumAlbedoTexels(), 3,

@@ -128,8 +128,8 @@ Status WriteRunSnapshot(const std::string& out, const Dataset& dataset, const Tr
 Status ReadRunSnapshot(const std::string& out, const Dataset& dataset, TriMesh* mesh,
                        Material* material, std::vector<double>* light_scales) {
   SFT_RETURN_IF_ERROR(ReadMesh(JoinPath(out, "mesh.ply"), mesh));
-  SFT_RETURN_IF_ERROR(LoadMaterial(JoinPath(out, "material.json"), *mesh, material,
-                                   MaterialUse::kCheckpoint));
+  SFT_RETURN_IF_ERROR(
+      LoadMaterial(JoinPath(out, "material.json"), *mesh, material, MaterialUse::kCheckpoint));
   return ReadLightScales(JoinPath(out, "lights.json"), dataset, light_scales);
 }
 

@@ -38,8 +38,8 @@ Status SwitchToUvTextures(const TriMesh& mesh, const Dataset& dataset, int textu
   options.texture_size = texture_size;
   UvAtlas atlas;
   UvAtlasReport atlas_report;
-  SFT_RETURN_IF_ERROR(BuildUvAtlas(positions, faces, options, &atlas, &atlas_report)
-                          .Prefixed("uv stage: atlas"));
+  SFT_RETURN_IF_ERROR(
+      BuildUvAtlas(positions, faces, options, &atlas, &atlas_report).Prefixed("uv stage: atlas"));
   BakedMaterial baked;
   BakeReport bake_report;
   SFT_RETURN_IF_ERROR(
@@ -53,15 +53,15 @@ Status SwitchToUvTextures(const TriMesh& mesh, const Dataset& dataset, int textu
   *material = std::move(uv);
   const UvTexelCharts charts =
       ComputeUvTexelCharts(faces, material->uv.corner_uvs, texture_size, texture_size);
-  *record = {{"texture_size", texture_size},
-             {"texture_size_from", automatic ? "pixel footprint" : "texture_size"},
-             {"charts", atlas_report.charts},
-             {"utilization", atlas_report.utilization},
-             {"max_stretch", atlas_report.max_stretch},
-             {"fitted_texels", charts.used_texels},
-             {"covered_texels", bake_report.covered_texels},
-             {"seconds", std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
-                             .count()}};
+  *record = {
+      {"texture_size", texture_size},
+      {"texture_size_from", automatic ? "pixel footprint" : "texture_size"},
+      {"charts", atlas_report.charts},
+      {"utilization", atlas_report.utilization},
+      {"max_stretch", atlas_report.max_stretch},
+      {"fitted_texels", charts.used_texels},
+      {"covered_texels", bake_report.covered_texels},
+      {"seconds", std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()}};
   return Status::Ok();
 }
 
@@ -71,8 +71,8 @@ void SwitchToMeshColors(int resolution, Material* material) {
   Material out;
   out.specular = material->specular;
   out.fresnel = material->fresnel;
-  SampleTextureIntoMeshColors(TextureImage(material->uv.albedo), material->uv.corner_uvs,
-                              num_faces, resolution, &out.albedo);
+  SampleTextureIntoMeshColors(TextureImage(material->uv.albedo), material->uv.corner_uvs, num_faces,
+                              resolution, &out.albedo);
   // Grey is replicated into three channels; the roughness is the first.
   MeshColors grey;
   SampleTextureIntoMeshColors(TextureImage(material->uv.roughness), material->uv.corner_uvs,

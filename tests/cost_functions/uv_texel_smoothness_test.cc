@@ -47,9 +47,7 @@ void CheckPairJacobians() {
 }
 
 TEST(UvTexelSmoothnessTest, JacobianMatchesFiniteDifferencesAlbedo) { CheckPairJacobians<3>(); }
-TEST(UvTexelSmoothnessTest, JacobianMatchesFiniteDifferencesRoughness) {
-  CheckPairJacobians<1>();
-}
+TEST(UvTexelSmoothnessTest, JacobianMatchesFiniteDifferencesRoughness) { CheckPairJacobians<1>(); }
 
 TEST(UvTexelSmoothnessTest, PairsAreNeighboursOfOneChart) {
   const UvTexelCharts charts = TwoCharts();

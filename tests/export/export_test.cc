@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include "src/core/file_util.h"
 #include "src/core/rng.h"
 #include "src/export/export_formats.h"
 #include "src/geometry/material.h"
@@ -18,8 +19,8 @@ TEST(ExportTest, WritesTheFittedUvTextures) {
   testing::TempDir dir;
   TriMesh mesh;
   ASSERT_TRUE(ReadMesh(testing::DataDir() + "/meshes/icosphere_r1_320f.obj", &mesh).ok());
-  Material material = ConstantMaterial(static_cast<int>(mesh.n_faces()),
-                                       Eigen::Vector3d(0.5, 0.5, 0.5), 0.5, 0.1);
+  Material material =
+      ConstantMaterial(static_cast<int>(mesh.n_faces()), Eigen::Vector3d(0.5, 0.5, 0.5), 0.5, 0.1);
   nlohmann::json record;
   ASSERT_TRUE(SwitchToUvTextures(mesh, Dataset(), 64, &material, &record).ok());
   // Texels no bake of a constant material gives: noise per texel.
@@ -59,9 +60,8 @@ TEST(ExportTest, WritesTheFittedUvTextures) {
   TriMesh exported_mesh;
   ASSERT_TRUE(ReadMesh(options.out + "/" + kObjFile, &exported_mesh).ok());
   Material back;
-  ASSERT_TRUE(LoadMaterial(options.out + "/" + kMtlFile, exported_mesh, &back,
-                           MaterialUse::kRender)
-                  .ok());
+  ASSERT_TRUE(
+      LoadMaterial(options.out + "/" + kMtlFile, exported_mesh, &back, MaterialUse::kRender).ok());
   ASSERT_TRUE(back.has_uv_textures());
   ASSERT_EQ(back.uv.albedo.values().size(), material.uv.albedo.values().size());
   double worst = 0.0;

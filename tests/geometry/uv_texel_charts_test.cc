@@ -18,8 +18,8 @@ double Uniform(uint64_t key) { return static_cast<double>(Mix64(key) >> 11) * 0x
 // and a third, unconnected-in-UV triangle (the same v0 v2 edge, other UVs) in the right half.
 struct Layout {
   std::vector<Eigen::Vector3i> faces = {{0, 1, 2}, {0, 2, 3}, {0, 2, 4}};
-  std::vector<Eigen::Vector2d> uvs = {{0.1, 0.1}, {0.4, 0.1}, {0.4, 0.4},  // face 0
-                                      {0.1, 0.1}, {0.4, 0.4}, {0.1, 0.4},  // face 1 (shares 0–2)
+  std::vector<Eigen::Vector2d> uvs = {{0.1, 0.1}, {0.4, 0.1}, {0.4, 0.4},   // face 0
+                                      {0.1, 0.1}, {0.4, 0.4}, {0.1, 0.4},   // face 1 (shares 0–2)
                                       {0.6, 0.6}, {0.9, 0.9}, {0.6, 0.9}};  // face 2 (a seam)
 };
 
