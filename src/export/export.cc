@@ -4,18 +4,18 @@
 #include <chrono>
 #include <cmath>
 
+#include "src/atlas/bake.h"
+#include "src/atlas/texture_size.h"
 #include "src/core/file_util.h"
-#include "src/export/bake.h"
 #include "src/export/export_formats.h"
 #include "src/geometry/material.h"
+#include "src/geometry/uv_texel_charts.h"
 #include "src/optim/run_outputs.h"
 
 namespace sft {
 namespace {
 
 using json = nlohmann::json;
-
-constexpr int kDefaultTextureSize = 1024;
 
 // The dataset to take the frame and cameras from; *found false (with a warning) when there is
 // none to read. An explicit --dataset that cannot be read is an error.
@@ -73,6 +73,62 @@ json AtlasJson(const UvAtlasReport& r, const BakeReport& b, int texture_size) {
           {"dilation_rings", b.dilation_rings}};
 }
 
+// The textured formats of a material that is UV textures already (a run whose last stage was a
+// uv stage): its corner UVs and fitted texels are written as they are, not re-baked.
+Status WriteFittedTextures(const ExportOptions& options, const std::vector<Eigen::Vector3i>& faces,
+                           const std::vector<Eigen::Vector3d>& positions, const Material& material,
+                           bool obj, bool gltf, json* summary, json* files) {
+  const UvTexture& albedo = material.uv.albedo;
+  const UvTexture& roughness = material.uv.roughness;
+  const int n = albedo.width();
+  if (albedo.height() != n || roughness.width() != n || roughness.height() != n) {
+    return Status::Error(JoinPath(options.reconstruction, "material.json") +
+                         ": the UV textures must be square and of one size to export (albedo " +
+                         std::to_string(albedo.width()) + "x" + std::to_string(albedo.height()) +
+                         ", roughness " + std::to_string(roughness.width()) + "x" +
+                         std::to_string(roughness.height()) + ")");
+  }
+  const UvTexelCharts charts = ComputeUvTexelCharts(faces, material.uv.corner_uvs, n, n);
+  UvAtlas atlas;
+  atlas.texture_size = n;
+  atlas.corner_uv = material.uv.corner_uvs;
+  atlas.chart_of_face = charts.chart_of_face;
+  atlas.num_charts = charts.num_charts;
+  BakedMaterial baked;
+  baked.albedo = Image(n, n, 3);
+  baked.roughness = Image(n, n, 1);
+  baked.coverage = Image(n, n, 1);
+  for (int k = 0; k < n * n; ++k) {
+    for (int c = 0; c < 3; ++c) baked.albedo.data[3 * k + c] = albedo.texel(k)[c];
+    baked.roughness.data[k] = roughness.texel(k)[0];
+    baked.coverage.data[k] = charts.used(k) ? 1.0f : 0.0f;
+  }
+  (*summary)["atlas"] = {{"texture_size", n},
+                         {"texture_size_from", "the fitted UV textures (uv stage)"},
+                         {"charts", charts.num_charts},
+                         {"fitted_texels", charts.used_texels},
+                         {"baked", false}};
+  if (options.texture_size != 0 && options.texture_size != n) {
+    (*summary)["warnings"].push_back("--texture-size " + std::to_string(options.texture_size) +
+                                     " ignored: the fitted textures are " + std::to_string(n) +
+                                     "² and are written as they are");
+  }
+  if (obj) {
+    SFT_RETURN_IF_ERROR(WriteObjExport(options.out, positions, faces, atlas, baked, material));
+    files->insert(files->end(), {kObjFile, kMtlFile, kAlbedoPngFile, kRoughnessPngFile});
+  }
+  if (gltf) {
+    std::vector<Eigen::Vector3d> y_up(positions.size());
+    for (size_t v = 0; v < positions.size(); ++v) {
+      y_up[v] = Eigen::Vector3d(positions[v].x(), positions[v].z(), -positions[v].y());
+    }
+    SFT_RETURN_IF_ERROR(
+        WriteGlbExport(JoinPath(options.out, kGlbFile), y_up, faces, atlas, baked, material));
+    files->push_back(kGlbFile);
+  }
+  return Status::Ok();
+}
+
 // The atlas, the bake and the textured formats (OBJ and/or glTF); adds the atlas's numbers to
 // *summary and the written files to *files. `dataset` may be null.
 Status WriteTexturedFormats(const ExportOptions& options, const TriMesh& mesh,
@@ -81,6 +137,9 @@ Status WriteTexturedFormats(const ExportOptions& options, const TriMesh& mesh,
                             const std::vector<Eigen::Vector3d>& positions, const Material& material,
                             const Dataset* dataset, bool obj, bool gltf, json* summary,
                             json* files) {
+  if (material.has_uv_textures()) {
+    return WriteFittedTextures(options, faces, positions, material, obj, gltf, summary, files);
+  }
   UvAtlasOptions atlas_options = options.atlas;
   std::string texture_from = "--texture-size";
   atlas_options.texture_size = options.texture_size;
@@ -139,22 +198,6 @@ bool ExportOptions::Check(std::string* why) const {
   return checked.Check(why);
 }
 
-int TextureSizeFromFootprint(const Dataset& dataset, const Eigen::Vector3d& center, double area) {
-  double footprint = std::numeric_limits<double>::infinity();
-  for (const ViewSpec& view : dataset.views) {
-    if (view.camera < 0 || view.camera >= static_cast<int>(dataset.cameras.size())) continue;
-    const double focal = dataset.cameras[view.camera].Focal().maxCoeff();
-    const Eigen::Vector3d eye = view.cam_from_world.Inverse().translation;
-    const double distance = (eye - center).norm();
-    if (focal > 0.0 && distance > 0.0) footprint = std::min(footprint, distance / focal);
-  }
-  if (!std::isfinite(footprint) || !(area > 0.0)) return kDefaultTextureSize;
-  const double side = std::sqrt(area / (footprint * footprint) / 0.5);
-  int size = 256;
-  while (size < side && size < 4096) size *= 2;
-  return size;
-}
-
 Status ExportReconstruction(const ExportOptions& options, json* summary) {
   const auto start = std::chrono::steady_clock::now();
   std::string why;
@@ -164,8 +207,8 @@ Status ExportReconstruction(const ExportOptions& options, json* summary) {
   TriMesh mesh;
   SFT_RETURN_IF_ERROR(ReadMesh(JoinPath(options.reconstruction, "mesh.ply"), &mesh));
   Material material;
-  SFT_RETURN_IF_ERROR(
-      LoadMaterial(JoinPath(options.reconstruction, "material.json"), mesh, &material));
+  SFT_RETURN_IF_ERROR(LoadMaterial(JoinPath(options.reconstruction, "material.json"), mesh,
+                                   &material, MaterialUse::kCheckpoint));
   json warnings = json::array();
   Dataset dataset;
   bool have_dataset = false;
@@ -211,6 +254,9 @@ Status ExportReconstruction(const ExportOptions& options, json* summary) {
   }
   files.push_back(kSummaryFile);
   (*summary)["files"] = files;
+  if (summary->contains("warnings")) {
+    for (const json& w : (*summary)["warnings"]) warnings.push_back(w);
+  }
   (*summary)["warnings"] = warnings;
   (*summary)["seconds"] =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

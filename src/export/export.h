@@ -1,10 +1,11 @@
 // `sft export`: a reconstruction's mesh and mesh-colors material as files other programs open
 // (docs/export.md): OBJ + MTL + PNG textures, glTF 2.0 binary, PLY with vertex colours.
 //
-// Reads REC/mesh.ply and REC/material.json (+ its .meshcolors files), and the dataset — --dataset,
-// else the one REC/state.json names — for its source frame and cameras; writes only into the
-// output folder (fixed names, export_formats.h), each file atomically, plus export.json (what was
-// written and the atlas's numbers).
+// Reads REC/mesh.ply and REC/material.json (+ its .meshcolors files; after a uv stage its PNG
+// textures and mesh.obj's UVs, written as they are instead of re-baked), and the dataset —
+// --dataset, else the one REC/state.json names — for its source frame and cameras; writes only into
+// the output folder (fixed names, export_formats.h), each file atomically, plus export.json (what
+// was written and the atlas's numbers).
 //
 // Frames. Positions are exported in the dataset's source frame (p_source = s·R·p + t,
 // "source_from_world" of imported captures) when the dataset records one, else in sft's world
@@ -12,7 +13,7 @@
 // turned so that its +Z becomes +Y: (x, y, z) ↦ (x, z, −y).
 //
 // Texture size: --texture-size when given; else from the dataset's finest pixel footprint (see
-// TextureSizeFromFootprint); else 1024.
+// TextureSizeFromFootprint, src/atlas/texture_size.h); else 1024.
 #ifndef SFT_EXPORT_EXPORT_H_
 #define SFT_EXPORT_EXPORT_H_
 
@@ -20,8 +21,8 @@
 #include <string>
 #include <vector>
 
+#include "src/atlas/uv_atlas.h"
 #include "src/core/status.h"
-#include "src/export/uv_atlas.h"
 #include "src/geometry/mesh.h"
 #include "src/io/dataset.h"
 
@@ -41,13 +42,6 @@ struct ExportOptions {
 // Runs the export; *summary is what export.json holds. Warnings (e.g. the dataset named by
 // state.json cannot be read, so the world frame is used) are listed in summary["warnings"].
 Status ExportReconstruction(const ExportOptions& options, nlohmann::json* summary);
-
-// The atlas side for a surface of `area` (scene units²) seen by `dataset`'s views: the finest
-// pixel footprint over the views, d/f (d the distance from the camera centre to `center`, f the
-// focal length in pixels), gives the texel size; the side is the power of two that holds
-// area/footprint² texels at 50% utilisation, clamped to [256, 4096]. 1024 when the dataset has
-// no views.
-int TextureSizeFromFootprint(const Dataset& dataset, const Eigen::Vector3d& center, double area);
 
 }  // namespace sft
 

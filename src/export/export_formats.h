@@ -12,9 +12,9 @@
 #include <string>
 #include <vector>
 
+#include "src/atlas/bake.h"
+#include "src/atlas/uv_atlas.h"
 #include "src/core/status.h"
-#include "src/export/bake.h"
-#include "src/export/uv_atlas.h"
 #include "src/geometry/material.h"
 
 namespace sft {

@@ -21,15 +21,22 @@ void Append(std::string* bytes, T value) {
 
 Status WriteColoredPly(const std::string& path, const std::vector<Eigen::Vector3d>& positions,
                        const std::vector<Eigen::Vector3i>& faces, const Material& material) {
-  // Mean albedo at each vertex: the mesh-colors texel at each corner (α, β at the corner).
+  // Mean albedo at each vertex: the mesh-colors texel at each corner (α, β at the corner), or the
+  // UV texture at the corner's UV.
   std::vector<Eigen::Vector3d> sum(positions.size(), Eigen::Vector3d::Zero());
   std::vector<int> count(positions.size(), 0);
   const Eigen::Vector2d corner_ab[3] = {{0.0, 0.0}, {1.0, 0.0}, {0.0, 1.0}};
   for (size_t f = 0; f < faces.size(); ++f) {
     for (int c = 0; c < 3; ++c) {
-      const double* a = material.albedo.texel(
-          material.albedo.TexelIndex(static_cast<int>(f), corner_ab[c].x(), corner_ab[c].y()));
-      sum[faces[f][c]] += Eigen::Vector3d(a[0], a[1], a[2]);
+      Eigen::Vector3d a;
+      if (material.has_uv_textures()) {  // the bilinear texture at the corner's UV.
+        material.uv.albedo.Sample(material.uv.corner_uvs[3 * f + c], a.data());
+      } else {
+        const double* t = material.albedo.texel(
+            material.albedo.TexelIndex(static_cast<int>(f), corner_ab[c].x(), corner_ab[c].y()));
+        a = Eigen::Vector3d(t[0], t[1], t[2]);
+      }
+      sum[faces[f][c]] += a;
       ++count[faces[f][c]];
     }
   }

@@ -99,10 +99,10 @@ void FillConstant(int num_faces, int resolution, const double* value, int channe
 
 const std::set<std::string>& KnownKeys() {
   static const std::set<std::string> keys = {
-      "albedo",      "albedo_texture", "colorspace", "mesh_colors", "roughness_mesh_colors",
-      "procedural",  "colors",         "scale",      "roughness",   "roughness_range",
-      "specular",    "fresnel",        "resolution", "seed",        "uv_albedo",
-      "uv_roughness"};
+      "albedo",       "albedo_texture", "colorspace", "mesh_colors", "roughness_mesh_colors",
+      "procedural",   "colors",         "scale",      "roughness",   "roughness_range",
+      "specular",     "fresnel",        "resolution", "seed",        "uv_albedo",
+      "uv_roughness", "uv_mesh"};
   return keys;
 }
 
@@ -141,7 +141,7 @@ Status ReadMeshColorsFor(const Context& ctx, const std::string& field, const std
 }
 
 // The UV-texture form: "uv_albedo" and/or "uv_roughness" (with a constant "albedo" or the default
-// when there is no "uv_albedo"); *source becomes "uv". Refused for fitting (MaterialUse::kFit).
+// when there is no "uv_albedo"); *source becomes "uv". Refused as a start (MaterialUse::kFit).
 Status CheckUvForm(const Context& ctx, const Json& json, MaterialUse use, std::string* source) {
   const bool uv_albedo = json.contains("uv_albedo"), uv_roughness = json.contains("uv_roughness");
   if (!uv_albedo && !uv_roughness) return Status::Ok();
@@ -197,6 +197,9 @@ Status CheckForm(const Context& ctx, const Json& json, MaterialUse use, std::str
   }
   if (has("resolution") && *source == "mesh_colors") {
     return ctx.Error("resolution", "does not apply with \"mesh_colors\" (the file has its own)");
+  }
+  if (has("uv_mesh") && *source != "uv") {
+    return ctx.Error("uv_mesh", "only applies with \"uv_albedo\" or \"uv_roughness\"");
   }
   if (has("resolution") && *source == "uv") {
     return ctx.Error("resolution", "does not apply to UV textures (they have their own size)");
@@ -371,6 +374,19 @@ Status ParseUvMaterial(const Context& ctx, const Json& json, const std::string& 
                        const TriMesh& mesh, UvMaterialMaps* maps) {
   const int num_faces = static_cast<int>(mesh.n_faces());
   maps->corner_uvs = FaceCornerUvs(mesh);
+  if (json.contains("uv_mesh")) {
+    std::string file;
+    SFT_RETURN_IF_ERROR(ReadString(ctx, json, "uv_mesh", &file));
+    TriMesh uv_mesh;
+    const Status read = ReadMesh(JoinPath(base_dir, file), &uv_mesh);
+    if (!read.ok()) return ctx.Error("uv_mesh", read.message());
+    if (uv_mesh.n_faces() != mesh.n_faces()) {
+      return ctx.Error("uv_mesh", JoinPath(base_dir, file) + " has " +
+                                      std::to_string(uv_mesh.n_faces()) + " faces, the mesh has " +
+                                      std::to_string(num_faces));
+    }
+    maps->corner_uvs = FaceCornerUvs(uv_mesh);
+  }
   if (maps->corner_uvs.size() != 3 * static_cast<size_t>(num_faces) || num_faces == 0) {
     return ctx.Error(json.contains("uv_albedo") ? "uv_albedo" : "uv_roughness",
                      "the mesh has no texture coordinates (UVs)");

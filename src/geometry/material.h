@@ -35,10 +35,12 @@ struct Material {
   const std::vector<double>& RoughnessValues() const;
 };
 
-// What the caller does with a loaded material. kFit: the reconstruction's parameter state and
-// its saved files cover mesh colors only, so the UV-texture forms are refused (an error naming
-// the field). kRender: every form (sft render, sft gradcheck).
-enum class MaterialUse { kFit, kRender };
+// What the caller does with a loaded material. kFit: a start material of a reconstruction, whose
+// stages begin with mesh colors, so the UV-texture forms are refused (an error naming the field).
+// kCheckpoint: a run folder's material (sft reconstruct --resume, sft export): the kFit forms
+// plus the UV-texture form that a uv stage writes (SaveUvMaterial). kRender: every form (sft
+// render, sft gradcheck).
+enum class MaterialUse { kFit, kCheckpoint, kRender };
 
 // A material with constant albedo and roughness at mesh-colors resolution `resolution`.
 Material ConstantMaterial(int num_faces, const Eigen::Vector3d& albedo, double roughness,
@@ -58,7 +60,9 @@ Material ConstantMaterial(int num_faces, const Eigen::Vector3d& albedo, double r
 //    uv_albedo, uv_roughness) the UV-texture material: the textures as given, sampled
 //    bilinearly at render time through the mesh's per-corner UVs; a constant becomes a 1×1
 //    texture. Albedo: an RGB(A) image (alpha ignored); roughness: a grey image, always linear.
-//    Only with MaterialUse::kRender.
+//    The corner UVs are the mesh's, or with "uv_mesh": "file.obj" those of that mesh file (the
+//    same faces in the same order; how a run folder keeps them, since mesh.ply has none).
+//    Only with MaterialUse::kCheckpoint and kRender.
 // An MTL file (what `sft export` writes; mtl_material.h) is read as the UV-texture form.
 // Optional everywhere: "fresnel": "constant"|"schlick". Relative paths are relative to the JSON
 // file's directory, or to the working directory for inline JSON. Ranges (docs/cli.md "Materials"):
@@ -73,6 +77,16 @@ Status LoadMaterial(const std::string& spec, const TriMesh& mesh, Material* mate
 // ({"mesh_colors": ..., "roughness_mesh_colors": ..., "specular": ...}), atomically. A UV-texture
 // material is an error (sft export writes those).
 Status SaveMaterial(const std::string& json_path, const Material& material);
+
+// Writes a UV-texture material (Material::has_uv_textures()) as STEM_albedo.png (8-bit sRGB),
+// STEM_roughness.png (8-bit linear) and the JSON {"uv_albedo", "colorspace": "srgb",
+// "uv_roughness", "uv_mesh", "specular", "fresnel"} (STEM = the JSON file's stem), each file
+// atomically, the JSON last. `uv_mesh` names (relative to the JSON's folder) a mesh file the
+// caller has written with the material's corner UVs. Texel values are clamped to [0, 1]; 8 bits
+// quantise them (albedo in sRGB steps of 1/255, roughness in linear steps of 1/255). Error for a
+// mesh-colors material.
+Status SaveUvMaterial(const std::string& json_path, const Material& material,
+                      const std::string& uv_mesh);
 
 }  // namespace sft
 

@@ -348,6 +348,20 @@ std::vector<Eigen::Vector2d> FaceCornerUvs(const TriMesh& mesh) {
   return uvs;
 }
 
+void SetFaceCornerUvs(const std::vector<Eigen::Vector2d>& uvs, TriMesh* mesh) {
+  CHECK_EQ(uvs.size(), 3 * mesh->n_faces()) << "SetFaceCornerUvs: 3 UVs per face";
+  mesh->request_halfedge_texcoords2D();
+  for (size_t f = 0; f < mesh->n_faces(); ++f) {
+    const TriMesh::FaceHandle fh(static_cast<int>(f));
+    int c = 0;
+    for (TriMesh::HalfedgeHandle h : mesh->fh_range(fh)) {
+      if (c >= 3) break;
+      const Eigen::Vector2d& uv = uvs[3 * f + c++];
+      mesh->set_texcoord2D(h, TriMesh::TexCoord2D(uv.x(), uv.y()));
+    }
+  }
+}
+
 void MeshBounds(const TriMesh& mesh, Eigen::Vector3d* lo, Eigen::Vector3d* hi) {
   Eigen::Vector3d l = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
   Eigen::Vector3d h = -l;

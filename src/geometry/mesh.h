@@ -57,6 +57,8 @@ double SurfaceArea(const TriMesh& mesh);
 
 // Per-face corner UVs (3 per face, corner order = face vertex order); empty when the mesh has none.
 std::vector<Eigen::Vector2d> FaceCornerUvs(const TriMesh& mesh);
+// Sets the halfedge texcoords from per-face corner UVs (FaceCornerUvs' layout; 3 per face, CHECK).
+void SetFaceCornerUvs(const std::vector<Eigen::Vector2d>& uvs, TriMesh* mesh);
 
 // Axis-aligned bounds of the vertices that some face uses (isolated vertices are not part of the
 // surface: a stray far-away `v` line must not move a normalization or a camera); both zero when

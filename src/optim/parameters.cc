@@ -46,17 +46,17 @@ SceneParameters::SceneParameters(const std::vector<Eigen::Vector3d>& positions,
                                  const Material& material, int num_lights, int num_gain_views) {
   CHECK_GE(num_gain_views, 0);
   layout_.num_vertices = static_cast<int>(positions.size());
-  layout_.num_albedo_texels = material.albedo.num_texels();
-  layout_.num_roughness_texels = material.roughness.num_texels();
+  layout_.num_albedo_texels = material.NumAlbedoTexels();
+  layout_.num_roughness_texels = material.NumRoughnessTexels();
   layout_.num_lights = num_lights;
   num_gain_views_ = num_gain_views;
   values_.assign(layout_.size() + 3 * num_gain_views, 0.0);
   for (size_t v = 0; v < positions.size(); ++v) {
     for (int k = 0; k < 3; ++k) values_[3 * v + k] = positions[v][k];
   }
-  std::copy(material.albedo.values().begin(), material.albedo.values().end(),
+  std::copy(material.AlbedoValues().begin(), material.AlbedoValues().end(),
             values_.begin() + layout_.AlbedoOffset());
-  std::copy(material.roughness.values().begin(), material.roughness.values().end(),
+  std::copy(material.RoughnessValues().begin(), material.RoughnessValues().end(),
             values_.begin() + layout_.RoughnessOffset());
   values_[layout_.SpecularIndex()] = material.specular;
   for (int l = 0; l < num_lights; ++l) values_[layout_.LightOffset() + l] = 1.0;
@@ -168,12 +168,12 @@ void SceneParameters::Positions(std::vector<Eigen::Vector3d>* positions) const {
 }
 
 void SceneParameters::WriteMaterial(Material* material) const {
-  CHECK_EQ(material->albedo.num_texels(), layout_.num_albedo_texels);
-  CHECK_EQ(material->roughness.num_texels(), layout_.num_roughness_texels);
+  CHECK_EQ(material->NumAlbedoTexels(), layout_.num_albedo_texels);
+  CHECK_EQ(material->NumRoughnessTexels(), layout_.num_roughness_texels);
   std::copy(values_.begin() + layout_.AlbedoOffset(), values_.begin() + layout_.RoughnessOffset(),
-            material->albedo.values().begin());
+            material->AlbedoValues().begin());
   std::copy(values_.begin() + layout_.RoughnessOffset(), values_.begin() + layout_.SpecularIndex(),
-            material->roughness.values().begin());
+            material->RoughnessValues().begin());
   material->specular = values_[layout_.SpecularIndex()];
 }
 

@@ -15,13 +15,15 @@ using PixelBlocks = std::vector<std::vector<int>>;  // [pixel] -> sorted offsets
 // The blocks a touched parameter brings into a pixel's superset: its own block and, for a texel,
 // every texel of the same face that surface points sample (i + j < r). Texels are often smaller
 // than pixels, so a few renders' samples miss most of the texels a pixel covers; their face is
-// the better predictor.
+// the better predictor. A UV texel brings only its own block (a bilinear lookup already touches
+// four, and texels of a UV texture belong to no single face).
 void ExpandBlock(const SceneParameters& params, const Material& material, int param,
                  std::vector<int>* out) {
   const BlockSpan span = params.BlockOf(param);
   const ParameterLayout& layout = params.layout();
   const bool albedo = !span.exposure && span.kind == ParameterKind::kAlbedo;
-  if (!albedo && (span.exposure || span.kind != ParameterKind::kRoughness)) {
+  if (material.has_uv_textures() ||
+      (!albedo && (span.exposure || span.kind != ParameterKind::kRoughness))) {
     out->push_back(span.offset);
     return;
   }

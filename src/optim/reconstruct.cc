@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "cost_functions/proximal_smoothing.h"
+#include "src/geometry/uv_texel_charts.h"
 #include "src/optim/fitted_environment.h"
 #include "src/optim/problem.h"
 
@@ -292,6 +293,9 @@ Material Reconstruction::CurrentMaterial() const {
   params_.WriteMaterial(&material);
   FillUnsampledTexels(&material.albedo);
   FillUnsampledTexels(&material.roughness);
+  // UV textures: the gutter texels no face reads are no part of the fit; fill them from the fitted
+  // ones so that filtering across chart borders never pulls in stale values.
+  if (material.has_uv_textures()) DilateUvGutters(faces_, &material.uv);
   return material;
 }
 

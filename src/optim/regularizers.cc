@@ -9,23 +9,24 @@
 #include "cost_functions/face_orientation.h"
 #include "cost_functions/proximal_smoothing.h"
 #include "cost_functions/texel_smoothness.h"
+#include "cost_functions/uv_texel_smoothness.h"
 #include "cost_functions/vertex_laplacian.h"
 
 namespace sft {
 namespace {
 
-// Smoothness over one mesh-colors attribute whose texel k is the block at offset + channels·k.
-void AddSmoothness(const TriMesh& rest, int resolution, int channels, int offset, double weight,
-                   const ParameterBounds& bounds, SceneParameters* params,
+// Smoothness over the texel pairs `pairs` of one attribute (mesh colors or a UV texture) whose
+// texel k is the block at offset + channels·k.
+void AddSmoothness(const std::vector<TexelPair>& pairs, int num_texels, int channels, int offset,
+                   double weight, const ParameterBounds& bounds, SceneParameters* params,
                    ceres::Problem* problem) {
-  const std::vector<TexelPair> pairs = TexelNeighbourPairs(rest, resolution);
-  const int num_texels = rest.n_faces() * MeshColors::TexelsPerFace(resolution);
   std::vector<double*> blocks(num_texels);
   for (int k = 0; k < num_texels; ++k) blocks[k] = params->data() + offset + channels * k;
   TexelSmoothnessOptions options;
   options.weight = std::sqrt(weight);
   AddTexelSmoothness(pairs, channels, options, blocks, problem);
-  // Texels no render touches (i + j = r) enter the problem here: give every texel the bounds.
+  // Texels no render touches (mesh colors' i + j = r) enter the problem here: give every texel
+  // the bounds.
   for (int k = 0; k < num_texels; ++k) {
     if (!problem->HasParameterBlock(blocks[k])) continue;
     for (int c = 0; c < channels; ++c) {
@@ -96,13 +97,22 @@ void AddRegularizers(const TriMesh& rest, const ActiveParameters& active,
     proximal.lambda = options.proximal_lambda;
     AddProximalSmoothing(rest, proximal, blocks, problem);
   }
+  // Neighbour pairs: the mesh-colors layout's, or a UV texture's within its charts.
+  auto pairs = [&](const MeshColors& colors, const UvTexture& texture) {
+    if (!material.has_uv_textures()) return TexelNeighbourPairs(rest, colors.resolution());
+    std::vector<Eigen::Vector3i> faces;
+    MeshToArrays(rest, nullptr, &faces);
+    return UvTexelNeighbourPairs(
+        ComputeUvTexelCharts(faces, material.uv.corner_uvs, texture.width(), texture.height()));
+  };
   if (active.albedo && options.albedo_smoothness > 0.0) {
-    AddSmoothness(rest, material.albedo.resolution(), 3, layout.AlbedoOffset(),
-                  options.albedo_smoothness, bounds, params, problem);
+    AddSmoothness(pairs(material.albedo, material.uv.albedo), material.NumAlbedoTexels(), 3,
+                  layout.AlbedoOffset(), options.albedo_smoothness, bounds, params, problem);
   }
   if (active.roughness && options.roughness_smoothness > 0.0) {
-    AddSmoothness(rest, material.roughness.resolution(), 1, layout.RoughnessOffset(),
-                  options.roughness_smoothness, bounds, params, problem);
+    AddSmoothness(pairs(material.roughness, material.uv.roughness), material.NumRoughnessTexels(),
+                  1, layout.RoughnessOffset(), options.roughness_smoothness, bounds, params,
+                  problem);
   }
   if (active.environment && params->has_environment() && options.environment_smoothness > 0.0) {
     const int num_texels = layout.num_environment_texels;

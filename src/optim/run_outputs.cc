@@ -110,8 +110,16 @@ Status ReadRunState(const std::string& out, RunState* state) {
 Status WriteRunSnapshot(const std::string& out, const Dataset& dataset, const TriMesh& mesh,
                         const Material& material, const std::vector<double>& light_scales) {
   SFT_RETURN_IF_ERROR(WriteMesh(JoinPath(out, "mesh.ply"), mesh));
-  SFT_RETURN_IF_ERROR(WriteMesh(JoinPath(out, "mesh.obj"), mesh));
-  SFT_RETURN_IF_ERROR(SaveMaterial(JoinPath(out, "material.json"), material));
+  if (material.has_uv_textures()) {
+    // UV textures: mesh.obj carries the corner UVs that material.json's "uv_mesh" names.
+    TriMesh with_uvs = mesh;
+    SetFaceCornerUvs(material.uv.corner_uvs, &with_uvs);
+    SFT_RETURN_IF_ERROR(WriteMesh(JoinPath(out, "mesh.obj"), with_uvs));
+    SFT_RETURN_IF_ERROR(SaveUvMaterial(JoinPath(out, "material.json"), material, "mesh.obj"));
+  } else {
+    SFT_RETURN_IF_ERROR(WriteMesh(JoinPath(out, "mesh.obj"), mesh));
+    SFT_RETURN_IF_ERROR(SaveMaterial(JoinPath(out, "material.json"), material));
+  }
   std::vector<double> scales = light_scales;
   if (scales.empty()) scales.assign(dataset.lights.size(), 1.0);
   return WriteLightScales(JoinPath(out, "lights.json"), dataset, scales);
@@ -120,7 +128,8 @@ Status WriteRunSnapshot(const std::string& out, const Dataset& dataset, const Tr
 Status ReadRunSnapshot(const std::string& out, const Dataset& dataset, TriMesh* mesh,
                        Material* material, std::vector<double>* light_scales) {
   SFT_RETURN_IF_ERROR(ReadMesh(JoinPath(out, "mesh.ply"), mesh));
-  SFT_RETURN_IF_ERROR(LoadMaterial(JoinPath(out, "material.json"), *mesh, material));
+  SFT_RETURN_IF_ERROR(
+      LoadMaterial(JoinPath(out, "material.json"), *mesh, material, MaterialUse::kCheckpoint));
   return ReadLightScales(JoinPath(out, "lights.json"), dataset, light_scales);
 }
 

@@ -13,6 +13,7 @@
 #include "src/optim/fitted_environment.h"
 #include "src/optim/run_outputs.h"
 #include "src/optim/schedule_config.h"
+#include "src/optim/uv_stage.h"
 
 namespace sft {
 namespace {
@@ -50,10 +51,15 @@ bool StageOptions::Check(std::string* why) const {
     *why = "texel_resolution: must be in [0, 64] or auto";
     return false;
   }
-  if (material_model != "mesh_colors") {
-    *why = "material_model: only \"mesh_colors\" is available";
+  if (material_model != "mesh_colors" && material_model != "uv") {
+    *why = "material_model: expected \"mesh_colors\" or \"uv\", got \"" + material_model + "\"";
     return false;
   }
+  if (texture_size != 0 && (texture_size < 64 || texture_size > 16384)) {
+    *why = "texture_size: must be in [64, 16384] (0 = from the pixel footprint)";
+    return false;
+  }
+
   if (!(restart_roughness >= 0.0 && restart_roughness <= 1.0) ||
       !(restart_specular >= 0.0 && restart_specular <= 1.0)) {
     *why = "restart_roughness, restart_specular: must be in [0, 1] (0 = keep)";
@@ -178,6 +184,9 @@ Status Schedule::Resume(const Dataset& dataset, const std::string& out,
   if (metrics.contains("stages") && metrics["stages"].is_array()) {
     s->stage_records_ = metrics["stages"];
   }
+  if (metrics.contains("material_switches") && metrics["material_switches"].is_array()) {
+    s->material_records_ = metrics["material_switches"];
+  }
   // Older run folders have no adam_state.bin: their Adam stages resume with fresh moments.
   auto saved_adam = std::make_unique<AdamCheckpoint>();
   bool found = false;
@@ -241,6 +250,13 @@ Status Schedule::ChangeTopology(TopologyChange change, const ScheduleCallbacks& 
   const int faces_before = static_cast<int>(current_.mesh.n_faces());
   const double start = NowSeconds();
   json record;
+  // Topology changes carry mesh colors across; UV textures are sampled into them first and the
+  // atlas is rebuilt on the new mesh below.
+  if (current_.material.has_uv_textures()) {
+    SwitchToMeshColors(ResolveTexelResolution(kTexelResolutionAuto, 1, current_.mesh, *dataset_,
+                                              views, stage.fit.cache.image_scale_log2),
+                       &current_.material);
+  }
   SFT_RETURN_IF_ERROR(ApplyTopologyChange(change, stage.topology, *dataset_, views,
                                           stage.fit.cache.image_scale_log2, stage.texel_resolution,
                                           &current_.mesh, &current_.material, &record));
@@ -259,6 +275,48 @@ Status Schedule::ChangeTopology(TopologyChange change, const ScheduleCallbacks& 
                   change == TopologyChange::kRemesh ? ("remesh " + stage.topology.remesh).c_str()
                                                     : "resample",
                   faces_before, current_.mesh.n_faces(), record["seconds"].get<double>());
+    callbacks.on_event(line);
+  }
+  return stage.material_model == "uv" ? SwitchMaterialModel(callbacks) : Status::Ok();
+}
+
+// Brings the material into the stage's model: a UV atlas baked from the mesh colors for a uv
+// stage, mesh colors sampled from the textures for a mesh-colors stage (no-op when it is there).
+Status Schedule::SwitchMaterialModel(const ScheduleCallbacks& callbacks) {
+  const StageOptions& stage = stages_[progress_.stage];
+  const bool uv = stage.material_model == "uv";
+  if (uv == current_.material.has_uv_textures()) return Status::Ok();
+  json record;
+  if (uv) {
+    SFT_RETURN_IF_ERROR(SwitchToUvTextures(current_.mesh, *dataset_, stage.texture_size,
+                                           &current_.material, &record));
+  } else {
+    std::vector<int> views;
+    SFT_RETURN_IF_ERROR(
+        SelectViews(stage.fit.views, static_cast<int>(dataset_->views.size()), &views));
+    const int resolution = ResolveTexelResolution(
+        stage.texel_resolution == 0 ? kTexelResolutionAuto : stage.texel_resolution, 1,
+        current_.mesh, *dataset_, views, stage.fit.cache.image_scale_log2);
+    SwitchToMeshColors(resolution, &current_.material);
+    record = {{"resolution", resolution}};
+  }
+  record["to"] = stage.material_model;
+  record["stage"] = stage.name;
+  record["outer"] = progress_.outer_done;
+  material_records_.push_back(record);
+  if (callbacks.on_event) {
+    char line[256];
+    if (uv) {
+      std::snprintf(line, sizeof(line),
+                    "%s: UV atlas %d² (%s), %d charts, %.0f%% used, %d texels fitted, %.1f s",
+                    stage.name.c_str(), record["texture_size"].get<int>(),
+                    record["texture_size_from"].get<std::string>().c_str(),
+                    record["charts"].get<int>(), 100.0 * record["utilization"].get<double>(),
+                    record["fitted_texels"].get<int>(), record["seconds"].get<double>());
+    } else {
+      std::snprintf(line, sizeof(line), "%s: UV textures sampled into mesh colours, resolution %d",
+                    stage.name.c_str(), record["resolution"].get<int>());
+    }
     callbacks.on_event(line);
   }
   return Status::Ok();
@@ -283,19 +341,22 @@ Status Schedule::PrepareStage(const ScheduleCallbacks& callbacks) {
   if (stage.topology.resample) {
     SFT_RETURN_IF_ERROR(ChangeTopology(TopologyChange::kResample, callbacks));
   }
+  if (stage.material_model != "uv") SFT_RETURN_IF_ERROR(SwitchMaterialModel(callbacks));
   std::vector<int> views;
   SFT_RETURN_IF_ERROR(
       SelectViews(stage.fit.views, static_cast<int>(dataset_->views.size()), &views));
   const int resolution =
       ResolveTexelResolution(stage.texel_resolution, current_.material.albedo.resolution(),
                              current_.mesh, *dataset_, views, stage.fit.cache.image_scale_log2);
-  if (resolution != current_.material.albedo.resolution()) {
+  // A uv stage resamples the mesh colors before they are baked (texel_resolution as usual).
+  if (!current_.material.has_uv_textures() && resolution != current_.material.albedo.resolution()) {
     current_.material = ResampleMaterial(current_.material, resolution);
     if (callbacks.on_event) {
       callbacks.on_event("texels: mesh-colours resolution " + std::to_string(resolution) +
                          (stage.texel_resolution == kTexelResolutionAuto ? " (auto)" : ""));
     }
   }
+  if (stage.material_model == "uv") SFT_RETURN_IF_ERROR(SwitchMaterialModel(callbacks));
   RestartLobe(stage, callbacks);
   progress_.stage_prepared = true;
   return CreateReconstruction();
@@ -304,7 +365,7 @@ Status Schedule::PrepareStage(const ScheduleCallbacks& callbacks) {
 // The stage's restart of the glossy lobe (StageOptions::restart_roughness, restart_specular).
 void Schedule::RestartLobe(const StageOptions& stage, const ScheduleCallbacks& callbacks) {
   if (stage.restart_roughness > 0.0) {
-    std::vector<double>& values = current_.material.roughness.values();
+    std::vector<double>& values = current_.material.RoughnessValues();
     std::fill(values.begin(), values.end(), stage.restart_roughness);
   }
   if (stage.restart_specular > 0.0) current_.material.specular = stage.restart_specular;
@@ -479,6 +540,7 @@ Status Schedule::Checkpoint() {
   info["outer"] = outer_records_;
   info["topology_changes"] = topology_records_;
   info["stages"] = stage_records_;
+  info["material_switches"] = material_records_;
   if (extra_metrics_) info.update(extra_metrics_());
   SFT_RETURN_IF_ERROR(WriteMetrics(out_, records_, phase_records_, info));
   RunState state;

@@ -46,8 +46,15 @@ struct StageOptions {
   // At the stage's start, the specular weight is set to this value, (0, 1]; 0 = keep.
   double restart_specular = 0.0;
   TopologyOptions topology;  // remeshing / resampling before the stage, and on folds.
-  // Slot for UV textures; accepts its one current value:
-  std::string material_model = "mesh_colors";  // "mesh_colors": per-face texel grids.
+  // How albedo and roughness are represented while the stage fits them: "mesh_colors" (per-face
+  // texel grids) or "uv" (bilinear UV textures: at the stage's start, and after a topology change
+  // within it, the current mesh is charted into a UV atlas and the mesh colors are baked into it;
+  // the texels are then the parameters; src/optim/uv_stage.h). A mesh-colors stage after a uv
+  // stage samples the textures back into mesh colors (texel_resolution, or "auto" when 0).
+  std::string material_model = "mesh_colors";
+  // Side of a uv stage's textures in texels, [64, 16384]; 0 = from the images' pixel footprint
+  // (as sft export chooses it: src/atlas/texture_size.h). Ignored by mesh_colors stages.
+  int texture_size = 0;
 
   bool Check(std::string* why) const;
 };
@@ -141,6 +148,7 @@ class Schedule {
   Status RunStageOuter(const ScheduleCallbacks& callbacks, bool* stop);
   Status UntangleCurrent(const ScheduleCallbacks& callbacks, nlohmann::json* record);
   Status ChangeTopology(TopologyChange change, const ScheduleCallbacks& callbacks);
+  Status SwitchMaterialModel(const ScheduleCallbacks& callbacks);
   Status PlanEffects(const ScheduleCallbacks& callbacks, nlohmann::json* record);
   Status OuterRecord(const ScheduleCallbacks& callbacks, int outer, nlohmann::json* out);
   Status FinishStage();
@@ -165,6 +173,8 @@ class Schedule {
   std::vector<PhaseRecord> phase_records_;
   nlohmann::json outer_records_ = nlohmann::json::array();
   nlohmann::json topology_records_ = nlohmann::json::array();
+  // Switches between mesh colors and UV textures (metrics.json "material_switches").
+  nlohmann::json material_records_ = nlohmann::json::array();
   nlohmann::json stage_records_ = nlohmann::json::array();
   // The effect planner's last report in this session (console lines name only changes).
   std::unique_ptr<EffectPlanReport> last_plan_;

@@ -169,8 +169,18 @@ const std::map<std::string, StageKey>& StageKeys() {
           return "";
         },
         [](const S& s) { return json(s.topology.max_faces); }}},
-      {"material_model", OneOf([](S* s) -> std::string& { return s->material_model; },
-                               {"mesh_colors"}, " (UV textures are not available yet)")},
+      {"material_model",
+       OneOf([](S* s) -> std::string& { return s->material_model; }, {"mesh_colors", "uv"}, "")},
+      {"texture_size",
+       {[](const json& v, S* s) -> std::string {
+          if (!v.is_number_integer() || v.get<int64_t>() < 0 || v.get<int64_t>() > 16384 ||
+              (v.get<int64_t>() > 0 && v.get<int64_t>() < 64)) {
+            return "expected 0 (from the pixel footprint) or an integer in [64, 16384]";
+          }
+          s->texture_size = v.get<int>();
+          return "";
+        },
+        [](const S& s) { return json(s.texture_size); }}},
   };
   return keys;
 }
@@ -325,7 +335,8 @@ std::string FormatSchedule(const std::vector<StageOptions>& stages) {
                   static_cast<int>(width), s.name.c_str(), PhaseScheduleName(f.phases),
                   1 << f.cache.image_scale_log2, f.cache.render.spp, f.cache.pyramid_levels,
                   f.outer_iterations, f.solver.steps,
-                  s.texel_resolution > 0 ? std::to_string(s.texel_resolution).c_str()
+                  s.material_model == "uv" ? "uv"
+                  : s.texel_resolution > 0 ? std::to_string(s.texel_resolution).c_str()
                   : s.texel_resolution == kTexelResolutionAuto ? "auto"
                                                                : "keep",
                   SolverKindName(f.solver.kind), before.c_str());

@@ -5,10 +5,10 @@
 //     carved hull, "refine" otherwise), "refine" or "hull";
 //   - "stages": an explicit stage list (an array of objects) instead of a built-in one.
 // A stage object holds any flat key plus "name", and the stage-only keys "texel_resolution",
-// "remesh", "remesh_edge_pixels", "resample", "resample_fold_fraction" and "material_model"
-// (the effect planner's keys, "effects": "auto" and "pin", are flat keys: config.h). A stage's
-// options are: defaults < the stage's keys < the flat keys. Errors name the file, the stage and the
-// key ("cfg.json: stages[1].remesh: expected none, adaptive or isotropic").
+// "remesh", "remesh_edge_pixels", "resample", "resample_fold_fraction", "material_model" and
+// "texture_size" (the effect planner's keys, "effects": "auto" and "pin", are flat keys: config.h).
+// A stage's options are: defaults < the stage's keys < the flat keys. Errors name the file, the
+// stage and the key ("cfg.json: stages[1].remesh: expected none, adaptive or isotropic").
 #ifndef SFT_OPTIM_SCHEDULE_CONFIG_H_
 #define SFT_OPTIM_SCHEDULE_CONFIG_H_
 

@@ -1,4 +1,4 @@
-#include "src/export/atlas_packing.h"
+#include "src/atlas/atlas_packing.h"
 
 #include <Eigen/Geometry>
 #include <algorithm>

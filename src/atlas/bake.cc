@@ -1,4 +1,4 @@
-#include "src/export/bake.h"
+#include "src/atlas/bake.h"
 
 #include <algorithm>
 #include <chrono>

@@ -1,4 +1,4 @@
-#include "src/export/chart_parameterization.h"
+#include "src/atlas/chart_parameterization.h"
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Polygon_mesh_processing/border.h>

@@ -1,4 +1,4 @@
-#include "src/export/charts.h"
+#include "src/atlas/charts.h"
 
 #include <Eigen/Core>
 #include <algorithm>

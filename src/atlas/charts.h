@@ -13,13 +13,13 @@
 // vertex (a saddle) cannot be laid out flat without overlap by a conformal map. Charts under
 // `min_chart_faces` are then dissolved and their faces offered to their neighbours under a wider
 // cone; what is left is grown again.
-#ifndef SFT_EXPORT_CHARTS_H_
-#define SFT_EXPORT_CHARTS_H_
+#ifndef SFT_ATLAS_CHARTS_H_
+#define SFT_ATLAS_CHARTS_H_
 
 #include <string>
 #include <vector>
 
-#include "src/export/mesh_topology.h"
+#include "src/atlas/mesh_topology.h"
 
 namespace sft {
 
@@ -58,4 +58,4 @@ bool KeepsBorderAnglesFlat(const MeshTopology& topology, const std::vector<int>&
 
 }  // namespace sft
 
-#endif  // SFT_EXPORT_CHARTS_H_
+#endif  // SFT_ATLAS_CHARTS_H_

@@ -1,4 +1,4 @@
-#include "src/export/uv_atlas.h"
+#include "src/atlas/uv_atlas.h"
 
 #include <tbb/parallel_for.h>
 
@@ -7,9 +7,9 @@
 #include <chrono>
 #include <cmath>
 
-#include "src/export/atlas_packing.h"
-#include "src/export/chart_parameterization.h"
-#include "src/export/mesh_topology.h"
+#include "src/atlas/atlas_packing.h"
+#include "src/atlas/chart_parameterization.h"
+#include "src/atlas/mesh_topology.h"
 
 namespace sft {
 namespace {

@@ -1,7 +1,7 @@
 // The UV atlas: charts are disks and more than one face each, no two UV triangles overlap (a
 // supersampled coverage count), charts keep their gutters, stretch is bounded, utilisation is
 // honest, and non-manifold, mis-oriented and degenerate input is handled.
-#include "src/export/uv_atlas.h"
+#include "src/atlas/uv_atlas.h"
 
 #include <gtest/gtest.h>
 
@@ -9,7 +9,7 @@
 #include <set>
 #include <utility>
 
-#include "src/export/bake.h"
+#include "src/atlas/bake.h"
 #include "tests/testing/meshes.h"
 
 namespace sft {

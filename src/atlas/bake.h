@@ -9,12 +9,12 @@
 // The rest of the atlas is then filled by dilation: ring by ring (8-neighbourhood), each empty
 // texel next to filled ones takes their mean, until no texel is empty, so that mip-mapping and
 // bilinear filtering never pull in black.
-#ifndef SFT_EXPORT_BAKE_H_
-#define SFT_EXPORT_BAKE_H_
+#ifndef SFT_ATLAS_BAKE_H_
+#define SFT_ATLAS_BAKE_H_
 
+#include "src/atlas/uv_atlas.h"
 #include "src/core/image.h"
 #include "src/core/status.h"
-#include "src/export/uv_atlas.h"
 #include "src/geometry/material.h"
 
 namespace sft {
@@ -45,4 +45,4 @@ inline Eigen::Vector2d UvToTexel(const Eigen::Vector2d& uv, int texture_size) {
 
 }  // namespace sft
 
-#endif  // SFT_EXPORT_BAKE_H_
+#endif  // SFT_ATLAS_BAKE_H_

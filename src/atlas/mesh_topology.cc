@@ -1,4 +1,4 @@
-#include "src/export/mesh_topology.h"
+#include "src/atlas/mesh_topology.h"
 
 #include <Eigen/Geometry>
 #include <algorithm>

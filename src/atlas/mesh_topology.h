@@ -1,4 +1,4 @@
-// Face adjacency of a triangle list for the UV atlas (src/export/charts.h): which faces meet
+// Face adjacency of a triangle list for the UV atlas (src/atlas/charts.h): which faces meet
 // across which edge, which faces use which vertex, and the per-face geometry the charting needs.
 //
 // An edge joins two faces only when exactly two faces use it and they traverse it in opposite
@@ -6,8 +6,8 @@
 // (three or more faces), or two faces that disagree about orientation — is cut: it becomes a
 // border of every chart, which is how the atlas "splits" non-manifold edges. A face with a
 // repeated vertex index or (near-)zero area is "degenerate" and never enters a chart.
-#ifndef SFT_EXPORT_MESH_TOPOLOGY_H_
-#define SFT_EXPORT_MESH_TOPOLOGY_H_
+#ifndef SFT_ATLAS_MESH_TOPOLOGY_H_
+#define SFT_ATLAS_MESH_TOPOLOGY_H_
 
 #include <Eigen/Core>
 #include <array>
@@ -60,4 +60,4 @@ class MeshTopology {
 
 }  // namespace sft
 
-#endif  // SFT_EXPORT_MESH_TOPOLOGY_H_
+#endif  // SFT_ATLAS_MESH_TOPOLOGY_H_

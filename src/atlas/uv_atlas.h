@@ -9,15 +9,15 @@
 // Non-manifold and inconsistently oriented edges are cut (mesh_topology.h), so the charts on
 // either side are parameterised apart. Degenerate faces (a repeated vertex or zero area) get all
 // three corners at the centre of the atlas's top-left texel, which lies in the gutter.
-#ifndef SFT_EXPORT_UV_ATLAS_H_
-#define SFT_EXPORT_UV_ATLAS_H_
+#ifndef SFT_ATLAS_UV_ATLAS_H_
+#define SFT_ATLAS_UV_ATLAS_H_
 
 #include <Eigen/Core>
 #include <string>
 #include <vector>
 
+#include "src/atlas/charts.h"
 #include "src/core/status.h"
-#include "src/export/charts.h"
 
 namespace sft {
 
@@ -64,4 +64,4 @@ Status BuildUvAtlas(const std::vector<Eigen::Vector3d>& positions,
 
 }  // namespace sft
 
-#endif  // SFT_EXPORT_UV_ATLAS_H_
+#endif  // SFT_ATLAS_UV_ATLAS_H_

@@ -8,8 +8,8 @@
 // is `gutter` texels in from both edges; the largest s for which everything fits is found by
 // bisection. Any two charts are then at least `gutter` texels apart, and every chart at least
 // `gutter` texels from the atlas's edge.
-#ifndef SFT_EXPORT_ATLAS_PACKING_H_
-#define SFT_EXPORT_ATLAS_PACKING_H_
+#ifndef SFT_ATLAS_ATLAS_PACKING_H_
+#define SFT_ATLAS_ATLAS_PACKING_H_
 
 #include <Eigen/Core>
 #include <vector>
@@ -29,4 +29,4 @@ Status PackCharts(int texture_size, int gutter, std::vector<ChartCorners>* chart
 
 }  // namespace sft
 
-#endif  // SFT_EXPORT_ATLAS_PACKING_H_
+#endif  // SFT_ATLAS_ATLAS_PACKING_H_

@@ -1,6 +1,6 @@
 // Baking: the atlas textures give back the mesh-colors material at every mesh-colors texel's
 // representative point, and dilation leaves no texel empty.
-#include "src/export/bake.h"
+#include "src/atlas/bake.h"
 
 #include <gtest/gtest.h>
 

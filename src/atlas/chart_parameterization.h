@@ -9,14 +9,14 @@
 //   L2 = sqrt(Σ_t A_t·(Γ_t² + γ_t²)/2 / Σ_t A_t),
 // with Γ_t, γ_t the singular values of triangle t's Jacobian and A_t its surface area, after the
 // area normalisation above: 1 for an isometry, larger for any distortion of lengths or areas.
-#ifndef SFT_EXPORT_CHART_PARAMETERIZATION_H_
-#define SFT_EXPORT_CHART_PARAMETERIZATION_H_
+#ifndef SFT_ATLAS_CHART_PARAMETERIZATION_H_
+#define SFT_ATLAS_CHART_PARAMETERIZATION_H_
 
 #include <Eigen/Core>
 #include <string>
 #include <vector>
 
-#include "src/export/mesh_topology.h"
+#include "src/atlas/mesh_topology.h"
 
 namespace sft {
 
@@ -42,4 +42,4 @@ double L2Stretch(const MeshTopology& topology, const std::vector<int>& faces,
 
 }  // namespace sft
 
-#endif  // SFT_EXPORT_CHART_PARAMETERIZATION_H_
+#endif  // SFT_ATLAS_CHART_PARAMETERIZATION_H_
