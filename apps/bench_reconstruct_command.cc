@@ -53,20 +53,6 @@ Status MakeOptions(const BenchReconstructOptions& cli, ReconstructOptions* optio
   return Status::Ok();
 }
 
-nlohmann::json MpiJson(const MpiViewStats& s) {
-  return {{"ranks", s.ranks},
-          {"evaluations", s.evaluations},
-          {"remote_jobs", s.remote_jobs},
-          {"seconds",
-           {{"broadcast", s.broadcast},
-            {"local_render", s.local_render},
-            {"imbalance", s.imbalance},
-            {"worker_idle", s.worker_idle},
-            {"gather", s.gather}}},
-          {"broadcast_bytes", s.broadcast_bytes},
-          {"gather_bytes", s.gather_bytes}};
-}
-
 // Under mpirun (rank 0): the handshake once the inputs are read, the views spread while
 // measuring. Null `session`: one process.
 Status RunBenchReconstruct(const BenchReconstructOptions& cli, const MpiSession* session,
@@ -118,7 +104,7 @@ Status RunBenchReconstruct(const BenchReconstructOptions& cli, const MpiSession*
   std::fflush(stdout);
   if (!cli.json.empty()) {
     nlohmann::json json = ReconstructCostToJson(report);
-    if (runner) json["mpi"] = MpiJson(runner->stats());
+    if (runner) json["mpi"] = MpiViewStatsJson(runner->stats());
     json["dataset"] = cli.dataset;
     json["init"] = cli.init;
     SFT_RETURN_IF_ERROR(WriteTextFile(cli.json, json.dump(1) + "\n"));

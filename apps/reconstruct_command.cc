@@ -245,21 +245,6 @@ int FittedViews(const Dataset& dataset, const std::vector<StageOptions>& stages)
   return fitted;
 }
 
-nlohmann::json MpiMetrics(const MpiViewStats& s) {
-  return {{"mpi",
-           {{"ranks", s.ranks},
-            {"evaluations", s.evaluations},
-            {"remote_jobs", s.remote_jobs},
-            {"seconds",
-             {{"broadcast", s.broadcast},
-              {"local_render", s.local_render},
-              {"imbalance", s.imbalance},
-              {"worker_idle", s.worker_idle},
-              {"gather", s.gather}}},
-            {"broadcast_bytes", s.broadcast_bytes},
-            {"gather_bytes", s.gather_bytes}}}};
-}
-
 // `sft reconstruct` under mpirun (src/optim/mpi_views.h): rank 0 runs the schedule with its
 // renders spread over the ranks; the others serve renders. Errors print on rank 0 only; every
 // rank exits non-zero when the ranks do not agree to start (the handshake).
@@ -287,7 +272,9 @@ int RunReconstructMpi(const ReconstructCommandOptions& cli) {
     if (session->size() > 1) SetViewRunner(runner.get());
     return Status::Ok();
   };
-  const auto metrics = [&]() { return runner ? MpiMetrics(runner->stats()) : nlohmann::json{}; };
+  const auto metrics = [&]() {
+    return runner ? nlohmann::json{{"mpi", MpiViewStatsJson(runner->stats())}} : nlohmann::json{};
+  };
   if (!(cli.mpi_timeout > 0.0)) {
     status = Status::Error("--mpi-timeout: must be > 0 seconds");
   } else {

@@ -73,6 +73,29 @@ json AtlasJson(const UvAtlasReport& r, const BakeReport& b, int texture_size) {
           {"dilation_rings", b.dilation_rings}};
 }
 
+// The textured formats (OBJ + MTL + PNGs and/or glTF binary, Y-up) of an atlas and its textures;
+// adds the written files to *files.
+Status WriteAtlasFormats(const ExportOptions& options,
+                         const std::vector<Eigen::Vector3d>& positions,
+                         const std::vector<Eigen::Vector3i>& faces, const UvAtlas& atlas,
+                         const BakedMaterial& baked, const Material& material, bool obj, bool gltf,
+                         json* files) {
+  if (obj) {
+    SFT_RETURN_IF_ERROR(WriteObjExport(options.out, positions, faces, atlas, baked, material));
+    files->insert(files->end(), {kObjFile, kMtlFile, kAlbedoPngFile, kRoughnessPngFile});
+  }
+  if (gltf) {
+    std::vector<Eigen::Vector3d> y_up(positions.size());
+    for (size_t v = 0; v < positions.size(); ++v) {
+      y_up[v] = Eigen::Vector3d(positions[v].x(), positions[v].z(), -positions[v].y());
+    }
+    SFT_RETURN_IF_ERROR(
+        WriteGlbExport(JoinPath(options.out, kGlbFile), y_up, faces, atlas, baked, material));
+    files->push_back(kGlbFile);
+  }
+  return Status::Ok();
+}
+
 // The textured formats of a material that is UV textures already (a run whose last stage was a
 // uv stage): its corner UVs and fitted texels are written as they are, not re-baked.
 Status WriteFittedTextures(const ExportOptions& options, const std::vector<Eigen::Vector3i>& faces,
@@ -113,20 +136,7 @@ Status WriteFittedTextures(const ExportOptions& options, const std::vector<Eigen
                                      " ignored: the fitted textures are " + std::to_string(n) +
                                      "² and are written as they are");
   }
-  if (obj) {
-    SFT_RETURN_IF_ERROR(WriteObjExport(options.out, positions, faces, atlas, baked, material));
-    files->insert(files->end(), {kObjFile, kMtlFile, kAlbedoPngFile, kRoughnessPngFile});
-  }
-  if (gltf) {
-    std::vector<Eigen::Vector3d> y_up(positions.size());
-    for (size_t v = 0; v < positions.size(); ++v) {
-      y_up[v] = Eigen::Vector3d(positions[v].x(), positions[v].z(), -positions[v].y());
-    }
-    SFT_RETURN_IF_ERROR(
-        WriteGlbExport(JoinPath(options.out, kGlbFile), y_up, faces, atlas, baked, material));
-    files->push_back(kGlbFile);
-  }
-  return Status::Ok();
+  return WriteAtlasFormats(options, positions, faces, atlas, baked, material, obj, gltf, files);
 }
 
 // The atlas, the bake and the textured formats (OBJ and/or glTF); adds the atlas's numbers to
@@ -161,20 +171,7 @@ Status WriteTexturedFormats(const ExportOptions& options, const TriMesh& mesh,
                           .Prefixed(JoinPath(options.reconstruction, "material.json")));
   (*summary)["atlas"] = AtlasJson(atlas_report, bake_report, atlas.texture_size);
   (*summary)["atlas"]["texture_size_from"] = texture_from;
-  if (obj) {
-    SFT_RETURN_IF_ERROR(WriteObjExport(options.out, positions, faces, atlas, baked, material));
-    files->insert(files->end(), {kObjFile, kMtlFile, kAlbedoPngFile, kRoughnessPngFile});
-  }
-  if (gltf) {
-    std::vector<Eigen::Vector3d> y_up(positions.size());
-    for (size_t v = 0; v < positions.size(); ++v) {
-      y_up[v] = Eigen::Vector3d(positions[v].x(), positions[v].z(), -positions[v].y());
-    }
-    SFT_RETURN_IF_ERROR(
-        WriteGlbExport(JoinPath(options.out, kGlbFile), y_up, faces, atlas, baked, material));
-    files->push_back(kGlbFile);
-  }
-  return Status::Ok();
+  return WriteAtlasFormats(options, positions, faces, atlas, baked, material, obj, gltf, files);
 }
 
 }  // namespace

@@ -20,6 +20,20 @@
 
 namespace sft {
 
+nlohmann::json MpiViewStatsJson(const MpiViewStats& s) {
+  return {{"ranks", s.ranks},
+          {"evaluations", s.evaluations},
+          {"remote_jobs", s.remote_jobs},
+          {"seconds",
+           {{"broadcast", s.broadcast},
+            {"local_render", s.local_render},
+            {"imbalance", s.imbalance},
+            {"worker_idle", s.worker_idle},
+            {"gather", s.gather}}},
+          {"broadcast_bytes", s.broadcast_bytes},
+          {"gather_bytes", s.gather_bytes}};
+}
+
 bool MpiSession::Launched() {
 #ifdef SFT_HAVE_MPI
   // Open MPI's launcher (OMPI_COMM_WORLD_SIZE), PMIx launchers (PMIX_RANK) and MPICH's Hydra

@@ -21,6 +21,7 @@
 
 #include <map>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <utility>
 #include <vector>
@@ -47,6 +48,11 @@ struct MpiViewStats {
   int64_t broadcast_bytes = 0;  // per receiving rank.
   int64_t gather_bytes = 0;     // results received.
 };
+
+// The stats as JSON (metrics.json's and `sft bench reconstruct --json`'s "mpi" entry): ranks,
+// evaluations, remote_jobs, seconds {broadcast, local_render, imbalance, worker_idle, gather},
+// broadcast_bytes, gather_bytes.
+nlohmann::json MpiViewStatsJson(const MpiViewStats& stats);
 
 // The MPI process group of this run.
 class MpiSession {
