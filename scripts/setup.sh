@@ -2,6 +2,12 @@
 # Installs every Debian 12 package sft needs to build, test and run. Idempotent: re-running it
 # only re-checks the packages. Needs root (or sudo). Set SFT_SKIP_APT=1 to skip (e.g. when the
 # packages are known to be present and the network is unavailable).
+#
+# Optional clients, for checks outside the default suite:
+#   --with-blender   Blender 3.4 and NumPy (the Blender round trip of `sft export`, whose test
+#                    skips without them; docs/export.md)
+#   --with-chromium  headless Chromium (screenshots of report.html and its 3D view;
+#                    scripts/check_report_viewer.sh)
 set -euo pipefail
 
 PACKAGES=(
@@ -29,7 +35,16 @@ PACKAGES=(
   libopenmpi-dev openmpi-bin
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev
+  # three.js (report.html's 3D view of the result, copied beside the report)
+  libjs-three
 )
+for arg in "$@"; do
+  case "$arg" in
+    --with-blender) PACKAGES+=(blender python3-numpy) ;;
+    --with-chromium) PACKAGES+=(chromium) ;;
+    *) echo "setup: unknown option $arg (use --with-blender, --with-chromium)" >&2; exit 2 ;;
+  esac
+done
 
 if [[ "${SFT_SKIP_APT:-0}" == "1" ]]; then
   echo "setup: SFT_SKIP_APT=1, not installing packages"
