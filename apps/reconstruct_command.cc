@@ -15,6 +15,7 @@
 #include "src/core/progress.h"
 #include "src/eval/mesh_metrics.h"
 #include "src/eval/reconstruct_report.h"
+#include "src/export/export.h"
 #include "src/geometry/material.h"
 #include "src/geometry/mesh.h"
 #include "src/io/dataset.h"
@@ -192,6 +193,28 @@ Status PrepareSchedule(ReconstructCommandOptions* cli, Dataset* dataset,
   return Schedule::Start(*dataset, cli->out, stages, state, run_info, schedule);
 }
 
+// OUT/export/ (ExportFinishedRun) for the report's 3D view and for other programs. A failed export
+// does not fail the run, whose results are written: one line says why, and the report shows it.
+ReportModel ExportAsset(const std::string& out, const Dataset& dataset, bool stopped) {
+  ReportModel model;
+  if (stopped) {
+    model.missing = "the run was interrupted; sft export --reconstruction " + out +
+                    " writes the asset of the state it reached";
+    return model;
+  }
+  nlohmann::json summary;
+  const Status exported = ExportFinishedRun(out, dataset, &summary);
+  if (!exported.ok()) {
+    model.missing = "the export failed: " + exported.message();
+    std::fprintf(stderr, "sft reconstruct: warning: %s\n", model.missing.c_str());
+    return model;
+  }
+  model.viewer.export_dir = kRunExportDir;
+  const std::string start = JoinPath(out, "initial_mesh.ply");
+  if (FileExists(start)) model.viewer.start_mesh = start;
+  return model;
+}
+
 Status RunReconstruct(const ReconstructCommandOptions& cli_in, const BeforeStart& before_start = {},
                       const std::function<nlohmann::json()>& extra_metrics = {}) {
   ReconstructCommandOptions cli = cli_in;
@@ -219,9 +242,10 @@ Status RunReconstruct(const ReconstructCommandOptions& cli_in, const BeforeStart
   SFT_RETURN_IF_ERROR(schedule->Run(callbacks));
   progress.Finish();
   if (!cli.no_report && schedule->reconstruction() != nullptr) {
+    const ReportModel model = ExportAsset(cli.out, dataset, schedule->stopped());
     SFT_RETURN_IF_ERROR(
         WriteReconstructReport(cli.out, dataset, schedule->records(), schedule->reconstruction(),
-                               schedule->outer_records(), schedule->stage_records()));
+                               schedule->outer_records(), schedule->stage_records(), model));
   }
   const ScheduleProgress& p = schedule->progress();
   if (schedule->stopped()) {
@@ -229,9 +253,10 @@ Status RunReconstruct(const ReconstructCommandOptions& cli_in, const BeforeStart
                          " outer iterations; state written to " + cli.out +
                          " (continue with --resume " + cli.out + ")");
   }
-  std::printf("sft reconstruct: %d outer iterations, %.1f s; mesh %s, report %s\n", p.outer_done,
-              p.seconds, JoinPath(cli.out, "mesh.ply").c_str(),
-              cli.no_report ? "(none)" : JoinPath(cli.out, "report.html").c_str());
+  std::printf("sft reconstruct: %d outer iterations, %.1f s; mesh %s, report %s, asset %s\n",
+              p.outer_done, p.seconds, JoinPath(cli.out, "mesh.ply").c_str(),
+              cli.no_report ? "(none)" : JoinPath(cli.out, "report.html").c_str(),
+              cli.no_report ? "(none)" : JoinPath(cli.out, kRunExportDir).c_str());
   return Status::Ok();
 }
 

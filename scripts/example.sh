@@ -32,4 +32,5 @@ echo "== re-renders of the reconstruction against the images and the true albedo
 ./build/sft eval --dataset "$out/dataset" --reconstruction "$out/reconstruction" --spp 32 \
   --bounces 1 --json "$out/eval.json" > /dev/null
 grep -E '^ "(full|albedo|roughness)"|^  "(psnr_srgb|ssim_srgb|psnr_linear)"' "$out/eval.json"
-echo "example: report in $out/reconstruction/report.html"
+echo "example: report in $out/reconstruction/report.html (its 3D view needs a browser with WebGL)"
+echo "example: asset in $out/reconstruction/export/ (model.glb, model.obj + model.mtl + PNGs; docs/export.md)"

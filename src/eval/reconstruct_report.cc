@@ -106,7 +106,7 @@ void AddEffectPlans(const nlohmann::json& outer, HtmlReport* html) {
 Status WriteReconstructReport(const std::string& out, const Dataset& dataset,
                               const std::vector<IterationRecord>& records,
                               Reconstruction* reconstruction, const nlohmann::json& outer_records,
-                              const nlohmann::json& stage_records) {
+                              const nlohmann::json& stage_records, const ReportModel& model) {
   HtmlReport html(out, "sft reconstruct: " + dataset.root);
   const IterationRecord* last = records.empty() ? nullptr : &records.back();
   html.AddSummaryTable({{"dataset", dataset.root},
@@ -144,6 +144,12 @@ Status WriteReconstructReport(const std::string& out, const Dataset& dataset,
   AddReferenceCharts(outer_records, &html);
   SFT_RETURN_IF_ERROR(AddStages(stage_records, &html));
   AddEffectPlans(outer_records, &html);
+  if (!model.viewer.export_dir.empty()) {
+    SFT_RETURN_IF_ERROR(AddModelViewer(model.viewer, dataset, &html));
+  } else if (!model.missing.empty()) {
+    html.AddHeading("The result in 3D");
+    html.AddParagraph("No 3D view: " + model.missing);
+  }
   html.AddHeading("Views at the final state");
   const std::vector<Image> renders = reconstruction->RenderViews(/*seed=*/0x5f7eed);
   const RenderCache& cache = reconstruction->cache();

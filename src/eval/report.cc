@@ -146,6 +146,8 @@ void HtmlReport::AddBarChart(const BarChart& chart) { body_ += BarChartSvg(chart
 
 void HtmlReport::AddSvg(const std::string& svg) { body_ += svg; }
 
+void HtmlReport::AddHtml(const std::string& markup) { body_ += markup + "\n"; }
+
 Status HtmlReport::WriteImage(const std::string& file, const Image& image) {
   SFT_RETURN_IF_ERROR(CheckImageFile(file));
   CHECK(!image.empty()) << file;

@@ -1,7 +1,8 @@
 // Self-contained HTML reports for long commands (the "human report" of the project standard):
 // a title, summary tables, rows of images (PNG files written next to the HTML and referenced by
-// relative paths) and simple inline SVG plots. No JavaScript and no external resources (the
-// style sheet is inline), so the report directory can be copied or archived as is. All text is
+// relative paths) and simple inline SVG plots. No external resources (the style sheet is inline;
+// the one script, the 3D view of model_viewer.h, is copied into the report's folder), so the
+// report directory can be copied or archived as is. All text is
 // HTML-escaped. The page is written atomically (WriteTextFile), as are the images (WritePng).
 //
 // Usage:
@@ -82,6 +83,8 @@ class HtmlReport {
   void AddBarChart(const BarChart& chart);
   // Appends an inline <svg> element made by this program (e.g. LineChartSvg); not escaped.
   void AddSvg(const std::string& svg);
+  // Appends markup made by this program (e.g. the 3D view of model_viewer.h); not escaped.
+  void AddHtml(const std::string& markup);
   // Writes `image` as an 8-bit sRGB-encoded PNG (colour clamped to [0, 1]; alpha dropped, so
   // thumbnails show on black) to dir/file, atomically. Errors: a file that is empty, absolute,
   // contains "..", or does not end in ".png"; a failed write.

@@ -195,29 +195,20 @@ bool ExportOptions::Check(std::string* why) const {
   return checked.Check(why);
 }
 
-Status ExportReconstruction(const ExportOptions& options, json* summary) {
-  const auto start = std::chrono::steady_clock::now();
-  std::string why;
-  if (!options.Check(&why)) return Status::Error("--" + why);
-  SFT_RETURN_IF_ERROR(
-      CheckOutputDirectory(options.out, {{options.reconstruction, options.dataset}, {}}, "--out"));
-  TriMesh mesh;
-  SFT_RETURN_IF_ERROR(ReadMesh(JoinPath(options.reconstruction, "mesh.ply"), &mesh));
-  Material material;
-  SFT_RETURN_IF_ERROR(LoadMaterial(JoinPath(options.reconstruction, "material.json"), mesh,
-                                   &material, MaterialUse::kCheckpoint));
-  json warnings = json::array();
-  Dataset dataset;
-  bool have_dataset = false;
-  SFT_RETURN_IF_ERROR(FindDataset(options, &dataset, &have_dataset, &warnings));
+namespace {
 
+// Everything after the inputs are read: the frame, the formats and export.json. `dataset` may be
+// null (sft's world frame is used).
+Status ExportModel(const ExportOptions& options, const TriMesh& mesh, const Material& material,
+                   const Dataset* dataset, json warnings,
+                   std::chrono::steady_clock::time_point start, json* summary) {
   std::vector<Eigen::Vector3d> world;
   std::vector<Eigen::Vector3i> faces;
   MeshToArrays(mesh, &world, &faces);
-  const bool source_frame = have_dataset && dataset.has_source_from_world;
+  const bool source_frame = dataset != nullptr && dataset->has_source_from_world;
   std::vector<Eigen::Vector3d> positions = world;
   if (source_frame) {
-    for (Eigen::Vector3d& p : positions) p = dataset.source_from_world * p;
+    for (Eigen::Vector3d& p : positions) p = dataset->source_from_world * p;
   }
   const bool obj = options.format == "obj" || options.format == "all";
   const bool gltf = options.format == "gltf" || options.format == "all";
@@ -231,7 +222,7 @@ Status ExportReconstruction(const ExportOptions& options, json* summary) {
               {"specular", material.specular},
               {"fresnel", material.fresnel == FresnelMode::kSchlick ? "schlick" : "constant"}};
   if (source_frame) {
-    const Similarity3d& s = dataset.source_from_world;
+    const Similarity3d& s = dataset->source_from_world;
     (*summary)["source_from_world"] = {
         {"scale", s.scale},
         {"rotation", {s.rotation.w(), s.rotation.x(), s.rotation.y(), s.rotation.z()}},
@@ -241,8 +232,7 @@ Status ExportReconstruction(const ExportOptions& options, json* summary) {
 
   if (obj || gltf) {
     SFT_RETURN_IF_ERROR(WriteTexturedFormats(options, mesh, world, faces, positions, material,
-                                             have_dataset ? &dataset : nullptr, obj, gltf, summary,
-                                             &files));
+                                             dataset, obj, gltf, summary, &files));
   }
   if (ply) {
     SFT_RETURN_IF_ERROR(
@@ -258,6 +248,42 @@ Status ExportReconstruction(const ExportOptions& options, json* summary) {
   (*summary)["seconds"] =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return WriteTextFile(JoinPath(options.out, kSummaryFile), summary->dump(1) + "\n");
+}
+
+// RUN/mesh.ply and RUN/material.json (with its mesh-colors or UV texture files).
+Status ReadRunModel(const std::string& run, TriMesh* mesh, Material* material) {
+  SFT_RETURN_IF_ERROR(ReadMesh(JoinPath(run, "mesh.ply"), mesh));
+  return LoadMaterial(JoinPath(run, "material.json"), *mesh, material, MaterialUse::kCheckpoint);
+}
+
+}  // namespace
+
+Status ExportReconstruction(const ExportOptions& options, json* summary) {
+  const auto start = std::chrono::steady_clock::now();
+  std::string why;
+  if (!options.Check(&why)) return Status::Error("--" + why);
+  SFT_RETURN_IF_ERROR(
+      CheckOutputDirectory(options.out, {{options.reconstruction, options.dataset}, {}}, "--out"));
+  TriMesh mesh;
+  Material material;
+  SFT_RETURN_IF_ERROR(ReadRunModel(options.reconstruction, &mesh, &material));
+  json warnings = json::array();
+  Dataset dataset;
+  bool have_dataset = false;
+  SFT_RETURN_IF_ERROR(FindDataset(options, &dataset, &have_dataset, &warnings));
+  return ExportModel(options, mesh, material, have_dataset ? &dataset : nullptr, warnings, start,
+                     summary);
+}
+
+Status ExportFinishedRun(const std::string& run, const Dataset& dataset, json* summary) {
+  const auto start = std::chrono::steady_clock::now();
+  ExportOptions options;
+  options.reconstruction = run;
+  options.out = JoinPath(run, kRunExportDir);
+  TriMesh mesh;
+  Material material;
+  SFT_RETURN_IF_ERROR(ReadRunModel(run, &mesh, &material));
+  return ExportModel(options, mesh, material, &dataset, json::array(), start, summary);
 }
 
 }  // namespace sft

@@ -43,6 +43,14 @@ struct ExportOptions {
 // state.json cannot be read, so the world frame is used) are listed in summary["warnings"].
 Status ExportReconstruction(const ExportOptions& options, nlohmann::json* summary);
 
+// The folder inside a run's output where `sft reconstruct` writes its asset at the end.
+constexpr char kRunExportDir[] = "export";
+
+// What a finished `sft reconstruct` writes into RUN/export/ (kRunExportDir): the same files as
+// `sft export --reconstruction RUN --format all` with the run's `dataset` and the automatic
+// texture size. The caller has checked RUN as an output folder (this writes below it only).
+Status ExportFinishedRun(const std::string& run, const Dataset& dataset, nlohmann::json* summary);
+
 }  // namespace sft
 
 #endif  // SFT_EXPORT_EXPORT_H_

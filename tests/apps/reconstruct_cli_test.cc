@@ -46,6 +46,20 @@ TEST(ReconstructCliTest, ReconstructEvalResume) {
                            "metrics.json", "state.json", "report.html", "initial_mesh.ply"}) {
     EXPECT_TRUE(fs::exists(tmp.Join(std::string("r/") + file))) << file;
   }
+  // The asset for other programs, and the report's 3D view of it beside the start mesh.
+  for (const char* file : {"model.obj", "model.mtl", "model_albedo.png", "model_roughness.png",
+                           "model.glb", "model.ply", "export.json"}) {
+    EXPECT_TRUE(fs::exists(tmp.Join(std::string("r/export/") + file))) << file;
+  }
+  const std::string report = testing::ReadTestFile(tmp.Join("r/report.html"));
+  EXPECT_THAT(report, HasSubstr("export/model_albedo.png"));
+  if (fs::exists("/usr/share/javascript/three/three.min.js")) {
+    EXPECT_THAT(report, HasSubstr("<canvas id=\"sft3d-start\""));
+    EXPECT_THAT(report, HasSubstr("<canvas id=\"sft3d-result\""));
+    EXPECT_TRUE(fs::exists(tmp.Join("r/report_files/three/GLTFLoader.js")));
+  } else {
+    EXPECT_THAT(report, HasSubstr("three.js is not installed"));
+  }
   const nlohmann::json metrics =
       nlohmann::json::parse(testing::ReadTestFile(tmp.Join("r/metrics.json")));
   const auto& iterations = metrics["iterations"];

@@ -27,9 +27,11 @@ std::string Mpirun() {
 }
 
 // Every output of a run whose bytes are its result (not timings): the meshes, the material and
-// its mesh-colors files, the light scales, the stages' normal images.
+// its mesh-colors files, the light scales, the stages' normal images, the exported asset (not its
+// export.json, which holds timings).
 std::set<std::string> ResultFiles(const std::string& dir) {
-  const std::set<std::string> skip = {"metrics.json", "metrics.csv", "state.json", "report.html"};
+  const std::set<std::string> skip = {"metrics.json", "metrics.csv", "state.json", "report.html",
+                                      "export/export.json"};
   std::set<std::string> files;
   for (const auto& entry : fs::recursive_directory_iterator(dir)) {
     const std::string name = fs::relative(entry.path(), dir).string();
