@@ -4,17 +4,14 @@
 // holds one of its inputs.
 // Unless --no-report, each render is also compared with its dataset image (CompareImages over the
 // view's mask, or the target's alpha when the view has no mask), the measures go into render.json
-// and DIR/report.html shows target, render and |difference| per view (PNGs in DIR/report_files/).
+// and DIR/report.html shows target, render and |difference| per view (src/eval/render_report.h).
 #include <cstdio>
-#include <filesystem>
-#include <limits>
 #include <nlohmann/json.hpp>
 
 #include "apps/commands.h"
 #include "src/core/file_util.h"
 #include "src/core/progress.h"
-#include "src/eval/image_compare.h"
-#include "src/eval/report.h"
+#include "src/eval/render_report.h"
 #include "src/geometry/material.h"
 #include "src/geometry/mesh.h"
 #include "src/io/dataset.h"
@@ -41,137 +38,6 @@ struct RenderCommandOptions {
   bool quiet = false;            // no progress line.
   bool no_report = false;        // skip the comparison with the dataset images and report.html.
 };
-
-constexpr char kReportFiles[] = "report_files";  // the report's PNGs, under OUT/.
-constexpr int kDifferenceGain = 4;               // |difference| thumbnails are this much brighter.
-
-// One render against its dataset image (the "target").
-struct ViewComparison {
-  Image target;             // as read (RGB or RGBA); empty when missing or unreadable.
-  Image mask;               // 1 channel, > 0.5 = object; empty when there is none.
-  std::string mask_source;  // the mask file (relative to the dataset) or "target alpha".
-  bool compared = false;    // `agreement` is valid.
-  ImageAgreement agreement;
-  std::string why_not;  // when !compared: the reason.
-};
-
-// 1 where channel 3 of `image` (RGBA) is > 0.5, else 0.
-Image AlphaMask(const Image& image) {
-  Image mask(image.width, image.height, 1);
-  for (int y = 0; y < image.height; ++y) {
-    for (int x = 0; x < image.width; ++x) mask.at(x, y) = image.at(x, y, 3) > 0.5f ? 1.0f : 0.0f;
-  }
-  return mask;
-}
-
-// Loads view `v`'s target and mask and compares `ours` with it. Never fails: problems (missing or
-// unreadable files, size mismatches, no mask) leave `compared` false with the reason.
-ViewComparison CompareWithTarget(const Dataset& dataset, int v, const Image& ours,
-                                 bool colour_pass) {
-  ViewComparison result;
-  const ViewSpec& view = dataset.views[v];
-  Image target;
-  const Status read = ReadImage(JoinPath(dataset.root, view.image), &target);
-  if (!read.ok()) {
-    result.why_not = read.message();
-    return result;
-  }
-  if (target.width != ours.width || target.height != ours.height) {
-    result.why_not = JoinPath(dataset.root, view.image) + ": size " + std::to_string(target.width) +
-                     "x" + std::to_string(target.height) + " differs from the render's " +
-                     std::to_string(ours.width) + "x" + std::to_string(ours.height);
-    return result;
-  }
-  if (target.channels == 1) target = ScaledRgb(target, 1.0);
-  result.target = std::move(target);
-  if (!view.mask.empty()) {
-    const Status mask = LoadViewMask(dataset, v, &result.mask);
-    if (!mask.ok()) {
-      result.mask = Image();
-      result.why_not = mask.message();
-      return result;
-    }
-    result.mask_source = view.mask;
-  } else if (result.target.channels == 4) {
-    result.mask = AlphaMask(result.target);
-    result.mask_source = "target alpha";
-  } else {
-    result.why_not = "view has no mask and " + view.image + " has no alpha channel";
-    return result;
-  }
-  if (!colour_pass) {
-    result.why_not = "only the color pass is compared with the dataset images";
-    return result;
-  }
-  if (ours.channels < 3) {
-    result.why_not = "the render has fewer than 3 channels";
-    return result;
-  }
-  result.agreement = CompareImages(ours, result.target, result.mask);
-  if (result.agreement.object_pixels == 0) {
-    result.why_not = result.mask_source + ": no object pixels";
-    return result;
-  }
-  result.compared = true;
-  return result;
-}
-
-nlohmann::json AgreementJson(const ViewComparison& c) {
-  return {{"relative_mean_abs_difference", c.agreement.relative_mean_abs_difference},
-          {"relative_mean_difference", c.agreement.relative_mean_difference},
-          {"max_block_relative_difference", c.agreement.max_block_relative_difference},
-          {"mean_block_relative_difference", c.agreement.mean_block_relative_difference},
-          {"blocks_compared", c.agreement.blocks_compared},
-          {"object_pixels", c.agreement.object_pixels},
-          {"mean_target", c.agreement.mean_reference},
-          {"mask", c.mask_source}};
-}
-
-// Writes view `v`'s thumbnails (target, render and |difference| × kDifferenceGain, all with the
-// target's exposure; the render alone gets its own when there is no target or the pass is not
-// colour) and returns the report row for them.
-Status MakeReportRow(HtmlReport* report, int v, const std::string& image_name, const Image& ours,
-                     const ViewComparison& c, bool colour_pass, ImageRow* row) {
-  char prefix[64];
-  std::snprintf(prefix, sizeof(prefix), "%s/view_%03d_", kReportFiles, v);
-  const std::string base(prefix);
-  row->label = "view " + std::to_string(v) + " (" + image_name + ")";
-  const bool have_target = !c.target.empty();
-  const Image* exposure_mask = c.mask.empty() ? nullptr : &c.mask;
-  const double target_scale = have_target ? ExposureScale(c.target, exposure_mask) : 1.0;
-  if (have_target) {
-    SFT_RETURN_IF_ERROR(report->WriteImage(base + "target.png", ScaledRgb(c.target, target_scale)));
-    row->images.push_back({base + "target.png", "target", nullptr});
-  } else {
-    row->images.push_back({"", "target: not available", nullptr});
-  }
-  double render_scale = target_scale;
-  if (!have_target || !colour_pass) {
-    Image alpha;
-    if (ours.channels == 4) alpha = AlphaMask(ours);
-    render_scale = ExposureScale(ours, alpha.empty() ? nullptr : &alpha);
-  }
-  SFT_RETURN_IF_ERROR(report->WriteImage(base + "render.png", ScaledRgb(ours, render_scale)));
-  row->images.push_back({base + "render.png", "render", nullptr});
-  if (c.compared) {
-    SFT_RETURN_IF_ERROR(report->WriteImage(
-        base + "difference.png", AbsDifferenceRgb(ours, c.target, kDifferenceGain * target_scale)));
-    row->images.push_back({base + "difference.png",
-                           "|render − target| ×" + std::to_string(kDifferenceGain), nullptr});
-    const ImageAgreement& a = c.agreement;
-    row->notes = {
-        {"relative mean |difference|", FormatNumber(a.relative_mean_abs_difference)},
-        {"relative mean difference (bias)", FormatNumber(a.relative_mean_difference)},
-        {"max 8×8 block relative difference", FormatNumber(a.max_block_relative_difference)},
-        {"blocks compared", std::to_string(a.blocks_compared)},
-        {"object pixels", std::to_string(a.object_pixels)},
-        {"mask", c.mask_source},
-        {"exposure", "×" + FormatNumber(target_scale)}};
-  } else {
-    row->notes = {{"comparison", "none: " + c.why_not}};
-  }
-  return Status::Ok();
-}
 
 // Parses the shared render flags into `options`, returning a failed status naming the flag.
 Status FinishRenderOptions(const std::string& pass, const std::string& effects,
@@ -222,22 +88,16 @@ Status RunRender(const RenderCommandOptions& opts) {
   }
   Progress progress("render (tiles)", total_tiles, !opts.quiet);
   render.on_tile_done = [&progress] { progress.Advance(); };
-  nlohmann::json report;
-  report["dataset"] = opts.dataset;
-  report["mesh"] = opts.mesh;
-  report["spp"] = render.spp;
-  report["bounces"] = render.bounces;
-  report["effects"] = render.effects.ToString();
-  report["shading"] = ShadingName(render.shading);
-  report["pass"] = opts.pass;
-  report["seed"] = render.seed;
-  const bool colour_pass = render.pass == RenderPass::kColor;
-  HtmlReport html(opts.out, "sft render: " + opts.dataset);
-  std::vector<ImageRow> rows;
-  std::vector<std::string> bar_labels;
-  std::vector<double> bar_values;
-  int compared = 0;
-  double sum_mean_abs = 0.0, sum_bias = 0.0, sum_max_block = 0.0;
+  nlohmann::json report = {{"dataset", opts.dataset},
+                           {"mesh", opts.mesh},
+                           {"spp", render.spp},
+                           {"bounces", render.bounces},
+                           {"effects", render.effects.ToString()},
+                           {"shading", ShadingName(render.shading)},
+                           {"pass", opts.pass},
+                           {"seed", render.seed}};
+  RenderReport comparison(opts.out, "sft render: " + opts.dataset,
+                          render.pass == RenderPass::kColor);
   nlohmann::json per_view = nlohmann::json::array();
   for (int v : selected) {
     Image image;
@@ -258,28 +118,9 @@ Status RunRender(const RenderCommandOptions& opts) {
                     " pixel values not finite");
     }
     if (!opts.no_report) {
-      const ViewComparison c = CompareWithTarget(dataset, v, image, colour_pass);
-      entry["target"] = dataset.views[v].image;
-      bar_labels.push_back(std::to_string(v));
-      if (c.compared) {
-        entry["comparison"] = AgreementJson(c);
-        ++compared;
-        sum_mean_abs += c.agreement.relative_mean_abs_difference;
-        sum_bias += c.agreement.relative_mean_difference;
-        sum_max_block += c.agreement.max_block_relative_difference;
-        bar_values.push_back(c.agreement.relative_mean_abs_difference);
-      } else {
-        entry["comparison"] = nullptr;
-        entry["comparison_skipped"] = c.why_not;
-        if (colour_pass) {
-          progress.Warn("view " + std::to_string(v) + " not compared: " + c.why_not);
-        }
-        bar_values.push_back(std::numeric_limits<double>::quiet_NaN());
-      }
-      ImageRow row;
-      SFT_RETURN_IF_ERROR(
-          MakeReportRow(&html, v, dataset.views[v].image, image, c, colour_pass, &row));
-      rows.push_back(std::move(row));
+      std::string warning;
+      SFT_RETURN_IF_ERROR(comparison.AddView(dataset, v, image, &entry, &warning));
+      if (!warning.empty()) progress.Warn(warning);
     }
     per_view.push_back(std::move(entry));
   }
@@ -287,54 +128,16 @@ Status RunRender(const RenderCommandOptions& opts) {
   report["views"] = per_view;
   report["seconds"] = progress.ElapsedSeconds();
   if (!opts.no_report) {
-    nlohmann::json overall = nullptr;
-    if (compared > 0) {
-      overall = {{"views_compared", compared},
-                 {"mean_relative_mean_abs_difference", sum_mean_abs / compared},
-                 {"mean_relative_mean_difference", sum_bias / compared},
-                 {"mean_max_block_relative_difference", sum_max_block / compared}};
-    }
-    report["comparison"] = overall;
-    report["views_compared"] = compared;
-    report["report"] = "report.html";
-    const double mean_abs = compared > 0 ? sum_mean_abs / compared : 0.0;
-    html.AddSummaryTable(
-        {{"dataset", opts.dataset},
-         {"mesh", opts.mesh},
-         {"material", opts.material.empty() ? "default" : opts.material},
-         {"pass", opts.pass},
-         {"spp", std::to_string(render.spp)},
-         {"bounces", std::to_string(render.bounces)},
-         {"effects", render.effects.ToString()},
-         {"seed", std::to_string(render.seed)},
-         {"views rendered", std::to_string(selected.size())},
-         {"views compared", std::to_string(compared)},
-         {"mean relative mean |difference|", compared > 0 ? FormatNumber(mean_abs) : "n/a"},
-         {"mean relative mean difference (bias)",
-          compared > 0 ? FormatNumber(sum_bias / compared) : "n/a"},
-         {"mean max 8×8 block relative difference",
-          compared > 0 ? FormatNumber(sum_max_block / compared) : "n/a"},
-         {"render seconds", FormatNumber(progress.ElapsedSeconds())}});
-    html.AddParagraph(
-        "Measures over the view's mask (or the target's alpha > 0.5): mean |render − target| "
-        "and mean (render − target) relative to the target's mean, over RGB. Thumbnails are "
-        "sRGB-encoded with the exposure that maps the target's 99th percentile (over the mask) "
-        "to 1; the difference uses the same exposure ×" +
-        std::to_string(kDifferenceGain) + ".");
-    BarChart chart;
-    chart.title = "relative mean |render − target| per view";
-    chart.x_label = "view";
-    chart.y_label = "mean |d| / mean target";
-    chart.labels = bar_labels;
-    chart.values = bar_values;
-    if (compared > 0) {
-      chart.reference_value = mean_abs;
-      chart.reference_label = "mean";
-    }
-    html.AddBarChart(chart);
-    html.AddHeading("Views");
-    for (const ImageRow& row : rows) SFT_RETURN_IF_ERROR(html.AddImageRow(row));
-    SFT_RETURN_IF_ERROR(html.Write("report.html"));
+    const RenderReportSettings settings{opts.dataset,
+                                        opts.mesh,
+                                        opts.material,
+                                        opts.pass,
+                                        render.spp,
+                                        render.bounces,
+                                        render.effects.ToString(),
+                                        render.seed};
+    SFT_RETURN_IF_ERROR(comparison.Write(settings, static_cast<int>(selected.size()),
+                                         progress.ElapsedSeconds(), &report));
   }
   return WriteTextFile(JoinPath(opts.out, "render.json"), report.dump(1) + "\n");
 }
