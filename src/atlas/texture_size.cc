@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include "src/geometry/mesh_colors.h"
+
 namespace sft {
 
 int TextureSizeFromFootprint(const Dataset& dataset, const Eigen::Vector3d& center, double area) {
@@ -17,6 +19,17 @@ int TextureSizeFromFootprint(const Dataset& dataset, const Eigen::Vector3d& cent
   }
   if (!std::isfinite(footprint) || !(area > 0.0)) return kDefaultTextureSize;
   const double side = std::sqrt(area / (footprint * footprint) / 0.5);
+  int size = 256;
+  while (size < side && size < 4096) size *= 2;
+  return size;
+}
+
+int TextureSizeForMeshColors(int num_faces, int resolution) {
+  constexpr double kUtilization = 0.35;
+  constexpr double kTexelsPerSample = 4.0;
+  const double samples =
+      static_cast<double>(std::max(num_faces, 0)) * MeshColors::TexelsPerFace(resolution);
+  const double side = std::sqrt(kTexelsPerSample * samples / kUtilization);
   int size = 256;
   while (size < side && size < 4096) size *= 2;
   return size;

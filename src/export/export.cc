@@ -160,6 +160,14 @@ Status WriteTexturedFormats(const ExportOptions& options, const TriMesh& mesh,
         dataset != nullptr ? TextureSizeFromFootprint(*dataset, 0.5 * (lo + hi), SurfaceArea(mesh))
                            : kDefaultTextureSize;
     texture_from = dataset != nullptr ? "pixel footprint" : "default";
+    // Not below what the bake needs to keep the mesh colours' detail (texture_size.h).
+    const int faces = static_cast<int>(mesh.n_faces());
+    const int bake = TextureSizeForMeshColors(
+        faces, std::max(material.albedo.resolution(), material.roughness.resolution()));
+    if (bake > atlas_options.texture_size) {
+      atlas_options.texture_size = bake;
+      texture_from = "mesh-colour density";
+    }
   }
   UvAtlas atlas;
   UvAtlasReport atlas_report;

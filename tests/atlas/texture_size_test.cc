@@ -1,4 +1,5 @@
-// The texture size from the dataset's pixel footprint (src/atlas/texture_size.h).
+// The texture size from the dataset's pixel footprint and from a mesh-colors material's density
+// (src/atlas/texture_size.h).
 #include "src/atlas/texture_size.h"
 
 #include <gtest/gtest.h>
@@ -23,6 +24,16 @@ TEST(TextureSizeTest, FromFootprint) {
   EXPECT_EQ(TextureSizeFromFootprint(dataset, origin, 1e7), 4096);  // clamped down.
   dataset.views.clear();
   EXPECT_EQ(TextureSizeFromFootprint(dataset, origin, 1e4), 1024);  // no views: the default.
+}
+
+TEST(TextureSizeTest, ForMeshColors) {
+  // Side = sqrt(4 · faces · (r+1)(r+2)/2 / 0.35), rounded up to a power of two.
+  EXPECT_EQ(TextureSizeForMeshColors(5856, 2), 1024);     // spot_textured_point: side 634.
+  EXPECT_EQ(TextureSizeForMeshColors(5000, 1), 512);      // side 414.
+  EXPECT_EQ(TextureSizeForMeshColors(50000, 1), 2048);    // side 1309.
+  EXPECT_EQ(TextureSizeForMeshColors(20, 1), 256);        // clamped up.
+  EXPECT_EQ(TextureSizeForMeshColors(2000000, 4), 4096);  // clamped down.
+  EXPECT_EQ(TextureSizeForMeshColors(0, 1), 256);
 }
 
 }  // namespace
