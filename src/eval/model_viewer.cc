@@ -57,8 +57,9 @@ constexpr char kViewerScript[] = R"JS(
     this.camera.add(head);
     this.camera.add(head.target);
     this.headlight = head;
-    var key = new THREE.DirectionalLight(0xfff1e0, 0.9), fill = new THREE.DirectionalLight(0xe0ecff, 0.35),
-        rim = new THREE.DirectionalLight(0xffffff, 0.5);
+    var key = new THREE.DirectionalLight(0xfff1e0, 0.9);
+    var fill = new THREE.DirectionalLight(0xe0ecff, 0.35);
+    var rim = new THREE.DirectionalLight(0xffffff, 0.5);
     key.position.set(1, 1.2, 1); fill.position.set(-1, 0.3, 0.8); rim.position.set(0, 0.8, -1.2);
     this.rigs.studio.add(key, fill, rim, new THREE.AmbientLight(0xffffff, 0.1));
     this.rigs.sky.add(new THREE.HemisphereLight(0xdde8ff, 0x40301c, 1.0));
@@ -76,7 +77,8 @@ constexpr char kViewerScript[] = R"JS(
   View.prototype.frame = function (box) {
     var c = box.getCenter(new THREE.Vector3()), r = box.getSize(new THREE.Vector3()).length() / 2;
     this.controls.target.copy(c);
-    this.camera.position.copy(c).add(new THREE.Vector3(0.35, 0.25, 1).normalize().multiplyScalar(3.2 * r));
+    var from = new THREE.Vector3(0.35, 0.25, 1).normalize().multiplyScalar(2.5 * r);
+    this.camera.position.copy(c).add(from);
     this.camera.near = r / 100; this.camera.far = r * 100;
     this.camera.updateProjectionMatrix();
     this.controls.update();
@@ -87,7 +89,8 @@ constexpr char kViewerScript[] = R"JS(
     start = new View(document.getElementById('sft3d-start'));
     views.push(start);
     var g = new THREE.BufferGeometry();
-    g.setAttribute('position', new THREE.BufferAttribute(new Float32Array(bytes(startPositions)), 3));
+    var positions = new Float32Array(bytes(startPositions));
+    g.setAttribute('position', new THREE.BufferAttribute(positions, 3));
     g.setIndex(new THREE.BufferAttribute(new Uint32Array(bytes(startIndices)), 1));
     start.scene.add(new THREE.Mesh(g, new THREE.MeshStandardMaterial(
         {color: 0xb0b0b0, roughness: 0.6, metalness: 0, flatShading: true})));
