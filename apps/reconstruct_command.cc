@@ -31,6 +31,10 @@ namespace {
 
 std::atomic<bool> g_interrupted{false};
 extern "C" void OnInterrupt(int) { g_interrupted = true; }
+// Rank 0 under mpirun: SIGTERM, which Open MPI's launcher sends when another rank died (a fault:
+// MpiViewRunner).
+std::atomic<bool> g_terminating{false};
+extern "C" void OnTerminate(int) { g_terminating = true; }
 
 // Command-line values; those left unset do not override the config file.
 struct ReconstructCommandOptions {
@@ -215,8 +219,11 @@ ReportModel ExportAsset(const std::string& out, const Dataset& dataset, bool sto
   return model;
 }
 
+// `stop`, when given, is asked after every solver iteration too: true stops the run as Ctrl-C
+// does. *stopped: whether the run stopped early (and wrote its checkpoint).
 Status RunReconstruct(const ReconstructCommandOptions& cli_in, const BeforeStart& before_start = {},
-                      const std::function<nlohmann::json()>& extra_metrics = {}) {
+                      const std::function<nlohmann::json()>& extra_metrics = {},
+                      const std::function<bool()>& stop = {}, bool* stopped = nullptr) {
   ReconstructCommandOptions cli = cli_in;
   // The reference first: a bad one must not leave an output folder behind.
   TriMesh reference;
@@ -231,7 +238,7 @@ Status RunReconstruct(const ReconstructCommandOptions& cli_in, const BeforeStart
   callbacks.on_iteration = [&](const IterationRecord& record) {
     progress.SetDetail(record.stage);
     if (!record.full) progress.Advance(schedule->CurrentStepWork());  // not a step.
-    return !g_interrupted.load();
+    return !g_interrupted.load() && !(stop && stop());
   };
   callbacks.on_event = [&](const std::string& line) { progress.Note(line); };
   if (!cli.reference.empty()) {
@@ -248,6 +255,7 @@ Status RunReconstruct(const ReconstructCommandOptions& cli_in, const BeforeStart
                                schedule->outer_records(), schedule->stage_records(), model));
   }
   const ScheduleProgress& p = schedule->progress();
+  if (stopped != nullptr) *stopped = schedule->stopped();
   if (schedule->stopped()) {
     return Status::Error("interrupted after " + std::to_string(p.outer_done) +
                          " outer iterations; state written to " + cli.out +
@@ -272,7 +280,10 @@ int FittedViews(const Dataset& dataset, const std::vector<StageOptions>& stages)
 
 // `sft reconstruct` under mpirun (src/optim/mpi_views.h): rank 0 runs the schedule with its
 // renders spread over the ranks; the others serve renders. Errors print on rank 0 only; every
-// rank exits non-zero when the ranks do not agree to start (the handshake).
+// rank exits non-zero when the ranks do not agree to start (the handshake). A fault (a rank that
+// died or stopped answering, or the launcher's SIGTERM) stops the run after the current solver
+// iteration, its renders finished on rank 0; rank 0 writes the checkpoint, prints one line and
+// ends every rank.
 int RunReconstructMpi(const ReconstructCommandOptions& cli) {
   std::unique_ptr<MpiSession> session;
   Status status = MpiSession::Start(&session);
@@ -293,19 +304,38 @@ int RunReconstructMpi(const ReconstructCommandOptions& cli) {
     agreed = true;
     SFT_RETURN_IF_ERROR(
         MpiHandshake(*session, Status::Ok(), path, FittedViews(dataset, stages), nullptr));
-    runner = std::make_unique<MpiViewRunner>(*session, cli.mpi_timeout);
+    g_terminating = false;
+    std::signal(SIGTERM, OnTerminate);  // from now on a SIGTERM stops the run as a fault.
+    runner = std::make_unique<MpiViewRunner>(*session, cli.mpi_timeout, &g_terminating);
     if (session->size() > 1) SetViewRunner(runner.get());
     return Status::Ok();
   };
   const auto metrics = [&]() {
     return runner ? nlohmann::json{{"mpi", MpiViewStatsJson(runner->stats())}} : nlohmann::json{};
   };
+  const auto fault = [&]() { return runner && runner->failed(); };
+  bool stopped = false;
   if (!(cli.mpi_timeout > 0.0)) {
     status = Status::Error("--mpi-timeout: must be > 0 seconds");
   } else {
-    status = RunReconstruct(cli, before_start, metrics);
+    status = RunReconstruct(cli, before_start, metrics, fault, &stopped);
   }
   SetViewRunner(nullptr);
+  if (fault()) {
+    // The workers cannot be released (one is gone or silent): one line, then every rank ends.
+    const std::string out = cli.resume.empty() ? cli.out : cli.resume;
+    if (stopped) {
+      status = Status::Error(runner->failure() + "; state written to " + out +
+                             " (continue with --resume " + out + ", with any number of ranks)");
+    } else if (status.ok()) {
+      status = Status::Error(runner->failure() + " after the run had finished (every output in " +
+                             out + " is written)");
+    }
+    PrintError("reconstruct", status);
+    std::fflush(nullptr);
+    session->Abort(1);
+  }
+  std::signal(SIGTERM, SIG_DFL);
   if (!agreed) {
     // Stopped before the run (a usage error, or --print-schedule): the workers are released
     // through the handshake, with rank 0's error.
@@ -366,8 +396,8 @@ CommandRunner SetupReconstructCommand(CLI::App* app) {
   app->add_flag("--quiet", opts->quiet, "No progress line");
   app->add_flag("--no-report", opts->no_report, "Do not write OUT/report.html");
   app->add_option("--mpi-timeout", opts->mpi_timeout,
-                  "Under mpirun: seconds rank 0 waits for another rank's renders before it ends "
-                  "the run")
+                  "Under mpirun: seconds rank 0 waits for another rank's renders before it stops "
+                  "the run (checkpoint written, every rank ended)")
       ->capture_default_str();
   return [opts]() {
     // First, so that an interrupt at any point stops cleanly (a checkpoint exists only once the

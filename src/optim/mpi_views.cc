@@ -3,16 +3,23 @@
 #include <glog/logging.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <climits>
+#include <csignal>
 #include <cstdint>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <fstream>
+#include <functional>
 #include <thread>
 #include <type_traits>
 
 #ifdef SFT_HAVE_MPI
 #include <mpi.h>
+#include <signal.h>
+#include <unistd.h>
 #endif
 
 #include "src/io/scene_setup.h"
@@ -51,11 +58,15 @@ Status MpiSession::Start(std::unique_ptr<MpiSession>*) {
   return Status::Error("sft was built without MPI (CMake option SFT_MPI)");
 }
 MpiSession::~MpiSession() = default;
+int MpiSession::DeadRank() const { return -1; }
+void MpiSession::Abort(int code) const { std::_Exit(code); }
 Status MpiHandshake(const MpiSession&, const Status& own, const std::string&, int, Dataset*) {
   return own;
 }
-MpiViewRunner::MpiViewRunner(const MpiSession&, double) {}
+MpiViewRunner::MpiViewRunner(const MpiSession& session, double, const std::atomic<bool>*)
+    : session_(session) {}
 MpiViewRunner::~MpiViewRunner() = default;
+bool MpiViewRunner::failed() { return false; }
 void MpiViewRunner::Run(const RenderState&, const std::vector<ViewJob>&, const LocalRender&,
                         const Consume&) {
   LOG(FATAL) << "MpiViewRunner without MPI";
@@ -327,61 +338,81 @@ void SendBytes(const std::vector<char>& bytes, int dest, int tag, int64_t* size,
   }
 }
 
-// Waits for `request` at most `timeout` seconds (polling; MPI has no timed wait). On timeout the
-// whole job ends: a rank that stopped answering cannot be waited out.
-void WaitBounded(MPI_Request* request, double timeout, int source) {
-  const auto start = Clock::now();
-  int done = 0;
-  MPI_Test(request, &done, MPI_STATUS_IGNORE);
-  while (!done) {
-    if (Since(start) > timeout) {
-      LOG(ERROR) << "rank " << source << " did not answer for " << timeout
-                 << " s (--mpi-timeout): ending the run";
-      MPI_Abort(MPI_COMM_WORLD, 1);
-    }
-    std::this_thread::sleep_for(std::chrono::microseconds(100));
-    MPI_Test(request, &done, MPI_STATUS_IGNORE);
-  }
-}
+// Health check of a wait, called with the seconds waited so far: false ends the wait.
+using Watch = std::function<bool(double waited)>;
 
-// Waits for `requests` without spinning: Open MPI's waits poll at full speed, and a worker that
-// waits that way (for rank 0's next evaluation, or for rank 0 to take its results) takes a core
-// from rank 0's renders and Ceres on a shared machine. Polls every 200 µs instead.
-void WaitIdle(std::vector<MPI_Request>* requests) {
+// Polls `requests` every `period` until they complete (true) or `watch` says stop (false). MPI
+// has no timed wait, and Open MPI's waits poll at full speed: a worker that waits that way (for
+// rank 0's next evaluation, or for rank 0 to take its results) takes a core from rank 0's
+// renders and Ceres on a shared machine.
+bool WaitWhile(std::vector<MPI_Request>* requests, std::chrono::microseconds period,
+               const Watch& watch) {
+  const auto start = Clock::now();
   int done = 0;
   MPI_Testall(static_cast<int>(requests->size()), requests->data(), &done, MPI_STATUSES_IGNORE);
   while (!done) {
-    std::this_thread::sleep_for(std::chrono::microseconds(200));
+    if (watch && !watch(Since(start))) return false;
+    std::this_thread::sleep_for(period);
     MPI_Testall(static_cast<int>(requests->size()), requests->data(), &done, MPI_STATUSES_IGNORE);
   }
+  return true;
+}
+
+// A worker's waits: every 200 µs, unbounded (rank 0 ends the run when it cannot go on).
+void WaitIdle(std::vector<MPI_Request>* requests) {
+  WaitWhile(requests, std::chrono::microseconds(200), nullptr);
+}
+
+// Rank 0's waits: every 100 µs, while `watch` holds.
+bool WaitWatched(std::vector<MPI_Request>* requests, const Watch& watch) {
+  return WaitWhile(requests, std::chrono::microseconds(100), watch);
 }
 
 // The evaluation header, broadcast non-blocking on every rank (a blocking and a non-blocking
 // broadcast do not match), so that idle workers wait for it without spinning.
-void BroadcastHeader(int64_t header[]) {
+bool BroadcastHeader(int64_t header[], const Watch& watch = nullptr) {
   std::vector<MPI_Request> request(1);
   MPI_Ibcast(header, kHeaderSize, MPI_INT64_T, 0, MPI_COMM_WORLD, &request[0]);
-  WaitIdle(&request);
+  if (!watch) {
+    WaitIdle(&request);
+    return true;
+  }
+  return WaitWatched(&request, watch);
 }
 
-// Receives a message sent by SendBytes (`timeout` > 0 bounds each wait; 0 waits forever).
-std::vector<char> ReceiveBytes(int source, int tag, double timeout) {
-  int64_t size = 0;
-  MPI_Request request;
-  MPI_Irecv(&size, 1, MPI_INT64_T, source, tag, MPI_COMM_WORLD, &request);
-  if (timeout > 0) {
-    WaitBounded(&request, timeout, source);
-  } else {
-    MPI_Wait(&request, MPI_STATUS_IGNORE);
-  }
-  std::vector<char> bytes(static_cast<size_t>(size));
+// The broadcasts of an evaluation (state, job list): non-blocking as the header, so that rank 0
+// (with a watch) notices a rank that stopped taking them. Workers pass no watch.
+bool BroadcastPieces(std::vector<char>* bytes, int64_t size, const Watch& watch) {
+  bytes->resize(static_cast<size_t>(size));
   for (int64_t at = 0; at < size; at += kPiece) {
     const int n = static_cast<int>(std::min(kPiece, size - at));
-    MPI_Recv(bytes.data() + at, n, MPI_BYTE, source, tag, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+    std::vector<MPI_Request> request(1);
+    MPI_Ibcast(bytes->data() + at, n, MPI_BYTE, 0, MPI_COMM_WORLD, &request[0]);
+    if (!watch) {
+      WaitIdle(&request);
+    } else if (!WaitWatched(&request, watch)) {
+      return false;
+    }
   }
-  return bytes;
+  return true;
 }
 
+// Rank 0 receives a message sent by SendBytes (false when `watch` stopped the wait).
+bool ReceiveBytes(int source, int tag, const Watch& watch, std::vector<char>* bytes) {
+  int64_t size = 0;
+  std::vector<MPI_Request> request(1);
+  MPI_Irecv(&size, 1, MPI_INT64_T, source, tag, MPI_COMM_WORLD, &request[0]);
+  if (!WaitWatched(&request, watch)) return false;
+  bytes->resize(static_cast<size_t>(size));
+  for (int64_t at = 0; at < size; at += kPiece) {
+    const int n = static_cast<int>(std::min(kPiece, size - at));
+    MPI_Irecv(bytes->data() + at, n, MPI_BYTE, source, tag, MPI_COMM_WORLD, &request[0]);
+    if (!WaitWatched(&request, watch)) return false;
+  }
+  return true;
+}
+
+// The handshake's broadcasts (blocking: every rank is there before the run).
 void BroadcastBytes(std::vector<char>* bytes, int64_t size) {
   bytes->resize(static_cast<size_t>(size));
   for (int64_t at = 0; at < size; at += kPiece) {
@@ -408,6 +439,34 @@ struct JobEntry {
   int32_t width, height, channels;
 };
 
+// What makes process ids comparable: the boot (the machine) and the PID namespace (the
+// container); "" when unknown (not Linux), and then no rank is checked.
+std::string MachineId() {
+  std::ifstream boot("/proc/sys/kernel/random/boot_id");
+  std::string id;
+  if (!(boot >> id)) return "";
+  char ns[128] = {};
+  if (readlink("/proc/self/ns/pid", ns, sizeof(ns) - 1) <= 0) return "";
+  return id + " " + ns;
+}
+
+struct ProcessEntry {
+  char machine[128];
+  int64_t pid;
+};
+
+// Whether process `pid` of this machine still runs: it exists and is not a zombie (a killed
+// rank stays one until its launcher reaps it).
+bool ProcessRuns(pid_t pid) {
+  if (kill(pid, 0) != 0 && errno == ESRCH) return false;
+  std::ifstream stat("/proc/" + std::to_string(pid) + "/stat");
+  std::string line;
+  if (!std::getline(stat, line)) return true;  // no /proc: kill's answer stands.
+  const size_t paren = line.rfind(')');
+  const char state = paren + 2 < line.size() ? line[paren + 2] : '?';
+  return state != 'Z' && state != 'X';
+}
+
 }  // namespace
 
 Status MpiSession::Start(std::unique_ptr<MpiSession>* session) {
@@ -418,8 +477,31 @@ Status MpiSession::Start(std::unique_ptr<MpiSession>* session) {
   std::unique_ptr<MpiSession> s(new MpiSession());
   MPI_Comm_rank(MPI_COMM_WORLD, &s->rank_);
   MPI_Comm_size(MPI_COMM_WORLD, &s->size_);
+  // Rank 0 learns which ranks share its machine, and their process ids (DeadRank).
+  const std::string machine = MachineId();
+  ProcessEntry own = {};
+  std::strncpy(own.machine, machine.c_str(), sizeof(own.machine) - 1);
+  own.pid = static_cast<int64_t>(getpid());
+  std::vector<ProcessEntry> all(s->rank_ == 0 ? s->size_ : 0);
+  MPI_Gather(&own, sizeof(own), MPI_BYTE, all.data(), sizeof(own), MPI_BYTE, 0, MPI_COMM_WORLD);
+  for (const ProcessEntry& e : all) {
+    const bool here = !machine.empty() && machine == e.machine;
+    s->pids_.push_back(here ? e.pid : 0);
+  }
   *session = std::move(s);
   return Status::Ok();
+}
+
+int MpiSession::DeadRank() const {
+  for (size_t r = 1; r < pids_.size(); ++r) {
+    if (pids_[r] > 0 && !ProcessRuns(static_cast<pid_t>(pids_[r]))) return static_cast<int>(r);
+  }
+  return -1;
+}
+
+void MpiSession::Abort(int code) const {
+  MPI_Abort(MPI_COMM_WORLD, code);
+  std::_Exit(code);  // MPI_Abort does not return; this says so to the compiler.
 }
 
 MpiSession::~MpiSession() { MPI_Finalize(); }
@@ -477,8 +559,13 @@ Status MpiHandshake(const MpiSession& session, const Status& own, const std::str
   return verdict.empty() ? Status::Ok() : Status::Error(verdict);
 }
 
-MpiViewRunner::MpiViewRunner(const MpiSession& session, double timeout_seconds)
-    : size_(session.size()), timeout_(timeout_seconds), speed_(session.size(), 1.0) {
+MpiViewRunner::MpiViewRunner(const MpiSession& session, double timeout_seconds,
+                             const std::atomic<bool>* terminating)
+    : session_(session),
+      size_(session.size()),
+      timeout_(timeout_seconds),
+      terminating_(terminating),
+      speed_(session.size(), 1.0) {
   stats_.ranks = size_;
 }
 
@@ -487,8 +574,30 @@ MpiViewRunner::~MpiViewRunner() { Stop(); }
 void MpiViewRunner::Stop() {
   if (stopped_) return;
   stopped_ = true;
+  if (failed()) {
+    LOG(ERROR) << failure_ << ": ending every rank";
+    session_.Abort(1);
+  }
   int64_t header[kHeaderSize] = {kStop, 0, 0, 0, 0};
-  BroadcastHeader(header);
+  BroadcastHeader(header, [this](double waited) { return Healthy(-1, waited); });
+}
+
+bool MpiViewRunner::failed() { return !Healthy(-1, 0.0); }
+
+bool MpiViewRunner::Healthy(int rank, double waited) {
+  if (!failure_.empty()) return false;
+  const int dead = session_.DeadRank();
+  if (dead > 0) {
+    failure_ = "rank " + std::to_string(dead) + " stopped answering (died or was killed)";
+  } else if (waited > timeout_) {
+    char seconds[32];
+    std::snprintf(seconds, sizeof(seconds), "%g", timeout_);
+    failure_ = (rank > 0 ? "rank " + std::to_string(rank) : std::string("a rank")) +
+               " stopped answering (nothing for " + seconds + " s, --mpi-timeout)";
+  } else if (terminating_ != nullptr && terminating_->load()) {
+    failure_ = "the MPI launcher is ending the run (SIGTERM: another rank died or was killed?)";
+  }
+  return failure_.empty();
 }
 
 std::vector<int> MpiViewRunner::Assign(const RenderState& state, const std::vector<ViewJob>& jobs,
@@ -522,7 +631,7 @@ std::vector<int> MpiViewRunner::Assign(const RenderState& state, const std::vect
   return rank;
 }
 
-void MpiViewRunner::BroadcastState(const RenderState& state, int64_t header[]) {
+bool MpiViewRunner::BroadcastState(const RenderState& state, int64_t header[]) {
   std::vector<std::vector<char> > parts = StateParts(state);
   if (sent_parts_.size() != parts.size()) sent_parts_.assign(parts.size(), {});
   // A new scene resends the positions too: the workers rebuild from the build positions.
@@ -539,14 +648,29 @@ void MpiViewRunner::BroadcastState(const RenderState& state, int64_t header[]) {
   }
   header[2] = mask;
   header[3] = static_cast<int64_t>(changed.size());
-  BroadcastHeader(header);
-  if (!changed.empty()) BroadcastBytes(&changed, header[3]);
+  const Watch watch = [this](double waited) { return Healthy(-1, waited); };
+  if (!BroadcastHeader(header, watch)) return false;
+  if (!changed.empty() && !BroadcastPieces(&changed, header[3], watch)) return false;
   stats_.broadcast_bytes += header[3];
+  return true;
 }
 
 void MpiViewRunner::Run(const RenderState& state, const std::vector<ViewJob>& jobs,
                         const LocalRender& local, const Consume& consume) {
   CHECK(!stopped_);
+  // After a fault, the jobs from `from` on are rendered here, in job order, as one process
+  // would. Requests still pending towards other ranks are left: no MPI call follows a fault but
+  // MPI_Abort, so nothing reads their buffers.
+  const auto finish_here = [&](size_t from) {
+    for (size_t k = from; k < jobs.size(); ++k) {
+      const auto render_start = Clock::now();
+      ViewResult result;
+      local(jobs[k], &result);
+      stats_.local_render += Since(render_start);
+      consume(k, &result);
+    }
+  };
+  if (failed()) return finish_here(0);
   const auto start = Clock::now();
   std::vector<double> cost;
   const std::vector<int> rank = Assign(state, jobs, &cost);
@@ -565,8 +689,11 @@ void MpiViewRunner::Run(const RenderState& state, const std::vector<ViewJob>& jo
   job_list.PutVector(entries);
   int64_t header[kHeaderSize] = {kRun, static_cast<int64_t>(jobs.size()), 0, 0,
                                  static_cast<int64_t>(job_list.bytes().size())};
-  BroadcastState(state, header);
-  BroadcastBytes(&job_list.bytes(), header[4]);
+  if (!BroadcastState(state, header) ||
+      !BroadcastPieces(&job_list.bytes(), header[4],
+                       [this](double waited) { return Healthy(-1, waited); })) {
+    return finish_here(0);
+  }
   stats_.broadcast_bytes += header[4];
   // Adjoint weights to the ranks that render those jobs. Delivered before rank 0 renders: rank 0
   // makes no MPI progress while it renders, and the workers' first jobs need them.
@@ -583,7 +710,11 @@ void MpiViewRunner::Run(const RenderState& state, const std::vector<ViewJob>& jo
     stats_.broadcast_bytes += static_cast<int64_t>(data.size() * sizeof(float));
   }
   for (size_t r = 0; r < requests.size(); ++r) {
-    WaitBounded(&requests[r], timeout_, request_ranks[r]);
+    std::vector<MPI_Request> request = {requests[r]};
+    const int to = request_ranks[r];
+    if (!WaitWatched(&request, [&](double waited) { return Healthy(to, waited); })) {
+      return finish_here(0);
+    }
   }
   const double broadcast_seconds = Since(start);
   stats_.broadcast += broadcast_seconds;
@@ -604,7 +735,12 @@ void MpiViewRunner::Run(const RenderState& state, const std::vector<ViewJob>& jo
   // workers' clocks start at the header, within a broadcast latency of rank 0's), the rest gather.
   double storing = 0.0, last_ready = 0.0;
   for (; k < jobs.size(); ++k) {
-    const std::vector<char> bytes = ReceiveBytes(rank[k], ResultTag(k), timeout_);
+    std::vector<char> bytes;
+    const int from = rank[k];
+    if (!ReceiveBytes(
+            from, ResultTag(k), [&](double waited) { return Healthy(from, waited); }, &bytes)) {
+      return finish_here(k);
+    }
     stats_.gather_bytes += static_cast<int64_t>(bytes.size());
     ViewResult result;
     double ready = 0.0;
@@ -646,6 +782,10 @@ Status ServeViews(const MpiSession& session, const Dataset& dataset) {
   std::unique_ptr<RenderScene> scene;
   int64_t scene_id = -1;
   std::vector<Eigen::Vector3d> scene_positions;
+  // Test hook (ServeViews' comment): results to send before dying; -1 never.
+  const char* die_env = std::getenv("SFT_TEST_MPI_DIE_AFTER_JOBS");
+  const int64_t die_after = die_env != nullptr ? std::atoll(die_env) : -1;
+  int64_t sent = 0;
   for (;;) {
     int64_t header[kHeaderSize];
     BroadcastHeader(header);
@@ -653,14 +793,14 @@ Status ServeViews(const MpiSession& session, const Dataset& dataset) {
     if (header[0] == kStop) return Status::Ok();
     if (header[3] > 0) {
       std::vector<char> changed;
-      BroadcastBytes(&changed, header[3]);
+      BroadcastPieces(&changed, header[3], nullptr);
       ByteReader r(changed);
       for (int p = 0; p < kNumParts; ++p) {
         if (header[2] & (int64_t{1} << p)) ApplyStatePart(p, r.GetVector<char>(), &state);
       }
     }
     std::vector<char> job_bytes;
-    BroadcastBytes(&job_bytes, header[4]);
+    BroadcastPieces(&job_bytes, header[4], nullptr);
     ByteReader job_reader(job_bytes);
     const std::vector<JobEntry> entries = job_reader.GetVector<JobEntry>();
     if (state.scene_id != scene_id) {
@@ -689,6 +829,11 @@ Status ServeViews(const MpiSession& session, const Dataset& dataset) {
     results.reserve(entries.size());
     for (size_t k = 0; k < entries.size(); ++k) {
       if (entries[k].rank != session.rank()) continue;
+      if (sent == die_after) {
+        WaitIdle(&requests);  // the results sent so far reach rank 0 first.
+        std::raise(SIGKILL);
+      }
+      ++sent;
       ViewJob job;
       job.view = entries[k].view;
       job.pass = static_cast<ViewPass>(entries[k].pass);

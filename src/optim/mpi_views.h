@@ -14,11 +14,16 @@
 //   3. rank 0 consumes its own results, then receives the others' in job order, so the render
 //      cache stores and sums (adjoint gradients) in the order a single process does: results are
 //      identical to the bit for any rank count.
+// Faults: a rank that dies or stops answering is a fault rank 0 notices itself (see
+// MpiViewRunner); it then renders every remaining job in its own process, so that the current
+// evaluation completes with the same results, and reports failed() for the caller to stop, write
+// its checkpoint and end every rank (MpiSession::Abort).
 // Built without MPI (CMake option SFT_MPI off), Launched() is false and nothing here is used.
 // A process not started by mpirun never initializes MPI.
 #ifndef SFT_OPTIM_MPI_VIEWS_H_
 #define SFT_OPTIM_MPI_VIEWS_H_
 
+#include <atomic>
 #include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -67,10 +72,19 @@ class MpiSession {
   int rank() const { return rank_; }
   int size() const { return size_; }
 
+  // Rank 0: the first rank known to be dead, or -1. Known only for ranks that run on this
+  // machine (same boot and PID namespace): their process is gone (exited, killed). Ranks
+  // elsewhere are caught by the timeout or the launcher's SIGTERM (MpiViewRunner).
+  int DeadRank() const;
+  // Ends every rank at once (MPI_Abort). After a fault: the dead rank cannot be released, and
+  // MPI_Finalize would wait for it.
+  [[noreturn]] void Abort(int code) const;
+
  private:
   MpiSession() = default;
   int rank_ = 0;
   int size_ = 1;
+  std::vector<int64_t> pids_;  // rank 0: every rank's process id; 0 when on another machine.
 };
 
 // The ranks' agreement before a run; every rank calls it once. Rank 0 passes `own` (its status
@@ -82,15 +96,27 @@ Status MpiHandshake(const MpiSession& session, const Status& own, const std::str
                     int fitted_views, Dataset* dataset);
 
 // Rank 0's ViewRunner. Stop() (or the destructor) releases the workers.
+//
+// A fault is any of: a rank on this machine whose process is gone (MpiSession::DeadRank, checked
+// every 0.1 s of every wait), a wait for another rank longer than `timeout_seconds` (> 0), or
+// `*terminating` set (the caller's SIGTERM handler: Open MPI's launcher sends SIGTERM to every
+// rank when another one died, one odls_base_sigkill_timeout after the death, and SIGKILL one
+// more later). From then on the runner makes no MPI call: it renders the rest of the current
+// evaluation and every later one with `local` (identical results) and failed() is true.
 class MpiViewRunner : public ViewRunner {
  public:
-  // `timeout_seconds` bounds every wait for a worker's result (> 0); when it passes, the run
-  // ends (MPI_Abort on every rank) with one error line naming the rank.
-  MpiViewRunner(const MpiSession& session, double timeout_seconds);
+  MpiViewRunner(const MpiSession& session, double timeout_seconds,
+                const std::atomic<bool>* terminating = nullptr);
   ~MpiViewRunner() override;
   void Run(const RenderState& state, const std::vector<ViewJob>& jobs, const LocalRender& local,
            const Consume& consume) override;
+  // After a fault, ends every rank (the fault in one log line first; callers that print their
+  // own line call MpiSession::Abort before).
   void Stop();
+  // Whether a fault happened (also when *terminating was set since the last wait).
+  bool failed();
+  // The fault in words ("rank 1 stopped answering (died or was killed)"); "" without one.
+  const std::string& failure() const { return failure_; }
   const MpiViewStats& stats() const { return stats_; }
 
  private:
@@ -98,10 +124,17 @@ class MpiViewRunner : public ViewRunner {
   // (*cost: each job's) and the ranks' measured speeds.
   std::vector<int> Assign(const RenderState& state, const std::vector<ViewJob>& jobs,
                           std::vector<double>* cost) const;
-  void BroadcastState(const RenderState& state, int64_t header[]);
+  // Sends the header and the state's changed parts (false on a fault).
+  bool BroadcastState(const RenderState& state, int64_t header[]);
+  // Called while rank 0 has waited `waited` seconds for `rank` (-1: any rank, a broadcast):
+  // false on a fault, which failure_ then names.
+  bool Healthy(int rank, double waited);
 
+  const MpiSession& session_;
   int size_ = 1;
   double timeout_ = 3600.0;
+  const std::atomic<bool>* terminating_ = nullptr;
+  std::string failure_;
   bool stopped_ = false;
   MpiViewStats stats_;
   // The state parts (serialized) the workers hold: only changed parts are sent.
@@ -115,6 +148,8 @@ class MpiViewRunner : public ViewRunner {
 };
 
 // A worker's serve loop: renders its jobs of every evaluation until rank 0 stops it.
+// Test hook (tests/apps/reconstruct_mpi_test.cc only): with the environment variable
+// SFT_TEST_MPI_DIE_AFTER_JOBS=N, the worker kills itself (SIGKILL) after sending N results.
 Status ServeViews(const MpiSession& session, const Dataset& dataset);
 
 }  // namespace sft

@@ -1,10 +1,12 @@
 // `mpirun -np N sft reconstruct` (src/optim/mpi_views.h): the same mesh and material to the last
 // bit as one process, with LM (Jacobian rows) and with Adam (adjoint gradients); wrong usage is
-// one line and a non-zero exit. Skipped when sft was built without MPI or mpirun is absent.
+// one line and a non-zero exit; a rank that dies mid-run ends it with one line and a checkpoint
+// that one process resumes. Skipped when sft was built without MPI or mpirun is absent.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <filesystem>
 #include <set>
 #include <string>
@@ -121,6 +123,47 @@ TEST_F(ReconstructMpiTest, WrongUsageIsOneLine) {
   EXPECT_THAT(out, HasSubstr("rank 1: "));
   EXPECT_THAT(out, HasSubstr("every rank reads the dataset from the same path: ds"));
   EXPECT_FALSE(fs::exists(tmp_.Join("unshared/state.json")));
+}
+
+// Rank 1 kills itself (SIGKILL, the test hook SFT_TEST_MPI_DIE_AFTER_JOBS) after 8 results, in
+// the first outer iteration: rank 0 finishes the evaluation alone, stops after the solver
+// iteration, writes its checkpoint and prints one line; the run ends non-zero and one process
+// resumes it to the end. Open MPI's launcher kills every rank 1 + 1 s after a death by default
+// (SIGTERM, then SIGKILL: odls_base_sigkill_timeout); 4 s keeps a loaded machine from cutting
+// rank 0 short, and mpirun then ends about 8 s after the death.
+TEST_F(ReconstructMpiTest, KilledRankEndsTheRunResumably) {
+  const std::string out = tmp_.Join("killed");
+  const std::string args = " reconstruct --quiet --no-report --dataset " + tmp_.Join("ds") +
+                           " --init " + tmp_.Join("init.ply") +
+                           " --spp 4 --bounces 1 --steps 3 --outer 3 --phases alternate"
+                           " --threads 1 --solver lm --out " +
+                           out;
+  std::string output;
+  const auto start = std::chrono::steady_clock::now();
+  EXPECT_NE(testing::RunCommand("SFT_TEST_MPI_DIE_AFTER_JOBS=8 " + mpirun_ +
+                                    " --bind-to none --mca odls_base_sigkill_timeout 4 -np 2 " +
+                                    testing::SftBinary() + args,
+                                &output),
+            0);
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_LT(seconds, 60.0) << output;
+  EXPECT_THAT(output,
+              HasSubstr("sft reconstruct: error: rank 1 stopped answering (died or was "
+                        "killed); state written to " +
+                        out + " (continue with --resume " + out + ", with any number of ranks)"));
+  size_t errors = 0;
+  for (size_t at = output.find("sft reconstruct: error"); at != std::string::npos;
+       at = output.find("sft reconstruct: error", at + 1)) {
+    ++errors;
+  }
+  EXPECT_EQ(errors, 1u) << output;
+  const std::string state = testing::ReadTestFile(out + "/state.json");
+  ASSERT_FALSE(state.empty()) << output;
+  EXPECT_THAT(state, HasSubstr("\"finished\": false"));
+
+  EXPECT_EQ(testing::RunSft("reconstruct --no-report --resume " + out, &output), 0) << output;
+  EXPECT_THAT(output, HasSubstr("sft reconstruct: 3 outer iterations"));
 }
 
 }  // namespace
