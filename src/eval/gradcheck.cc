@@ -7,7 +7,7 @@
 #include <random>
 
 #include "src/core/file_util.h"
-#include "src/io/image_io.h"
+#include "src/image/image_io.h"
 #include "src/io/scene_setup.h"
 #include "src/render/scene.h"
 

@@ -7,7 +7,7 @@
 #include <opencv2/imgproc.hpp>
 #include <vector>
 
-#include "src/io/image_io.h"
+#include "src/image/image_io.h"
 #ifdef SFT_HAVE_OPENCV_QUALITY
 #include <opencv2/quality/qualityssim.hpp>
 #endif

@@ -12,7 +12,7 @@
 #include "src/geometry/material.h"
 #include "src/geometry/mesh.h"
 #include "src/io/dataset.h"
-#include "src/io/image_io.h"
+#include "src/image/image_io.h"
 #include "src/io/light_scales.h"
 #include "src/io/scene_setup.h"
 #include "src/optim/fitted_environment.h"

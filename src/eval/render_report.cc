@@ -6,7 +6,7 @@
 #include <utility>
 
 #include "src/core/file_util.h"
-#include "src/io/image_io.h"
+#include "src/image/image_io.h"
 
 namespace sft {
 namespace {

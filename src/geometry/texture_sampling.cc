@@ -8,7 +8,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "src/core/file_util.h"
-#include "src/io/image_io.h"
+#include "src/image/image_io.h"
 
 namespace sft {
 namespace {

@@ -17,7 +17,7 @@
 
 namespace sft {
 
-// Reads `file` (PNG or EXR, src/io/image_io.h) without colour conversion, then checks and
+// Reads `file` (PNG or EXR, src/image/image_io.h) without colour conversion, then checks and
 // linearises its values in place: a non-finite value is an error naming the pixel; values outside
 // [0, 1] are clamped with one warning that names `what` (e.g. "albedo"); `srgb` decodes the sRGB
 // transfer function after clamping. Errors (one line, naming the file): missing or unreadable

@@ -5,7 +5,7 @@
 
 #include "src/core/file_util.h"
 #include "src/geometry/material.h"
-#include "src/io/image_io.h"
+#include "src/image/image_io.h"
 
 namespace sft {
 namespace {

@@ -10,7 +10,7 @@
 
 #include "src/core/file_util.h"
 #include "src/core/progress.h"
-#include "src/io/image_io.h"
+#include "src/image/image_io.h"
 
 namespace sft {
 namespace {

@@ -13,7 +13,7 @@
 #include "src/io/auto_masks.h"
 #include "src/io/colmap_model.h"
 #include "src/io/dataset.h"
-#include "src/io/image_io.h"
+#include "src/image/image_io.h"
 #include "src/io/import_files.h"
 #include "src/io/point_cloud_ply.h"
 #include "src/io/probe_alignment.h"

@@ -17,7 +17,7 @@
 
 #include "src/core/file_util.h"
 #include "src/io/dataset_internal.h"
-#include "src/io/image_io.h"
+#include "src/image/image_io.h"
 
 namespace sft {
 namespace dataset_internal {

@@ -4,7 +4,7 @@
 #include <cmath>
 
 #include "src/core/file_util.h"
-#include "src/io/image_io.h"
+#include "src/image/image_io.h"
 
 namespace sft {
 

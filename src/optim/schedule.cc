@@ -8,7 +8,7 @@
 #include "src/core/file_util.h"
 #include "src/init/self_intersection.h"
 #include "src/init/untangle.h"
-#include "src/io/image_io.h"
+#include "src/image/image_io.h"
 #include "src/io/scene_setup.h"
 #include "src/optim/fitted_environment.h"
 #include "src/optim/run_outputs.h"

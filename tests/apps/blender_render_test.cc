@@ -19,7 +19,7 @@
 
 #include "src/core/image.h"
 #include "src/eval/image_compare.h"
-#include "src/io/image_io.h"
+#include "src/image/image_io.h"
 #include "tests/testing/synth_dataset.h"
 #include "tests/testing/temp_dir.h"
 

@@ -24,7 +24,7 @@
 #include <vector>
 
 #include "src/core/image.h"
-#include "src/io/image_io.h"
+#include "src/image/image_io.h"
 #include "tests/testing/temp_dir.h"
 
 namespace sft {

@@ -26,7 +26,7 @@
 #include "src/geometry/mesh.h"
 #include "src/io/auto_masks.h"
 #include "src/io/dataset.h"
-#include "src/io/image_io.h"
+#include "src/image/image_io.h"
 #include "tests/testing/temp_dir.h"
 
 namespace sft {

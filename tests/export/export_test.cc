@@ -8,7 +8,7 @@
 #include "src/core/rng.h"
 #include "src/export/export_formats.h"
 #include "src/geometry/material.h"
-#include "src/io/image_io.h"
+#include "src/image/image_io.h"
 #include "src/optim/uv_stage.h"
 #include "tests/testing/temp_dir.h"
 

@@ -10,7 +10,7 @@
 #include <fstream>
 
 #include "src/core/image.h"
-#include "src/io/image_io.h"
+#include "src/image/image_io.h"
 #include "tests/testing/temp_dir.h"
 
 namespace sft {

@@ -9,7 +9,7 @@
 #include "src/core/image.h"
 #include "src/geometry/material.h"
 #include "src/geometry/mtl_material.h"
-#include "src/io/image_io.h"
+#include "src/image/image_io.h"
 #include "tests/testing/temp_dir.h"
 
 namespace sft {

@@ -13,7 +13,7 @@
 #include "src/core/file_util.h"
 #include "src/io/colmap_import.h"
 #include "src/io/dataset.h"
-#include "src/io/image_io.h"
+#include "src/image/image_io.h"
 #include "src/io/point_cloud_ply.h"
 #include "tests/testing/temp_dir.h"
 

@@ -14,7 +14,7 @@
 
 #include "src/io/colmap_import.h"
 #include "src/io/dataset.h"
-#include "src/io/image_io.h"
+#include "src/image/image_io.h"
 #include "tests/testing/temp_dir.h"
 
 namespace sft {

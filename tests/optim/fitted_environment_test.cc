@@ -10,7 +10,7 @@
 #include "src/geometry/material.h"
 #include "src/geometry/mesh.h"
 #include "src/io/dataset.h"
-#include "src/io/image_io.h"
+#include "src/image/image_io.h"
 #include "src/optim/reconstruct.h"
 #include "tests/testing/synth_dataset.h"
 #include "tests/testing/temp_dir.h"

@@ -11,7 +11,7 @@
 #include "src/geometry/material.h"
 #include "src/geometry/mesh.h"
 #include "src/io/dataset.h"
-#include "src/io/image_io.h"
+#include "src/image/image_io.h"
 #include "src/io/scene_setup.h"
 #include "src/render/render.h"
 #include "tests/testing/temp_dir.h"

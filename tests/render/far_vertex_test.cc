@@ -11,7 +11,7 @@
 
 #include "src/core/image.h"
 #include "src/geometry/material.h"
-#include "src/io/image_io.h"
+#include "src/image/image_io.h"
 #include "src/render/camera_rig.h"
 #include "src/render/render.h"
 #include "src/render/scene.h"

@@ -9,7 +9,7 @@
 #include <sstream>
 
 #include "src/core/file_util.h"
-#include "src/io/image_io.h"
+#include "src/image/image_io.h"
 #include "tests/testing/npz_writer.h"
 #include "tests/testing/temp_dir.h"
 

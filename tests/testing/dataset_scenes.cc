@@ -8,7 +8,7 @@
 #include <fstream>
 
 #include "src/io/dataset.h"
-#include "src/io/image_io.h"
+#include "src/image/image_io.h"
 
 namespace sft {
 namespace testing {

@@ -1,4 +1,4 @@
-#include "src/io/image_io.h"
+#include "src/image/image_io.h"
 
 #include <tinyexr.h>
 

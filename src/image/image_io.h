@@ -1,7 +1,7 @@
 // Image files. EXR (tinyexr) holds linear values as stored; PNG (OpenCV) 8- or 16-bit is
 // sRGB-encoded and decoded to linear on read unless `srgb` is false (masks, data textures).
-#ifndef SFT_IO_IMAGE_IO_H_
-#define SFT_IO_IMAGE_IO_H_
+#ifndef SFT_IMAGE_IMAGE_IO_H_
+#define SFT_IMAGE_IMAGE_IO_H_
 
 #include <string>
 
@@ -39,4 +39,4 @@ Status WriteImage(const std::string& path, const Image& image);
 
 }  // namespace sft
 
-#endif  // SFT_IO_IMAGE_IO_H_
+#endif  // SFT_IMAGE_IMAGE_IO_H_
