@@ -105,6 +105,14 @@ Status PrepareUnknownLighting(const std::string& run, const EnvironmentEstimateO
       return Status::Error(saved + ": not a fitted environment (needs at least 2 × 1 RGB texels)");
     }
     texels = ToRgb(image);
+    for (size_t k = 0; k < texels.data.size(); ++k) {
+      if (!std::isfinite(texels.data[k]) || texels.data[k] < 0.0f) {
+        const int texel = static_cast<int>(k / 3);
+        return Status::Error(saved + ": texel (" + std::to_string(texel % texels.width) + ", " +
+                             std::to_string(texel / texels.width) +
+                             ") is negative or not finite (radiance must be finite and >= 0)");
+      }
+    }
     *note = "lighting: unknown in the dataset; continuing the fitted " +
             std::to_string(texels.width) + "×" + std::to_string(texels.height) +
             " environment of " + saved;

@@ -7,10 +7,12 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <limits>
+
 #include "src/geometry/material.h"
 #include "src/geometry/mesh.h"
-#include "src/io/dataset.h"
 #include "src/image/image_io.h"
+#include "src/io/dataset.h"
 #include "src/optim/reconstruct.h"
 #include "tests/testing/synth_dataset.h"
 #include "tests/testing/temp_dir.h"
@@ -70,6 +72,46 @@ class FittedEnvironmentTest : public ::testing::Test {
 };
 
 testing::TempDir* FittedEnvironmentTest::dir_ = nullptr;
+
+// A resumed run's environment.exr that is not a fitted map stops the resume with one error naming
+// the file: not an image, too small, a texel that is not finite or is negative.
+TEST_F(FittedEnvironmentTest, BadSavedEnvironmentNamesTheFile) {
+  testing::TempDir run;
+  const std::string saved = run.Join(kFittedEnvironmentFile);
+  const EnvironmentEstimateOptions options;
+  std::string note;
+  testing::WriteTestFile(saved, "not an EXR");
+  Dataset dataset = dataset_;
+  Status status = PrepareUnknownLighting(run.path(), options, &dataset, &note);
+  ASSERT_FALSE(status.ok());
+  EXPECT_THAT(status.message(), HasSubstr(saved));
+
+  ASSERT_TRUE(WriteExr(saved, Image(1, 1, 3)).ok());
+  dataset = dataset_;
+  status = PrepareUnknownLighting(run.path(), options, &dataset, &note);
+  ASSERT_FALSE(status.ok());
+  EXPECT_THAT(status.message(), HasSubstr("not a fitted environment"));
+
+  for (const float bad : {std::numeric_limits<float>::quiet_NaN(), -0.5f}) {
+    Image map(4, 2, 3);
+    map.data.assign(map.data.size(), 0.3f);
+    map.at(3, 1, 2) = bad;
+    ASSERT_TRUE(WriteExr(saved, map).ok());
+    dataset = dataset_;
+    status = PrepareUnknownLighting(run.path(), options, &dataset, &note);
+    ASSERT_FALSE(status.ok()) << bad;
+    EXPECT_THAT(status.message(), HasSubstr(saved + ": texel (3, 1)"));
+  }
+
+  // A good map continues, and says so.
+  Image map(4, 2, 3);
+  map.data.assign(map.data.size(), 0.3f);
+  ASSERT_TRUE(WriteExr(saved, map).ok());
+  dataset = dataset_;
+  ASSERT_TRUE(PrepareUnknownLighting(run.path(), options, &dataset, &note).ok());
+  EXPECT_THAT(note, HasSubstr("continuing the fitted 4×2 environment"));
+  EXPECT_FALSE(LightingUnknown(dataset));
+}
 
 // The start map is constant: the photographs' mean over the masks over the assumed albedo; the
 // fitted light becomes every view's only light, in memory.
