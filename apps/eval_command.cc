@@ -6,7 +6,7 @@
 //          F1 at the tolerance, precision, recall and the Chamfer distance in units of the
 //          reference's bounding-box diagonal (src/eval/mesh_metrics.h).
 //   reconstruction   --dataset D --reconstruction O [--spp 64] [--bounces 2] [--views ...]
-//          [--mesh M] [--material SPEC] [--relight SPEC ...] [--out DIR]
+//          [--mesh M] [--material SPEC] [--relight SPEC ...] [--out DIR] [--held-out]
 //          PSNR and SSIM of re-renders of O against D's images and true albedo/roughness
 //          (src/eval/reconstruction_eval.h); with --relight, of O against D's true object under
 //          other lights (src/eval/relight_eval.h), the renders written under --out.
@@ -93,10 +93,10 @@ int RunEvalCommand(const EvalCommandOptions& opts) {
     return PrintError("eval", Status::Error("--reference and --mesh are both required (or "
                                             "--dataset and --reconstruction)"));
   }
-  if (!images &&
-      (!opts.images.relight.empty() || !opts.images.out.empty() || !opts.images.material.empty())) {
-    return PrintError("eval", Status::Error("--relight, --out and --material need --dataset and "
-                                            "--reconstruction"));
+  if (!images && (!opts.images.relight.empty() || !opts.images.out.empty() ||
+                  !opts.images.material.empty() || opts.images.held_out)) {
+    return PrintError("eval", Status::Error("--relight, --out, --material and --held-out need "
+                                            "--dataset and --reconstruction"));
   }
   if (images && !opts.images.out.empty() && opts.images.relight.empty()) {
     return PrintError("eval", Status::Error("--out holds the --relight renders: give --relight"));
@@ -153,6 +153,9 @@ CommandRunner SetupEvalCommand(CLI::App* app) {
       ->capture_default_str();
   app->add_option("--views", opts->images.views, "Reconstruction mode: only these views")
       ->delimiter(',');
+  app->add_flag("--held-out", opts->images.held_out,
+                "Reconstruction mode: score the views sft reconstruct --holdout kept out of the "
+                "fit (after the median fitted exposure gain, and after a per-view gain fit)");
   app->add_option("--material", opts->images.material,
                   "Reconstruction mode: material instead of O/material.json (JSON file, inline "
                   "JSON or an export's model.mtl)");

@@ -20,6 +20,7 @@
 #include "src/geometry/mesh.h"
 #include "src/io/dataset.h"
 #include "src/optim/fitted_environment.h"
+#include "src/optim/holdout.h"
 #include "src/optim/mpi_views.h"
 #include "src/optim/run_outputs.h"
 #include "src/optim/schedule.h"
@@ -48,6 +49,7 @@ struct ReconstructCommandOptions {
   int outer = 0, steps = 0, spp = 0, bounces = 0, threads = 0;
   int64_t seed = 0;
   std::vector<int> views;
+  int holdout = 0;              // every K-th selected view is held out of the fit; 0 = off.
   std::set<std::string> given;  // config keys whose flag was on the command line.
   std::string reference;        // ground-truth mesh: F1 and Chamfer after every outer iteration.
   double reference_tolerance = 0.005;  // F1 tolerance, fraction of the reference's diagonal.
@@ -65,10 +67,10 @@ using BeforeStart = std::function<Status(const std::string& dataset, const Datas
 // The flat keys of the command line (flags override the config file's keys in every stage).
 Status FlagKeys(const ReconstructCommandOptions& cli, ScheduleConfig* config) {
   const nlohmann::json all = {
-      {"phases", cli.phases},   {"solver", cli.solver}, {"outer_iterations", cli.outer},
-      {"steps", cli.steps},     {"spp", cli.spp},       {"bounces", cli.bounces},
-      {"threads", cli.threads}, {"seed", cli.seed},     {"views", cli.views},
-      {"effects", cli.effects}};
+      {"phases", cli.phases},   {"solver", cli.solver},  {"outer_iterations", cli.outer},
+      {"steps", cli.steps},     {"spp", cli.spp},        {"bounces", cli.bounces},
+      {"threads", cli.threads}, {"seed", cli.seed},      {"views", cli.views},
+      {"effects", cli.effects}, {"holdout", cli.holdout}};
   for (const auto& [key, value] : all.items()) {
     if (cli.given.count(key) == 0) continue;
     const Status status = MergeScheduleConfig({{key, value}}, "flag", config);
@@ -89,9 +91,10 @@ Status FreshStages(const ReconstructCommandOptions& cli, const StartChoice& star
   return ResolveStages(*config, start.kind == StartKind::kCarved, stages);
 }
 
-// A resumed run's stages: state.json's, with --config's flat keys and the flags over each.
+// A resumed run's stages: state.json's, with --config's flat keys and the flags over each; the
+// run's held-out views stay out of every stage, and a different --holdout is refused.
 Status ResumedStages(const ReconstructCommandOptions& cli, const RunState& state,
-                     std::vector<StageOptions>* stages) {
+                     const Dataset& dataset, std::vector<StageOptions>* stages) {
   SFT_RETURN_IF_ERROR(StagesFromJson(state.stages, JoinPath(cli.resume, "state.json"), stages));
   ScheduleConfig overrides;
   if (!cli.config.empty()) {
@@ -102,12 +105,17 @@ Status ResumedStages(const ReconstructCommandOptions& cli, const RunState& state
     }
   }
   SFT_RETURN_IF_ERROR(FlagKeys(cli, &overrides));
+  if (overrides.holdout_given && overrides.holdout != state.holdout) {
+    return Status::Error("--holdout " + std::to_string(overrides.holdout) + ": the run in " +
+                         cli.resume + " was started with --holdout " +
+                         std::to_string(state.holdout) + " and keeps its held-out views");
+  }
   for (StageOptions& stage : *stages) {
     SFT_RETURN_IF_ERROR(ApplyStageConfig(overrides.flat, "overrides", &stage));
     std::string why;
     if (!stage.Check(&why)) return Status::Error(stage.name + ": " + why);
   }
-  return Status::Ok();
+  return ExcludeHeldOutViews(state.held_out_views, static_cast<int>(dataset.views.size()), stages);
 }
 
 // F1 and Chamfer of the current mesh against --reference (50k samples per surface).
@@ -157,13 +165,15 @@ Status PrepareSchedule(ReconstructCommandOptions* cli, Dataset* dataset,
     SFT_RETURN_IF_ERROR(ReadRunState(cli->resume, &state));
     if (cli->dataset.empty()) cli->dataset = state.dataset();
     SFT_RETURN_IF_ERROR(ReadDataset(cli->dataset, dataset));
-    SFT_RETURN_IF_ERROR(ResumedStages(*cli, state, &stages));
+    SFT_RETURN_IF_ERROR(ResumedStages(*cli, state, *dataset, &stages));
     if (cli->print_schedule) return PrintSchedule(stages);
     SFT_RETURN_IF_ERROR(CheckOutputDirectory(cli->out, {{cli->dataset}, {}}, "--resume"));
     SFT_RETURN_IF_ERROR(UnknownLighting(cli->resume, *cli, dataset));
     if (before_start) SFT_RETURN_IF_ERROR(before_start(cli->dataset, *dataset, stages));
-    return Schedule::Resume(*dataset, cli->out, stages, state.run_info, state.progress,
-                            state.view_gains, schedule);
+    SFT_RETURN_IF_ERROR(Schedule::Resume(*dataset, cli->out, stages, state.run_info, state.progress,
+                                         state.view_gains, schedule));
+    (*schedule)->SetHeldOut(state.holdout, state.held_out_views);
+    return Status::Ok();
   }
   if (cli->dataset.empty() || (cli->out.empty() && !cli->print_schedule)) {
     return Status::Error("--dataset and --out are required (or --resume OUT)");
@@ -173,6 +183,9 @@ Status PrepareSchedule(ReconstructCommandOptions* cli, Dataset* dataset,
   SFT_RETURN_IF_ERROR(ChooseStart(*dataset, cli->init, &start));
   ScheduleConfig config;
   SFT_RETURN_IF_ERROR(FreshStages(*cli, start, &config, &stages));
+  std::vector<int> held_out;
+  SFT_RETURN_IF_ERROR(ApplyHoldout(config.holdout, config.flat.value("views", std::vector<int>()),
+                                   static_cast<int>(dataset->views.size()), &stages, &held_out));
   if (cli->print_schedule) return PrintSchedule(stages);
   const RunInputs inputs{{cli->dataset},
                          {start.path, MaterialFile(cli->material), cli->config, cli->reference}};
@@ -184,7 +197,7 @@ Status PrepareSchedule(ReconstructCommandOptions* cli, Dataset* dataset,
   }
   SFT_RETURN_IF_ERROR(UnknownLighting("", *cli, dataset));
   ScheduleStart state;
-  SFT_RETURN_IF_ERROR(LoadStartMesh(*dataset, start, InitialMeshOptions(), &state.mesh));
+  SFT_RETURN_IF_ERROR(LoadStartMesh(*dataset, start, InitialMeshOptions(), &state.mesh, held_out));
   SFT_RETURN_IF_ERROR(LoadMaterial(cli->material.empty() ? kInitialMaterial : cli->material,
                                    state.mesh, &state.material));
   const nlohmann::json run_info = {
@@ -194,7 +207,9 @@ Status PrepareSchedule(ReconstructCommandOptions* cli, Dataset* dataset,
       {"config", config.flat},
       {"schedule", config.stages.is_null() ? config.schedule : "explicit"}};
   if (before_start) SFT_RETURN_IF_ERROR(before_start(cli->dataset, *dataset, stages));
-  return Schedule::Start(*dataset, cli->out, stages, state, run_info, schedule);
+  SFT_RETURN_IF_ERROR(Schedule::Start(*dataset, cli->out, stages, state, run_info, schedule));
+  (*schedule)->SetHeldOut(config.holdout, held_out);
+  return Status::Ok();
 }
 
 // OUT/export/ (ExportFinishedRun) for the report's 3D view and for other programs. A failed export
@@ -386,6 +401,10 @@ CommandRunner SetupReconstructCommand(CLI::App* app) {
   key_flag(app->add_option("--views", opts->views, "Only these view indices (comma-separated)")
                ->delimiter(','),
            "views");
+  key_flag(app->add_option("--holdout", opts->holdout,
+                           "Keep every K-th selected view (0, K, 2K, ...) out of the fit, for "
+                           "sft eval --held-out; 0 = off"),
+           "holdout");
   app->add_option("--reference", opts->reference,
                   "Ground-truth mesh: F1 and Chamfer after every outer iteration (metrics.json)");
   app->add_option("--reference-tolerance", opts->reference_tolerance,

@@ -6,13 +6,14 @@
 #include <memory>
 
 #include "src/core/file_util.h"
+#include "src/eval/held_out_eval.h"
 #include "src/eval/image_metrics.h"
 #include "src/eval/relight_eval.h"
 #include "src/eval/view_scores.h"
 #include "src/geometry/material.h"
 #include "src/geometry/mesh.h"
-#include "src/io/dataset.h"
 #include "src/image/image_io.h"
+#include "src/io/dataset.h"
 #include "src/io/light_scales.h"
 #include "src/io/scene_setup.h"
 #include "src/optim/fitted_environment.h"
@@ -65,6 +66,10 @@ bool ReconstructionEvalOptions::Check(std::string* why) const {
   }
   if (bounces < 1 || bounces > 16) {
     *why = "bounces: must be in [1, 16]";
+    return false;
+  }
+  if (held_out && !views.empty()) {
+    *why = "views: --held-out scores the run's held-out views; give one of --views and --held-out";
     return false;
   }
   return true;
@@ -161,6 +166,16 @@ Eigen::Vector3d BestChannelScale(const std::vector<AlbedoPair>& pairs) {
   return scale;
 }
 
+// The "held_out" section of the report: null unless --held-out.
+json HeldOutJson(bool wanted, const HeldOutSetup& setup, const HeldOutScores& scores) {
+  if (!wanted) return nullptr;
+  json out = {{"views", setup.views},
+              {"gain", {setup.gain[0], setup.gain[1], setup.gain[2]}},
+              {"gain_views", setup.gain_views}};
+  out.update(scores.ToJson());
+  return out;
+}
+
 }  // namespace
 
 Status EvaluateReconstruction(const std::string& dataset_dir, const std::string& reconstruction,
@@ -204,6 +219,13 @@ Status EvaluateReconstruction(const std::string& dataset_dir, const std::string&
   SFT_RETURN_IF_ERROR(MakeDatasetViews(dataset, &views));
   std::vector<int> selected;
   SFT_RETURN_IF_ERROR(SelectViews(options.views, static_cast<int>(views.views.size()), &selected));
+  HeldOutSetup held_out;
+  if (options.held_out) {
+    SFT_RETURN_IF_ERROR(
+        ReadHeldOutSetup(reconstruction, static_cast<int>(views.views.size()), &held_out));
+    selected = held_out.views;
+  }
+  HeldOutScores held_out_scores;
   const RenderScene scene(mesh);
   RenderOptions render;
   render.spp = options.spp;
@@ -221,7 +243,10 @@ Status EvaluateReconstruction(const std::string& dataset_dir, const std::string&
     SFT_RETURN_IF_ERROR(LoadViewImage(dataset, v, &target));
     if (!dataset.views[v].mask.empty()) SFT_RETURN_IF_ERROR(LoadViewMask(dataset, v, &mask));
     RenderView(scene, material, views.views[v], render, &ours);
-    SFT_RETURN_IF_ERROR(full.Add(v, ToRgb(ours), target, mask));
+    if (options.held_out) {
+      SFT_RETURN_IF_ERROR(held_out_scores.Add(v, ToRgb(ours), target, mask, held_out.gain));
+    }
+    SFT_RETURN_IF_ERROR(full.Add(v, ScaleChannels(ours, held_out.gain), target, mask));
     if (!albedo_folder.empty() || can_render_truth) {
       Image true_pass;
       SFT_RETURN_IF_ERROR(TruePass(dataset, v, albedo_folder, truth.scene.get(), &truth.material,
@@ -276,7 +301,8 @@ Status EvaluateReconstruction(const std::string& dataset_dir, const std::string&
              {"lighting", lighting_estimated ? "estimated" : "given"},
              {"albedo_scale", {albedo_scale[0], albedo_scale[1], albedo_scale[2]}},
              {"roughness", roughness.ToJson()},
-             {"relight", relight}};
+             {"relight", relight},
+             {"held_out", HeldOutJson(options.held_out, held_out, held_out_scores)}};
   return Status::Ok();
 }
 

@@ -35,6 +35,9 @@ struct ReconstructionEvalOptions {
   // no relighting. Needs the dataset's ground_truth.mesh and ground_truth.material.
   std::vector<std::string> relight;
   std::string out;  // folder for the relit renders; empty = none written.
+  // Score the run's held-out views (state.json's held_out_views; src/eval/held_out_eval.h)
+  // instead of `views`: "full" after the median fitted gain, and a "held_out" section.
+  bool held_out = false;
 
   bool Check(std::string* why) const;
 };
@@ -43,7 +46,8 @@ struct ReconstructionEvalOptions {
 // null, "roughness": {...} | null, "relight": {...} | null (EvaluateRelighting), "definitions":
 // {...}, ...}; each pass {"psnr_srgb",
 // "ssim_srgb", "psnr_linear", "ssim_linear", "rel_rmse", "views": [{"view", the same five}]}
-// (rel_rmse null where undefined).
+// (rel_rmse null where undefined). With options.held_out also "held_out": {"views", "gain",
+// "gain_views", HeldOutScores::ToJson's keys}, else null.
 Status EvaluateReconstruction(const std::string& dataset_dir, const std::string& reconstruction,
                               const ReconstructionEvalOptions& options, nlohmann::json* report);
 

@@ -1,6 +1,7 @@
 #include "src/optim/run_outputs.h"
 
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 
 #include "src/core/file_util.h"
@@ -20,6 +21,28 @@ json TimeSplitJson(const SolverTimeSplit& t) {
   return split;
 }
 
+// "holdout" and "held_out_views" (absent in runs before --holdout: none held out).
+Status ReadHeldOut(const json& j, const std::string& path, RunState* state) {
+  state->holdout = 0;
+  state->held_out_views.clear();
+  if (!j.contains("held_out_views") && !j.contains("holdout")) return Status::Ok();
+  const json& k = j.value("holdout", json(0));
+  const json& views = j.value("held_out_views", json::array());
+  bool ok = k.is_number_integer() && k.get<int64_t>() >= 0 && k.get<int64_t>() <= INT32_MAX &&
+            views.is_array();
+  for (size_t i = 0; ok && i < views.size(); ++i) {
+    ok = views[i].is_number_integer() && views[i].get<int64_t>() >= 0 &&
+         views[i].get<int64_t>() <= INT32_MAX;
+    if (ok) state->held_out_views.push_back(views[i].get<int>());
+  }
+  if (!ok) {
+    return Status::Error(path + ": holdout/held_out_views: expected an integer >= 0 and an " +
+                         "array of view indices");
+  }
+  state->holdout = k.get<int>();
+  return Status::Ok();
+}
+
 }  // namespace
 
 Status WriteRunState(const std::string& out, const RunState& state) {
@@ -34,7 +57,9 @@ Status WriteRunState(const std::string& out, const RunState& state) {
             {"topology_changes", p.topology_changes},
             {"stage_outers_done", p.stage_outers_done},
             {"seconds", p.seconds},
-            {"finished", state.finished}};
+            {"finished", state.finished},
+            {"holdout", state.holdout},
+            {"held_out_views", state.held_out_views}};
   if (!state.view_gains.empty()) {
     json gains = json::array();
     for (const Eigen::Vector3d& g : state.view_gains) gains.push_back({g[0], g[1], g[2]});
@@ -100,6 +125,7 @@ Status ReadRunState(const std::string& out, RunState* state) {
                            "per dataset view");
     }
   }
+  SFT_RETURN_IF_ERROR(ReadHeldOut(j, path, state));
   if (p.stage > static_cast<int>(state->stages.size())) {
     return Status::Error(path + ": stage " + std::to_string(p.stage) + " of " +
                          std::to_string(state->stages.size()));

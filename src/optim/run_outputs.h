@@ -8,7 +8,8 @@
 //                               accepted, per-view PSNR; metrics.json adds per-phase solver
 //                               statistics, per-outer records, topology changes and stages;
 //   state.json                  what --resume needs (format sft-reconstruct-state/2): the run's
-//                               info (dataset, start, config), the stages, where the run stands;
+//                               info (dataset, start, config), the stages, where the run stands,
+//                               the held-out views;
 //   adam_state.bin              Adam's moments and step count in an Adam stage
 //                               (src/optim/adam_checkpoint.h);
 //   initial_mesh.ply            the run's starting mesh;
@@ -40,6 +41,10 @@ struct RunState {
   bool finished = false;  // every stage done.
   // Exposure gains per dataset view ("exposure_gains"); empty when no stage fits them (all 1).
   std::vector<Eigen::Vector3d> view_gains;
+  // --holdout K ("holdout"; 0 = off) and the views it kept out of the fit ("held_out_views",
+  // ascending; src/optim/holdout.h). A resumed run keeps them.
+  int holdout = 0;
+  std::vector<int> held_out_views;
 
   std::string dataset() const { return run_info.value("dataset", ""); }
 };

@@ -6,9 +6,9 @@
 #include <cstdio>
 
 #include "src/core/file_util.h"
+#include "src/image/image_io.h"
 #include "src/init/self_intersection.h"
 #include "src/init/untangle.h"
-#include "src/image/image_io.h"
 #include "src/io/scene_setup.h"
 #include "src/optim/fitted_environment.h"
 #include "src/optim/run_outputs.h"
@@ -541,6 +541,7 @@ Status Schedule::Checkpoint() {
   info["topology_changes"] = topology_records_;
   info["stages"] = stage_records_;
   info["material_switches"] = material_records_;
+  info["held_out_views"] = held_out_views_;
   if (extra_metrics_) info.update(extra_metrics_());
   SFT_RETURN_IF_ERROR(WriteMetrics(out_, records_, phase_records_, info));
   RunState state;
@@ -559,6 +560,8 @@ Status Schedule::Checkpoint() {
   for (const StageOptions& s : stages_) state.stages.push_back(StageJson(s));
   state.progress = progress_;
   state.finished = finished();
+  state.holdout = holdout_;
+  state.held_out_views = held_out_views_;
   return WriteRunState(out_, state);
 }
 

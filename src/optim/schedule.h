@@ -114,6 +114,13 @@ class Schedule {
   // Called at every checkpoint; its object is merged into metrics.json's top level (e.g. the MPI
   // time split of `mpirun` runs).
   void SetExtraMetrics(std::function<nlohmann::json()> extra) { extra_metrics_ = std::move(extra); }
+  // The run's --holdout K and the views it keeps out of the fit (src/optim/holdout.h; the stages'
+  // views already exclude them): recorded in state.json and metrics.json at every checkpoint.
+  void SetHeldOut(int holdout, std::vector<int> views) {
+    holdout_ = holdout;
+    held_out_views_ = std::move(views);
+  }
+  const std::vector<int>& held_out_views() const { return held_out_views_; }
 
   bool finished() const { return progress_.stage >= static_cast<int>(stages_.size()); }
   bool stopped() const { return stopped_; }
@@ -186,6 +193,8 @@ class Schedule {
   double seconds_at_start_ = 0.0;
   bool stopped_ = false;
   std::function<nlohmann::json()> extra_metrics_;
+  int holdout_ = 0;                  // --holdout K (0 = off).
+  std::vector<int> held_out_views_;  // views no stage fits.
 };
 
 }  // namespace sft

@@ -8,6 +8,7 @@
 
 #include "src/core/file_util.h"
 #include "src/optim/config.h"
+#include "src/optim/holdout.h"
 
 namespace sft {
 namespace {
@@ -237,6 +238,13 @@ Status MergeScheduleConfig(const json& config, const std::string& source, Schedu
         SFT_RETURN_IF_ERROR(ApplyStageConfig(value[k], where, &probe));
       }
       out->stages = value;
+    } else if (name == "holdout") {
+      if (!value.is_number_integer() || value.get<int64_t>() < 0 ||
+          value.get<int64_t>() > 1000000 || !ValidHoldout(static_cast<int>(value.get<int64_t>()))) {
+        return Status::Error(source + ": holdout: expected 0 (off) or an integer in [2, 1000000]");
+      }
+      out->holdout = value.get<int>();
+      out->holdout_given = true;
     } else if (name == "name") {
       return Status::Error(source + ": name: a stage key (put it inside \"stages\")");
     } else {

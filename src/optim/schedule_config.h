@@ -3,7 +3,8 @@
 //     override the same key in every stage, as the command-line flags do;
 //   - "schedule": a built-in stage list, "auto" (default: "hull" when the run starts from a
 //     carved hull, "refine" otherwise), "refine" or "hull";
-//   - "stages": an explicit stage list (an array of objects) instead of a built-in one.
+//   - "stages": an explicit stage list (an array of objects) instead of a built-in one;
+//   - "holdout": K, every K-th selected view is kept out of the fit (src/optim/holdout.h).
 // A stage object holds any flat key plus "name", and the stage-only keys "texel_resolution",
 // "remesh", "remesh_edge_pixels", "resample", "resample_fold_fraction", "material_model" and
 // "texture_size" (the effect planner's keys, "effects": "auto" and "pin", are flat keys: config.h).
@@ -25,6 +26,8 @@ struct ScheduleConfig {
   std::string schedule = "auto";                   // auto | refine | large_steps | hull.
   nlohmann::json stages;                           // explicit list; null = the built-in one.
   nlohmann::json flat = nlohmann::json::object();  // keys that override every stage.
+  int holdout = 0;             // "holdout": every K-th selected view held out; 0 = off, K >= 2.
+  bool holdout_given = false;  // "holdout" was given (a resumed run must not change it).
 };
 
 // Adds `config`'s keys to *out (later calls override earlier ones key by key; "stages" and

@@ -1,5 +1,6 @@
 #include "src/optim/start_mesh.h"
 
+#include <algorithm>
 #include <vector>
 
 #include "src/core/file_util.h"
@@ -39,10 +40,18 @@ Status ChooseStart(const Dataset& dataset, const std::string& init_path, StartCh
 }
 
 Status LoadStartMesh(const Dataset& dataset, const StartChoice& choice,
-                     const InitialMeshOptions& carve, TriMesh* mesh) {
+                     const InitialMeshOptions& carve, TriMesh* mesh,
+                     const std::vector<int>& excluded_views) {
   if (choice.kind != StartKind::kCarved) return ReadMesh(choice.path, mesh);
-  std::vector<CarvingView> views;
-  SFT_RETURN_IF_ERROR(LoadCarvingViews(dataset, &views));
+  std::vector<CarvingView> all;
+  SFT_RETURN_IF_ERROR(LoadCarvingViews(dataset, &all));
+  std::vector<CarvingView> views;  // LoadCarvingViews gives one per dataset view, in order.
+  for (size_t v = 0; v < all.size(); ++v) {
+    if (std::find(excluded_views.begin(), excluded_views.end(), static_cast<int>(v)) ==
+        excluded_views.end()) {
+      views.push_back(std::move(all[v]));
+    }
+  }
   InitialMeshReport report;
   return MakeInitialMesh(views, carve, /*sparse_points=*/{}, mesh, &report);
 }

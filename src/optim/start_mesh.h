@@ -6,6 +6,7 @@
 #define SFT_OPTIM_START_MESH_H_
 
 #include <string>
+#include <vector>
 
 #include "src/core/status.h"
 #include "src/geometry/mesh.h"
@@ -31,9 +32,11 @@ struct StartChoice {
 // which view lacks it and what to pass instead.
 Status ChooseStart(const Dataset& dataset, const std::string& init_path, StartChoice* choice);
 
-// Loads (or carves, with `carve` options) the start mesh. `progress` prints the carving's line.
+// Loads (or carves, with `carve` options) the start mesh. Carving leaves out the masks of
+// `excluded_views` (held-out views, src/optim/holdout.h).
 Status LoadStartMesh(const Dataset& dataset, const StartChoice& choice,
-                     const InitialMeshOptions& carve, TriMesh* mesh);
+                     const InitialMeshOptions& carve, TriMesh* mesh,
+                     const std::vector<int>& excluded_views = {});
 
 }  // namespace sft
 
