@@ -178,20 +178,27 @@ json HeldOutJson(bool wanted, const HeldOutSetup& setup, const HeldOutScores& sc
 
 }  // namespace
 
-Status EvaluateReconstruction(const std::string& dataset_dir, const std::string& reconstruction,
-                              const ReconstructionEvalOptions& options, json* report) {
-  std::string why;
-  if (!options.Check(&why)) return Status::Error("--" + why);
-  Dataset dataset;
-  SFT_RETURN_IF_ERROR(ReadDataset(dataset_dir, &dataset));
-  const Dataset capture = dataset;  // before the fitted light scales: relighting's "capture".
+namespace {
+
+// What a run renders with: the dataset as the run saw it (its fitted environment when the
+// lighting was unknown, the fitted light scales) and the reconstruction's mesh and material.
+struct RunToRender {
+  Dataset capture;  // the dataset as read, before the fitted light scales: relighting's capture.
+  Dataset dataset;  // with the fitted lighting.
   TriMesh mesh;
   Material material;
-  SFT_RETURN_IF_ERROR(LoadReconstruction(reconstruction, options, &mesh, &material));
+  bool lighting_estimated = false;
+};
+
+Status LoadRunToRender(const std::string& dataset_dir, const std::string& reconstruction,
+                     const ReconstructionEvalOptions& options, RunToRender* run) {
+  SFT_RETURN_IF_ERROR(ReadDataset(dataset_dir, &run->dataset));
+  run->capture = run->dataset;
+  SFT_RETURN_IF_ERROR(LoadReconstruction(reconstruction, options, &run->mesh, &run->material));
   // Unknown lighting: the run's fitted environment (its environment.exr), before its light
   // scales, which count that light.
-  const bool lighting_estimated = LightingUnknown(dataset);
-  if (lighting_estimated) {
+  run->lighting_estimated = LightingUnknown(run->dataset);
+  if (run->lighting_estimated) {
     if (!FileExists(JoinPath(reconstruction, kFittedEnvironmentFile))) {
       return Status::Error(JoinPath(reconstruction, kFittedEnvironmentFile) +
                            ": missing; the dataset's lighting is unknown and the run's fitted "
@@ -199,24 +206,99 @@ Status EvaluateReconstruction(const std::string& dataset_dir, const std::string&
     }
     std::string note;
     SFT_RETURN_IF_ERROR(
-        PrepareUnknownLighting(reconstruction, EnvironmentEstimateOptions(), &dataset, &note));
+        PrepareUnknownLighting(reconstruction, EnvironmentEstimateOptions(), &run->dataset, &note));
   }
   const std::string lights = JoinPath(reconstruction, "lights.json");
   if (FileExists(lights)) {
     std::vector<double> scales;
-    SFT_RETURN_IF_ERROR(ReadLightScales(lights, dataset, &scales));
-    ApplyLightScales(scales, &dataset);
+    SFT_RETURN_IF_ERROR(ReadLightScales(lights, run->dataset, &scales));
+    ApplyLightScales(scales, &run->dataset);
   }
+  return Status::Ok();
+}
+
+RenderOptions EvalRenderOptions(const ReconstructionEvalOptions& options, const Dataset& dataset) {
+  RenderOptions render;
+  render.spp = options.spp;
+  render.bounces = options.bounces;
+  render.seed = options.seed;
+  render.shading = DatasetShading(dataset);  // as the fit renders it with "shading": "auto".
+  return render;
+}
+
+// The per-view scores of the colour, albedo and roughness passes.
+struct PassScores {
+  ViewScores full, albedo, roughness;
+  std::vector<AlbedoPair> albedo_pairs;  // scored after the best channel scale (ScoreAlbedo).
+  HeldOutScores held_out;
+};
+
+Status ScoreViews(const RunToRender& run, const RenderScene& scene, const Truth& truth,
+                  const DatasetViews& views, const std::vector<int>& selected,
+                  const RenderOptions& render, const HeldOutSetup* held_out, PassScores* scores) {
   std::string albedo_folder, roughness_folder;
-  SFT_RETURN_IF_ERROR(PassFolder(dataset, "albedo", &albedo_folder));
-  SFT_RETURN_IF_ERROR(PassFolder(dataset, "roughness", &roughness_folder));
-  Truth truth;
-  SFT_RETURN_IF_ERROR(LoadTruth(dataset, &truth));
+  SFT_RETURN_IF_ERROR(PassFolder(run.dataset, "albedo", &albedo_folder));
+  SFT_RETURN_IF_ERROR(PassFolder(run.dataset, "roughness", &roughness_folder));
   const bool can_render_truth = truth.scene != nullptr;
+  RenderOptions albedo_pass = render;
+  albedo_pass.pass = RenderPass::kAlbedo;
+  RenderOptions roughness_pass = render;
+  roughness_pass.pass = RenderPass::kRoughness;
+  const Eigen::Vector3d gain = held_out ? held_out->gain : Eigen::Vector3d::Ones();
+  for (int v : selected) {
+    Image target, mask, ours;
+    SFT_RETURN_IF_ERROR(LoadViewImage(run.dataset, v, &target));
+    if (!run.dataset.views[v].mask.empty()) {
+      SFT_RETURN_IF_ERROR(LoadViewMask(run.dataset, v, &mask));
+    }
+    RenderView(scene, run.material, views.views[v], render, &ours);
+    if (held_out) SFT_RETURN_IF_ERROR(scores->held_out.Add(v, ToRgb(ours), target, mask, gain));
+    SFT_RETURN_IF_ERROR(scores->full.Add(v, ScaleChannels(ours, gain), target, mask));
+    if (!albedo_folder.empty() || can_render_truth) {
+      Image true_pass;
+      SFT_RETURN_IF_ERROR(TruePass(run.dataset, v, albedo_folder, truth.scene.get(),
+                                   &truth.material, views.views[v], albedo_pass, &true_pass));
+      RenderView(scene, run.material, views.views[v], albedo_pass, &ours);
+      scores->albedo_pairs.push_back({v, ToRgb(ours), ToRgb(true_pass), mask});
+    }
+    if (!roughness_folder.empty() || can_render_truth) {
+      Image true_pass;
+      SFT_RETURN_IF_ERROR(TruePass(run.dataset, v, roughness_folder, truth.scene.get(),
+                                   &truth.material, views.views[v], roughness_pass, &true_pass));
+      RenderView(scene, run.material, views.views[v], roughness_pass, &ours);
+      SFT_RETURN_IF_ERROR(scores->roughness.Add(v, ToRgb(ours), true_pass, mask));
+    }
+  }
+  return Status::Ok();
+}
+
+// Scores the albedo pairs; with estimated lighting the albedo is known up to one factor per
+// channel, so after the best one (returned).
+Status ScoreAlbedo(bool lighting_estimated, PassScores* scores, Eigen::Vector3d* scale) {
+  *scale = lighting_estimated ? BestChannelScale(scores->albedo_pairs) : Eigen::Vector3d::Ones();
+  for (AlbedoPair& p : scores->albedo_pairs) {
+    for (size_t i = 0; i < p.ours.data.size(); ++i) {
+      p.ours.data[i] *= static_cast<float>((*scale)[i % 3]);
+    }
+    SFT_RETURN_IF_ERROR(scores->albedo.Add(p.view, p.ours, p.truth, p.mask));
+  }
+  return Status::Ok();
+}
+
+}  // namespace
+
+Status EvaluateReconstruction(const std::string& dataset_dir, const std::string& reconstruction,
+                              const ReconstructionEvalOptions& options, json* report) {
+  std::string why;
+  if (!options.Check(&why)) return Status::Error("--" + why);
+  RunToRender run;
+  SFT_RETURN_IF_ERROR(LoadRunToRender(dataset_dir, reconstruction, options, &run));
+  Truth truth;
+  SFT_RETURN_IF_ERROR(LoadTruth(run.dataset, &truth));
   std::vector<RelightCondition> conditions;
-  SFT_RETURN_IF_ERROR(PrepareRelight(capture, truth, options, &conditions));
+  SFT_RETURN_IF_ERROR(PrepareRelight(run.capture, truth, options, &conditions));
   DatasetViews views;
-  SFT_RETURN_IF_ERROR(MakeDatasetViews(dataset, &views));
+  SFT_RETURN_IF_ERROR(MakeDatasetViews(run.dataset, &views));
   std::vector<int> selected;
   SFT_RETURN_IF_ERROR(SelectViews(options.views, static_cast<int>(views.views.size()), &selected));
   HeldOutSetup held_out;
@@ -225,59 +307,19 @@ Status EvaluateReconstruction(const std::string& dataset_dir, const std::string&
         ReadHeldOutSetup(reconstruction, static_cast<int>(views.views.size()), &held_out));
     selected = held_out.views;
   }
-  HeldOutScores held_out_scores;
-  const RenderScene scene(mesh);
-  RenderOptions render;
-  render.spp = options.spp;
-  render.bounces = options.bounces;
-  render.seed = options.seed;
-  render.shading = DatasetShading(dataset);  // as the fit renders it with "shading": "auto".
-  RenderOptions albedo_pass = render;
-  albedo_pass.pass = RenderPass::kAlbedo;
-  RenderOptions roughness_pass = render;
-  roughness_pass.pass = RenderPass::kRoughness;
-  ViewScores full, albedo, roughness;
-  std::vector<AlbedoPair> albedo_pairs;
-  for (int v : selected) {
-    Image target, mask, ours;
-    SFT_RETURN_IF_ERROR(LoadViewImage(dataset, v, &target));
-    if (!dataset.views[v].mask.empty()) SFT_RETURN_IF_ERROR(LoadViewMask(dataset, v, &mask));
-    RenderView(scene, material, views.views[v], render, &ours);
-    if (options.held_out) {
-      SFT_RETURN_IF_ERROR(held_out_scores.Add(v, ToRgb(ours), target, mask, held_out.gain));
-    }
-    SFT_RETURN_IF_ERROR(full.Add(v, ScaleChannels(ours, held_out.gain), target, mask));
-    if (!albedo_folder.empty() || can_render_truth) {
-      Image true_pass;
-      SFT_RETURN_IF_ERROR(TruePass(dataset, v, albedo_folder, truth.scene.get(), &truth.material,
-                                   views.views[v], albedo_pass, &true_pass));
-      RenderView(scene, material, views.views[v], albedo_pass, &ours);
-      albedo_pairs.push_back({v, ToRgb(ours), ToRgb(true_pass), mask});
-    }
-    if (!roughness_folder.empty() || can_render_truth) {
-      Image true_pass;
-      SFT_RETURN_IF_ERROR(TruePass(dataset, v, roughness_folder, truth.scene.get(), &truth.material,
-                                   views.views[v], roughness_pass, &true_pass));
-      RenderView(scene, material, views.views[v], roughness_pass, &ours);
-      SFT_RETURN_IF_ERROR(roughness.Add(v, ToRgb(ours), true_pass, mask));
-    }
-  }
-  // With estimated lighting the albedo is known up to one factor per channel: scored after the
-  // best one.
-  const Eigen::Vector3d albedo_scale =
-      lighting_estimated ? BestChannelScale(albedo_pairs) : Eigen::Vector3d::Ones();
-  for (AlbedoPair& p : albedo_pairs) {
-    for (size_t i = 0; i < p.ours.data.size(); ++i) {
-      p.ours.data[i] *= static_cast<float>(albedo_scale[i % 3]);
-    }
-    SFT_RETURN_IF_ERROR(albedo.Add(p.view, p.ours, p.truth, p.mask));
-  }
+  const RenderScene scene(run.mesh);
+  const RenderOptions render = EvalRenderOptions(options, run.dataset);
+  PassScores scores;
+  SFT_RETURN_IF_ERROR(ScoreViews(run, scene, truth, views, selected, render,
+                                 options.held_out ? &held_out : nullptr, &scores));
+  Eigen::Vector3d albedo_scale;
+  SFT_RETURN_IF_ERROR(ScoreAlbedo(run.lighting_estimated, &scores, &albedo_scale));
   json relight = nullptr;
   if (!conditions.empty()) {
     RelightInputs inputs;
-    inputs.dataset = &capture;
+    inputs.dataset = &run.capture;
     inputs.scene = &scene;
-    inputs.material = &material;
+    inputs.material = &run.material;
     inputs.truth = truth.scene.get();
     inputs.true_material = &truth.material;
     inputs.views = selected;
@@ -296,13 +338,36 @@ Status EvaluateReconstruction(const std::string& dataset_dir, const std::string&
              {"views", selected},
              {"psnr_peak", 1.0},
              {"definitions", ViewScoreDefinitions()},
-             {"full", full.ToJson()},
-             {"albedo", albedo.ToJson()},
-             {"lighting", lighting_estimated ? "estimated" : "given"},
+             {"full", scores.full.ToJson()},
+             {"albedo", scores.albedo.ToJson()},
+             {"lighting", run.lighting_estimated ? "estimated" : "given"},
              {"albedo_scale", {albedo_scale[0], albedo_scale[1], albedo_scale[2]}},
-             {"roughness", roughness.ToJson()},
+             {"roughness", scores.roughness.ToJson()},
              {"relight", relight},
-             {"held_out", HeldOutJson(options.held_out, held_out, held_out_scores)}};
+             {"held_out", HeldOutJson(options.held_out, held_out, scores.held_out)}};
+  return Status::Ok();
+}
+
+Status RenderRunViews(const std::string& dataset_dir, const std::string& reconstruction,
+                      const std::vector<int>& views, const ReconstructionEvalOptions& options,
+                      std::vector<Image>* renders) {
+  std::string why;
+  if (!options.Check(&why)) return Status::Error("--" + why);
+  RunToRender run;
+  SFT_RETURN_IF_ERROR(LoadRunToRender(dataset_dir, reconstruction, options, &run));
+  DatasetViews dataset_views;
+  SFT_RETURN_IF_ERROR(MakeDatasetViews(run.dataset, &dataset_views));
+  const RenderScene scene(run.mesh);
+  const RenderOptions render = EvalRenderOptions(options, run.dataset);
+  renders->clear();
+  for (int v : views) {
+    if (v < 0 || v >= static_cast<int>(dataset_views.views.size())) {
+      return Status::Error("view " + std::to_string(v) + ": not in " + dataset_dir);
+    }
+    Image image;
+    RenderView(scene, run.material, dataset_views.views[v], render, &image);
+    renders->push_back(ToRgb(image));
+  }
   return Status::Ok();
 }
 

@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "src/core/image.h"
 #include "src/core/status.h"
 
 namespace sft {
@@ -50,6 +51,14 @@ struct ReconstructionEvalOptions {
 // "gain_views", HeldOutScores::ToJson's keys}, else null.
 Status EvaluateReconstruction(const std::string& dataset_dir, const std::string& reconstruction,
                               const ReconstructionEvalOptions& options, nlohmann::json* report);
+
+// Renders `views` (dataset view indices) of the run in `reconstruction` as EvaluateReconstruction
+// does (its mesh and material or the overrides, the fitted lighting and light scales, options'
+// spp, bounces and seed), as linear RGB (e.g. the held-out rows of report.html). Errors: as
+// EvaluateReconstruction's loading, and a view outside the dataset.
+Status RenderRunViews(const std::string& dataset_dir, const std::string& reconstruction,
+                      const std::vector<int>& views, const ReconstructionEvalOptions& options,
+                      std::vector<Image>* renders);
 
 }  // namespace sft
 

@@ -184,7 +184,7 @@ TEST(EvalRelightTest, BadRelightInputIsOneErrorLine) {
        "ground_truth.mesh"},
       {"eval --reference " + tmp.Join("ds/gt/mesh.ply") + " --mesh " + tmp.Join("ds/gt/mesh.ply") +
            " --relight side",
-       "--relight, --out and --material need --dataset"},
+       "--relight, --out, --material and --held-out need --dataset"},
       {base + "side --out " + tmp.Join("ds/relit"), "--out"},
       {"eval --spp 1 --dataset " + tmp.Join("ds") + " --reconstruction " + tmp.Join("ds/gt") +
            " --out " + tmp.Join("o"),

@@ -1,6 +1,6 @@
 // sft reconstruct --holdout and sft eval --held-out end to end on a tiny synthesized dataset:
 // held-out views stay out of every fit (also on resume), are recorded in state.json and are
-// scored by eval; bad values are one line and write nothing.
+// scored by eval and shown in the report; bad values are one line and write nothing.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -44,7 +44,7 @@ TEST(ReconstructHoldoutTest, HeldOutViewsAreKeptOutAndScored) {
       "");
   std::string out;
   const std::string run = tmp.Join("r");
-  ASSERT_EQ(RunSft("reconstruct --quiet --no-report --dataset " + tmp.Join("ds") + " --init " +
+  ASSERT_EQ(RunSft("reconstruct --quiet --dataset " + tmp.Join("ds") + " --init " +
                        tmp.Join("ds/gt/mesh.ply") +
                        " --spp 8 --bounces 1 --steps 2 --phases texture --outer 1 --holdout 2 "
                        "--out " +
@@ -52,6 +52,11 @@ TEST(ReconstructHoldoutTest, HeldOutViewsAreKeptOutAndScored) {
                    &out),
             0)
       << out;
+  // The report shows the held-out views beside the fitted ones.
+  const std::string page = testing::ReadTestFile(run + "/report.html");
+  EXPECT_THAT(page, HasSubstr("view 0 (held out)"));
+  EXPECT_THAT(page, HasSubstr("view 2 (held out)"));
+  EXPECT_THAT(page, HasSubstr("PSNR after its own gain"));
   const nlohmann::json state = ReadJson(run + "/state.json");
   EXPECT_EQ(state["held_out_views"], nlohmann::json({0, 2}));
   EXPECT_EQ(state["holdout"], 2);
