@@ -11,28 +11,15 @@
 #include "src/optim/run_outputs.h"
 #include "src/optim/schedule_config.h"
 #include "tests/testing/temp_dir.h"
+#include "tests/testing/test_images.h"
 
 namespace sft {
 namespace {
 
 using ::testing::HasSubstr;
 
-// A structured RGB image in [0.1, 0.9].
-Image Pattern(int width, int height) {
-  Image image(width, height, 3);
-  for (int y = 0; y < height; ++y) {
-    for (int x = 0; x < width; ++x) {
-      for (int c = 0; c < 3; ++c) {
-        image.at(x, y, c) = static_cast<float>(0.5 + 0.2 * std::sin(0.4 * x + 0.3 * y + c) +
-                                               0.2 * std::cos(0.23 * x * (c + 1) - 0.5 * y));
-      }
-    }
-  }
-  return image;
-}
-
 TEST(HeldOutEvalTest, GainFitOfAHalfBrightTargetIsOneHalf) {
-  const Image ours = Pattern(24, 20);
+  const Image ours = testing::SmoothPattern(24, 20);
   const Image target = ScaleChannels(ours, Eigen::Vector3d::Constant(0.5));
   const Eigen::Vector3d gain = FitViewGain(ours, target, Image());
   for (int c = 0; c < 3; ++c) EXPECT_NEAR(gain[c], 0.5, 1e-6) << c;
@@ -53,7 +40,7 @@ TEST(HeldOutEvalTest, GainFitOfAHalfBrightTargetIsOneHalf) {
 }
 
 TEST(HeldOutEvalTest, GainFitIsPerChannelAndOverTheMask) {
-  const Image ours = Pattern(16, 16);
+  const Image ours = testing::SmoothPattern(16, 16);
   Image target = ScaleChannels(ours, Eigen::Vector3d(0.5, 2.0, 0.25));
   Image mask(16, 16, 1, 1.0f);
   for (int y = 0; y < 16; ++y) {

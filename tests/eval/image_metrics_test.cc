@@ -8,29 +8,15 @@
 #include <cmath>
 
 #include "src/core/rng.h"
+#include "tests/testing/test_images.h"
 
 namespace sft {
 namespace {
 
 using ::testing::HasSubstr;
 
-// A smooth but structured RGB test pattern in [0.1, 0.9].
-Image Pattern(int width, int height, int shift = 0) {
-  Image image(width, height, 3);
-  for (int y = 0; y < height; ++y) {
-    for (int x = 0; x < width; ++x) {
-      const double u = x + shift;
-      for (int c = 0; c < 3; ++c) {
-        image.at(x, y, c) = static_cast<float>(0.5 + 0.2 * std::sin(0.4 * u + 0.3 * y + c) +
-                                               0.2 * std::cos(0.23 * u * (c + 1) - 0.5 * y));
-      }
-    }
-  }
-  return image;
-}
-
 TEST(ImageMetricsTest, IdenticalImagesGiveCappedPsnrAndUnitSsim) {
-  const Image a = Pattern(40, 30);
+  const Image a = testing::SmoothPattern(40, 30);
   ImageMetricsOptions options;
   double psnr = 0.0, ssim = 0.0;
   ASSERT_TRUE(ComputePsnr(a, a, Image(), options, &psnr).ok());
@@ -46,7 +32,7 @@ TEST(ImageMetricsTest, IdenticalImagesGiveCappedPsnrAndUnitSsim) {
 
 // Differences of ±σ everywhere give MSE = σ² exactly: PSNR = 20·log10(peak/σ).
 TEST(ImageMetricsTest, KnownNoiseLevelGivesKnownPsnr) {
-  const Image a = Pattern(32, 32);
+  const Image a = testing::SmoothPattern(32, 32);
   Image b = a;
   const double sigma = 0.01;
   for (size_t i = 0; i < b.data.size(); ++i) {
@@ -65,7 +51,7 @@ TEST(ImageMetricsTest, KnownNoiseLevelGivesKnownPsnr) {
 // from the mask's border; noise inside lowers both.
 TEST(ImageMetricsTest, MaskSelectsPixels) {
   const int w = 48, h = 48;
-  const Image a = Pattern(w, h);
+  const Image a = testing::SmoothPattern(w, h);
   Image mask(w, h, 1, 0.0f);
   for (int y = 0; y < h; ++y) {
     for (int x = 0; x < w / 2; ++x) mask.at(x, y) = 1.0f;
@@ -114,7 +100,7 @@ TEST(ImageMetricsTest, SsimOfConstantImagesIsTheLuminanceTerm) {
 }
 
 TEST(ImageMetricsTest, ShiftedImageHasLowerSsim) {
-  const Image a = Pattern(64, 48), shifted = Pattern(64, 48, 3);
+  const Image a = testing::SmoothPattern(64, 48), shifted = testing::SmoothPattern(64, 48, 3);
   ImageMetricsOptions options;
   double ssim = 0.0, fallback = 0.0;
   ASSERT_TRUE(ComputeSsim(shifted, a, Image(), options, &ssim).ok());
@@ -125,7 +111,7 @@ TEST(ImageMetricsTest, ShiftedImageHasLowerSsim) {
   EXPECT_NEAR(ssim, fallback, 1e-6);
   // A 1-pixel shift is more similar than a 3-pixel shift.
   double closer = 0.0;
-  ASSERT_TRUE(ComputeSsim(Pattern(64, 48, 1), a, Image(), options, &closer).ok());
+  ASSERT_TRUE(ComputeSsim(testing::SmoothPattern(64, 48, 1), a, Image(), options, &closer).ok());
   EXPECT_GT(closer, ssim);
   EXPECT_LT(closer, 1.0);
 }
@@ -168,10 +154,10 @@ TEST(ImageMetricsTest, DisplayPsnrOfConstantImagesIsKnown) {
 }
 
 TEST(ImageMetricsTest, BadInputsAreErrors) {
-  const Image a = Pattern(16, 16);
+  const Image a = testing::SmoothPattern(16, 16);
   ImageMetricsOptions options;
   double value = 0.0;
-  EXPECT_THAT(ComputePsnr(a, Pattern(16, 15), Image(), options, &value).message(),
+  EXPECT_THAT(ComputePsnr(a, testing::SmoothPattern(16, 15), Image(), options, &value).message(),
               HasSubstr("sizes differ"));
   EXPECT_THAT(ComputeSsim(a, Image(16, 16, 4), Image(), options, &value).message(),
               HasSubstr("sizes differ"));
@@ -184,7 +170,7 @@ TEST(ImageMetricsTest, BadInputsAreErrors) {
   nan_image.at(3, 4, 1) = std::nanf("");
   EXPECT_THAT(ComputePsnr(nan_image, a, Image(), options, &value).message(),
               HasSubstr("non-finite"));
-  EXPECT_THAT(ComputeRelativeRmse(a, Pattern(16, 15), Image(), &value).message(),
+  EXPECT_THAT(ComputeRelativeRmse(a, testing::SmoothPattern(16, 15), Image(), &value).message(),
               HasSubstr("sizes differ"));
   ImageScores scores;
   EXPECT_THAT(ComputeImageScores(nan_image, a, Image(), options, &scores).message(),
