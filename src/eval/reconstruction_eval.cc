@@ -191,7 +191,7 @@ struct RunToRender {
 };
 
 Status LoadRunToRender(const std::string& dataset_dir, const std::string& reconstruction,
-                     const ReconstructionEvalOptions& options, RunToRender* run) {
+                       const ReconstructionEvalOptions& options, RunToRender* run) {
   SFT_RETURN_IF_ERROR(ReadDataset(dataset_dir, &run->dataset));
   run->capture = run->dataset;
   SFT_RETURN_IF_ERROR(LoadReconstruction(reconstruction, options, &run->mesh, &run->material));

@@ -7,8 +7,8 @@
 
 #include "src/core/file_util.h"
 #include "src/eval/view_scores.h"
-#include "src/io/dataset.h"
 #include "src/image/image_io.h"
+#include "src/io/dataset.h"
 #include "src/io/scene_setup.h"
 
 namespace sft {

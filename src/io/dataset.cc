@@ -16,8 +16,8 @@
 #include <vector>
 
 #include "src/core/file_util.h"
-#include "src/io/dataset_internal.h"
 #include "src/image/image_io.h"
+#include "src/io/dataset_internal.h"
 
 namespace sft {
 namespace dataset_internal {

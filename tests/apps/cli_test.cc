@@ -6,8 +6,8 @@
 #include <filesystem>
 
 #include "src/core/image.h"
-#include "src/io/dataset.h"
 #include "src/image/image_io.h"
+#include "src/io/dataset.h"
 #include "tests/testing/temp_dir.h"
 
 namespace sft {

@@ -12,9 +12,9 @@
 #include <sstream>
 
 #include "src/core/file_util.h"
+#include "src/image/image_io.h"
 #include "src/io/colmap_model.h"
 #include "src/io/dataset.h"
-#include "src/image/image_io.h"
 #include "src/io/point_cloud_ply.h"
 #include "tests/testing/temp_dir.h"
 

@@ -11,8 +11,8 @@
 
 #include "src/core/image.h"
 #include "src/geometry/mesh.h"
-#include "src/init/surface_cleanup.h"
 #include "src/image/image_io.h"
+#include "src/init/surface_cleanup.h"
 #include "tests/testing/synth_dataset.h"
 #include "tests/testing/temp_dir.h"
 

@@ -6,8 +6,8 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
-#include "src/io/dataset.h"
 #include "src/image/image_io.h"
+#include "src/io/dataset.h"
 #include "tests/testing/synth_dataset.h"
 #include "tests/testing/temp_dir.h"
 

@@ -24,9 +24,9 @@
 
 #include "src/eval/mesh_metrics.h"
 #include "src/geometry/mesh.h"
+#include "src/image/image_io.h"
 #include "src/io/auto_masks.h"
 #include "src/io/dataset.h"
-#include "src/image/image_io.h"
 #include "tests/testing/temp_dir.h"
 
 namespace sft {

@@ -11,9 +11,9 @@
 #include <filesystem>
 
 #include "src/core/file_util.h"
+#include "src/image/image_io.h"
 #include "src/io/colmap_import.h"
 #include "src/io/dataset.h"
-#include "src/image/image_io.h"
 #include "src/io/point_cloud_ply.h"
 #include "tests/testing/temp_dir.h"
 

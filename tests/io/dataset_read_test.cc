@@ -9,8 +9,8 @@
 #include <vector>
 
 #include "src/core/memory.h"
-#include "src/io/dataset.h"
 #include "src/image/image_io.h"
+#include "src/io/dataset.h"
 #include "src/io/scene_setup.h"
 #include "tests/testing/dataset_scenes.h"
 #include "tests/testing/temp_dir.h"

@@ -12,9 +12,9 @@
 #include <cmath>
 #include <random>
 
+#include "src/image/image_io.h"
 #include "src/io/colmap_import.h"
 #include "src/io/dataset.h"
-#include "src/image/image_io.h"
 #include "tests/testing/temp_dir.h"
 
 namespace sft {

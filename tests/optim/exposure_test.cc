@@ -9,8 +9,8 @@
 
 #include "src/geometry/material.h"
 #include "src/geometry/mesh.h"
-#include "src/io/dataset.h"
 #include "src/image/image_io.h"
+#include "src/io/dataset.h"
 #include "src/optim/config.h"
 #include "src/optim/problem.h"
 #include "src/optim/reconstruct.h"

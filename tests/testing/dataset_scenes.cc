@@ -7,8 +7,8 @@
 #include <filesystem>
 #include <fstream>
 
-#include "src/io/dataset.h"
 #include "src/image/image_io.h"
+#include "src/io/dataset.h"
 
 namespace sft {
 namespace testing {
