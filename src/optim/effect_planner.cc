@@ -73,11 +73,14 @@ class Measurer {
   Status Images(const EffectPlan& plan, Sample (&out)[2]) {
     for (int k = 0; k < 2; ++k) {
       out[k].clear();
-      for (int v : views_) {
-        Image image;
-        if (!cache_->RenderWith(v, plan, seeds_[k], &image)) {
-          return Status::Error("effect planner: a render was not finite (" + plan.Summary() + ")");
-        }
+      // One call for every view, so that under mpirun the views render on every rank.
+      std::vector<Image> images;
+      if (!cache_->RenderWith(views_, plan, seeds_[k], &images)) {
+        return Status::Error("effect planner: a render was not finite (" + plan.Summary() + ")");
+      }
+      for (size_t i = 0; i < views_.size(); ++i) {
+        const int v = views_[i];
+        const Image& image = images[i];
         const LevelCache& level = cache_->level(v, 0);
         const std::vector<uint8_t>& active = cache_->targets(v).active[0];
         for (int p = 0; p < image.width * image.height; ++p) {
@@ -106,11 +109,8 @@ class Measurer {
     const int n = 3 * cache_->params().layout().num_vertices;
     for (int k = 0; k < 2; ++k) {
       std::vector<double> gradient(cache_->params().size(), 0.0);
-      for (size_t i = 0; i < views_.size(); ++i) {
-        if (!cache_->AddAdjointGradientWith(views_[i], weights_[i], plan, seeds_[k], &gradient)) {
-          return Status::Error("effect planner: a gradient was not finite (" + plan.Summary() +
-                               ")");
-        }
+      if (!cache_->AddAdjointGradientsWith(views_, weights_, plan, seeds_[k], &gradient)) {
+        return Status::Error("effect planner: a gradient was not finite (" + plan.Summary() + ")");
       }
       out[k].assign(gradient.begin(), gradient.begin() + n);
     }

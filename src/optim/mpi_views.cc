@@ -22,9 +22,8 @@
 #include <unistd.h>
 #endif
 
-#include "src/io/scene_setup.h"
 #include "src/optim/mpi_wire.h"
-#include "src/render/scene.h"
+#include "src/optim/state_renderer.h"
 
 namespace sft {
 
@@ -548,12 +547,9 @@ void MpiViewRunner::Run(const RenderState& state, const std::vector<ViewJob>& jo
 }
 
 Status ServeViews(const MpiSession& session, const Dataset& dataset) {
-  DatasetViews views;
-  SFT_RETURN_IF_ERROR(MakeDatasetViews(dataset, &views));
+  std::unique_ptr<StateRenderer> renderer;
+  SFT_RETURN_IF_ERROR(StateRenderer::Create(dataset, &renderer));
   RenderState state;
-  std::unique_ptr<RenderScene> scene;
-  int64_t scene_id = -1;
-  std::vector<Eigen::Vector3d> scene_positions;
   // Test hook (ServeViews' comment): results to send before dying; -1 never.
   const char* die_env = std::getenv("SFT_TEST_MPI_DIE_AFTER_JOBS");
   const int64_t die_after = die_env != nullptr ? std::atoll(die_env) : -1;
@@ -575,15 +571,10 @@ Status ServeViews(const MpiSession& session, const Dataset& dataset) {
     BroadcastPieces(&job_bytes, header[4], nullptr);
     ByteReader job_reader(job_bytes);
     const std::vector<JobEntry> entries = job_reader.GetVector<JobEntry>();
-    if (state.scene_id != scene_id) {
-      scene = std::make_unique<RenderScene>(state.build_positions, state.faces);
-      scene_positions = state.build_positions;
-      scene_id = state.scene_id;
-    }
-    if (state.positions != scene_positions) {
-      scene->SetVertices(state.positions);
-      scene_positions = state.positions;
-    }
+    // A worker that cannot render rank 0's state dies: rank 0 sees a dead rank, renders the
+    // evaluation itself and ends the run (MpiViewRunner).
+    const Status updated = renderer->Update(state);
+    if (!updated.ok()) LOG(FATAL) << "rank " << session.rank() << ": " << updated.message();
     // Receives for this rank's adjoint weights, posted at once (rank 0 waits for their delivery).
     std::vector<Image> weights(entries.size());
     std::vector<MPI_Request> weight_requests(entries.size(), MPI_REQUEST_NULL);
@@ -616,10 +607,7 @@ Status ServeViews(const MpiSession& session, const Dataset& dataset) {
         job.weights = std::move(weights[k]);
       }
       ViewResult result;
-      const ViewSetup view = ScaledViewSetup(views, state.view_indices[job.view],
-                                             state.image_scale_log2, state.light_scales);
-      RenderViewJob(*scene, state.material, view, state.render, state.request, state.num_lights,
-                    job, &result);
+      renderer->Render(state, job, &result);
       ByteWriter w;
       PutResult(result, Since(start), &w);
       results.push_back(std::move(w.bytes()));

@@ -6,8 +6,8 @@
 // the jobs of every evaluation (view_jobs.h) to an MpiViewRunner. Ranks 1..N−1 load the dataset
 // from rank 0's path and serve jobs (ServeViews) until rank 0 stops them. One evaluation:
 //   1. rank 0 broadcasts a header, the parts of the RenderState that changed since the last
-//      evaluation (scene, positions, material, settings) and the job list with each job's rank;
-//      adjoint weights go to the job's rank alone;
+//      evaluation (scene, positions, material, settings, a fitted environment's texels) and the
+//      job list with each job's rank; adjoint weights go to the job's rank alone;
 //   2. every rank renders its jobs in job order (the jobs are cut into contiguous runs, rank 0's
 //      first, balanced by each (view, pass)'s last measured render time and each rank's last
 //      measured speed);

@@ -93,7 +93,7 @@ Image GetImage(ByteReader* r) {
 
 std::vector<std::vector<char> > StateParts(const RenderState& s) {
   std::vector<std::vector<char> > parts(kNumParts);
-  ByteWriter scene, positions, material, settings;
+  ByteWriter scene, positions, material, settings, environment;
   scene.Put(s.scene_id);
   scene.PutVector(s.build_positions);
   scene.PutVector(s.faces);
@@ -106,13 +106,15 @@ std::vector<std::vector<char> > StateParts(const RenderState& s) {
   settings.PutVector(s.light_scales);
   PutRenderOptions(s.render, &settings);
   PutRequest(s.request, &settings);
-  settings.Put(s.num_lights);
+  settings.Put(s.layout);
   settings.Put(s.image_scale_log2);
   settings.PutVector(s.view_indices);
+  PutImage(s.environment, &environment);
   parts[kScenePart] = std::move(scene.bytes());
   parts[kPositionsPart] = std::move(positions.bytes());
   parts[kMaterialPart] = std::move(material.bytes());
   parts[kSettingsPart] = std::move(settings.bytes());
+  parts[kEnvironmentPart] = std::move(environment.bytes());
   return parts;
 }
 
@@ -137,9 +139,12 @@ void ApplyStatePart(int part, const std::vector<char>& bytes, RenderState* s) {
       s->light_scales = r.GetVector<double>();
       s->render = GetRenderOptions(&r);
       s->request = GetRequest(&r);
-      s->num_lights = r.Get<int>();
+      s->layout = r.Get<ParameterLayout>();
       s->image_scale_log2 = r.Get<int>();
       s->view_indices = r.GetVector<int>();
+      break;
+    case kEnvironmentPart:
+      s->environment = GetImage(&r);
       break;
   }
 }

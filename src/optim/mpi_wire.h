@@ -17,8 +17,17 @@
 
 namespace sft {
 
-// The state's parts, each sent only when it changed.
-enum StatePart { kScenePart = 0, kPositionsPart, kMaterialPart, kSettingsPart, kNumParts };
+// The state's parts, each sent only when it changed: the scene (id, build positions, faces), the
+// vertex positions, the material, the settings (light scales, render options, derivative
+// request, parameter layout, image scale, views) and the fitted environment's texels.
+enum StatePart {
+  kScenePart = 0,
+  kPositionsPart,
+  kMaterialPart,
+  kSettingsPart,
+  kEnvironmentPart,
+  kNumParts
+};
 
 // Values copied as bytes: trivially copyable types and fixed-size Eigen vectors (plain arrays of
 // their scalars, though their copy constructors are user-provided).

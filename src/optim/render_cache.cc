@@ -230,11 +230,11 @@ void RenderCache::UpdateScene() {
   params_->WriteMaterial(&material_);
   if (params_->has_environment()) {
     Image texels = params_->EnvironmentTexels();
-    if (!fitted_environment_ || texels.data != fitted_texels_) {
+    if (!fitted_environment_ || texels.data != fitted_texels_.data) {
       const LightSpec& light = dataset_->lights.at(params_->layout().environment_light);
       fitted_environment_ =
           std::make_unique<EnvironmentMap>(texels, light.world_from_env, light.scale);
-      fitted_texels_ = std::move(texels.data);
+      fitted_texels_ = std::move(texels);
     }
   }
 }
@@ -242,9 +242,7 @@ void RenderCache::UpdateScene() {
 ViewSetup RenderCache::ScaledView(int v) const {
   ViewSetup view =
       ScaledViewSetup(*views_, view_indices_[v], options_.image_scale_log2, params_->LightScales());
-  if (params_->layout().FitsEnvironment(view.environment_light_index)) {
-    view.environment = fitted_environment_.get();
-  }
+  UseFittedEnvironment(params_->layout(), fitted_environment_.get(), &view);
   return view;
 }
 
@@ -256,7 +254,8 @@ DerivativeRequest RenderCache::ActiveRequest() const {
   return request;
 }
 
-RenderState RenderCache::CurrentState() const {
+RenderState RenderCache::CurrentState(const RenderOptions& render,
+                                      const DerivativeRequest& request) const {
   RenderState state;
   state.scene_id = scene_id_;
   state.build_positions = scene_build_positions_;
@@ -264,18 +263,22 @@ RenderState RenderCache::CurrentState() const {
   state.positions = scene_positions_;
   state.material = material_;
   state.light_scales = params_->LightScales();
-  state.render = options_.render;
-  state.request = ActiveRequest();
-  state.num_lights = params_->layout().num_lights;
+  state.render = render;
+  state.request = request;
+  state.layout = params_->layout();
   state.image_scale_log2 = options_.image_scale_log2;
   state.view_indices = view_indices_;
+  if (params_->has_environment()) state.environment = fitted_texels_;
   return state;
 }
 
 void RenderCache::RunJobs(const std::vector<ViewJob>& jobs, const ViewRunner::Consume& consume) {
+  RunJobs(jobs, options_.render, ActiveRequest(), consume);
+}
+
+void RenderCache::RunJobs(const std::vector<ViewJob>& jobs, const RenderOptions& render,
+                          const DerivativeRequest& request, const ViewRunner::Consume& consume) {
   UpdateScene();
-  const RenderOptions& render = options_.render;
-  const DerivativeRequest request = ActiveRequest();
   const ParameterLayout& layout = params_->layout();
   const auto local = [&](const ViewJob& job, ViewResult* result) {
     RenderViewJob(*scene_, material_, ScaledView(job.view), render, request, layout, job, result);
@@ -288,16 +291,14 @@ void RenderCache::RunJobs(const std::vector<ViewJob>& jobs, const ViewRunner::Co
     consume_seconds += Seconds(start);
   };
   const auto start = std::chrono::steady_clock::now();
-  // A fitted environment is not sent to other ranks (RenderState has no texels): such fits render
-  // every view here.
-  if (runner_ == nullptr || params_->has_environment()) {
+  if (runner_ == nullptr) {
     for (size_t k = 0; k < jobs.size(); ++k) {
       ViewResult result;
       local(jobs[k], &result);
       timed_consume(k, &result);
     }
   } else {
-    runner_->Run(CurrentState(), jobs, local, timed_consume);
+    runner_->Run(CurrentState(render, request), jobs, local, timed_consume);
   }
   render_seconds_ += std::max(0.0, Seconds(start) - consume_seconds);
 }
@@ -526,40 +527,43 @@ bool RenderCache::AddAdjointGradient(int v, const Image& weights, std::vector<do
 
 bool RenderCache::AddAdjointGradients(const std::vector<int>& views,
                                       std::vector<double>* gradient) {
-  std::vector<ViewJob> jobs(views.size());
   std::vector<Image> weights(views.size());
-  for (size_t k = 0; k < views.size(); ++k) {
-    weights[k] = AdjointWeights(views[k]);
-    jobs[k].view = views[k];
-    jobs[k].pass = ViewPass::kAdjoint;
-    jobs[k].seed = AdjointSeed(seed_, options_.independent_gradient);
-    jobs[k].weights = GainedWeights(weights[k], params_->Gains(views[k]));
-  }
-  bool finite = true;
-  RunJobs(jobs, [&](size_t k, ViewResult* result) {
-    finite = AddGradientResult(views[k], weights[k], *result, gradient) && finite;
-  });
-  return finite;
+  for (size_t k = 0; k < views.size(); ++k) weights[k] = AdjointWeights(views[k]);
+  return RunAdjointJobs(views, weights, options_.render, ActiveRequest(),
+                        AdjointSeed(seed_, options_.independent_gradient), gradient);
 }
 
 bool RenderCache::AddAdjointGradientWith(int v, const Image& weights, const EffectPlan& plan,
                                          uint64_t seed, std::vector<double>* gradient) {
-  UpdateScene();
+  return AddAdjointGradientsWith({v}, {weights}, plan, seed, gradient);
+}
+
+bool RenderCache::AddAdjointGradientsWith(const std::vector<int>& views,
+                                          const std::vector<Image>& weights,
+                                          const EffectPlan& plan, uint64_t seed,
+                                          std::vector<double>* gradient) {
   RenderOptions render = options_.render;
   DerivativeRequest request = ActiveRequest();
   plan.ApplyTo(&render, &request);
-  ViewJob job;
-  job.view = v;
-  job.pass = ViewPass::kAdjoint;
-  job.seed = seed;
-  job.weights = GainedWeights(weights, params_->Gains(v));
-  const auto start = std::chrono::steady_clock::now();
-  ViewResult result;
-  RenderViewJob(*scene_, material_, ScaledView(v), render, request, params_->layout(), job,
-                &result);
-  render_seconds_ += Seconds(start);
-  ++renders_;
-  return AddGradientResult(v, weights, result, gradient);
+  return RunAdjointJobs(views, weights, render, request, seed, gradient);
+}
+
+bool RenderCache::RunAdjointJobs(const std::vector<int>& views, const std::vector<Image>& weights,
+                                 const RenderOptions& render, const DerivativeRequest& request,
+                                 uint64_t seed, std::vector<double>* gradient) {
+  CHECK_EQ(views.size(), weights.size());
+  std::vector<ViewJob> jobs(views.size());
+  for (size_t k = 0; k < views.size(); ++k) {
+    jobs[k].view = views[k];
+    jobs[k].pass = ViewPass::kAdjoint;
+    jobs[k].seed = seed;
+    jobs[k].weights = GainedWeights(weights[k], params_->Gains(views[k]));
+  }
+  bool finite = true;
+  RunJobs(jobs, render, request, [&](size_t k, ViewResult* result) {
+    finite = AddGradientResult(views[k], weights[k], *result, gradient) && finite;
+  });
+  return finite;
 }
 
 bool RenderCache::AddGradientResult(int v, const Image& weights, const ViewResult& result,
@@ -592,21 +596,32 @@ bool RenderCache::AddGradientResult(int v, const Image& weights, const ViewResul
 }
 
 bool RenderCache::RenderWith(int v, const EffectPlan& plan, uint64_t seed, Image* image) {
-  UpdateScene();
+  std::vector<Image> images;
+  const bool finite = RenderWith(std::vector<int>{v}, plan, seed, &images);
+  *image = std::move(images[0]);
+  return finite;
+}
+
+bool RenderCache::RenderWith(const std::vector<int>& views, const EffectPlan& plan, uint64_t seed,
+                             std::vector<Image>* images) {
   RenderOptions render = options_.render;
-  DerivativeRequest unused = options_.edges;
-  plan.ApplyTo(&render, &unused);
-  render.seed = seed;
-  const auto start = std::chrono::steady_clock::now();
-  Image rendered;
-  RenderStats stats;
-  RenderView(*scene_, material_, ScaledView(v), render, &rendered, &stats);
-  render_seconds_ += Seconds(start);
-  ++renders_;
-  *image = ToRgb(rendered);
-  const Eigen::Vector3d gain = params_->Gains(v);
-  if (gain != Eigen::Vector3d::Ones()) ApplyGains(gain, image);
-  return stats.NonFinite() == 0;
+  DerivativeRequest request = ActiveRequest();  // not used by image jobs.
+  plan.ApplyTo(&render, &request);
+  std::vector<ViewJob> jobs(views.size());
+  for (size_t k = 0; k < views.size(); ++k) {
+    jobs[k].view = views[k];
+    jobs[k].seed = seed;
+  }
+  images->assign(views.size(), Image());
+  bool finite = true;
+  RunJobs(jobs, render, request, [&](size_t k, ViewResult* result) {
+    finite = finite && result->non_finite == 0;
+    Image& image = (*images)[k];
+    image = ToRgb(result->image);
+    const Eigen::Vector3d gain = params_->Gains(views[k]);
+    if (gain != Eigen::Vector3d::Ones()) ApplyGains(gain, &image);
+  });
+  return finite;
 }
 
 }  // namespace sft

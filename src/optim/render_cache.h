@@ -18,10 +18,10 @@
 // g and adds Σ_p w_pc I_pc to the gains' gradient. The gains are exact (linear); I_c is the Monte
 // Carlo render of the same pass.
 //
-// Every render of Render, RenderSome and AddAdjointGradients is a ViewJob (view_jobs.h) run by the
-// ViewRunner installed when the cache was created (CurrentViewRunner): in this process, or spread
-// over MPI ranks (mpi_views.h). Results come back in view order, so the stored renders, rows and
-// gradient sums are the same to the bit either way.
+// Every render but RenderPassImage's is a ViewJob (view_jobs.h) run by the ViewRunner installed
+// when the cache was created (CurrentViewRunner): in this process, or spread over MPI ranks
+// (mpi_views.h). Results come back in view order, so the stored renders, rows and gradient sums
+// are the same to the bit either way.
 #ifndef SFT_OPTIM_RENDER_CACHE_H_
 #define SFT_OPTIM_RENDER_CACHE_H_
 
@@ -128,11 +128,20 @@ class RenderCache : public ceres::EvaluationCallback {
   const RenderCacheOptions& options() const { return options_; }
 
   // For measurements at the fit's scale (the effect planner): view v's colour image (RGB, level
-  // 0) under `plan` with `seed`, not stored. False when the render is not finite.
+  // 0, gains applied) under `plan` with `seed`, not stored. False when the render is not finite.
   bool RenderWith(int v, const EffectPlan& plan, uint64_t seed, Image* image);
+  // RenderWith of every view in `views` (their renders may run on other ranks): (*images)[k] is
+  // views[k]'s. False when any is not finite.
+  bool RenderWith(const std::vector<int>& views, const EffectPlan& plan, uint64_t seed,
+                  std::vector<Image>* images);
   // Like AddAdjointGradient, under `plan` with `seed`.
   bool AddAdjointGradientWith(int v, const Image& weights, const EffectPlan& plan, uint64_t seed,
                               std::vector<double>* gradient);
+  // AddAdjointGradientWith of every view in `views` with its `weights`, added to *gradient in the
+  // order of `views` (the views' renders may run on other ranks). False when any is not finite.
+  bool AddAdjointGradientsWith(const std::vector<int>& views, const std::vector<Image>& weights,
+                               const EffectPlan& plan, uint64_t seed,
+                               std::vector<double>* gradient);
 
   int num_views() const { return static_cast<int>(levels_.size()); }
   int num_levels(int v) const { return static_cast<int>(levels_[v].size()); }
@@ -188,9 +197,17 @@ class RenderCache : public ceres::EvaluationCallback {
   ViewSetup ScaledView(int v) const;
   void StoreRender(int v, const Image& image, const JacobianRows* rows);
   // Runs `jobs` at the current parameters through the runner (or here) and hands each result to
-  // `consume` in job order; render_seconds_ gets the wall time outside `consume`.
+  // `consume` in job order; render_seconds_ gets the wall time outside `consume`. The renders use
+  // the cache's options and ActiveRequest, or `render` and `request` (a plan's).
   void RunJobs(const std::vector<ViewJob>& jobs, const ViewRunner::Consume& consume);
-  RenderState CurrentState() const;
+  void RunJobs(const std::vector<ViewJob>& jobs, const RenderOptions& render,
+               const DerivativeRequest& request, const ViewRunner::Consume& consume);
+  RenderState CurrentState(const RenderOptions& render, const DerivativeRequest& request) const;
+  // The adjoint jobs of `views` (weights ungained) under `render` and `request` with `seed`, their
+  // gradients added to *gradient in the order of `views`. False when any is not finite.
+  bool RunAdjointJobs(const std::vector<int>& views, const std::vector<Image>& weights,
+                      const RenderOptions& render, const DerivativeRequest& request,
+                      uint64_t seed, std::vector<double>* gradient);
   DerivativeRequest ActiveRequest() const;
   // Adds view v's adjoint result (of `weights`, ungained) to *gradient: light entries divided by
   // their scales, the exposure gains' part from the result's image. False when not finite.
@@ -209,7 +226,7 @@ class RenderCache : public ceres::EvaluationCallback {
   // The fitted environment at the current parameters (SceneParameters::has_environment): the map
   // views of that light render with instead of the dataset's, rebuilt when its texels change.
   std::unique_ptr<EnvironmentMap> fitted_environment_;
-  std::vector<float> fitted_texels_;
+  Image fitted_texels_;  // the map's texels (SceneParameters::EnvironmentTexels).
   // The scene's identity for other ranks (RenderState::scene_id), its faces and first positions.
   int64_t scene_id_ = 0;
   std::vector<Eigen::Vector3i> faces_;

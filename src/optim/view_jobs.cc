@@ -22,11 +22,9 @@ ViewSetup ScaledViewSetup(const DatasetViews& views, int dataset_view, int image
   return view;
 }
 
-void RenderViewJob(const RenderScene& scene, const Material& material, const ViewSetup& view,
-                   const RenderOptions& render_options, const DerivativeRequest& request_options,
-                   int num_lights, const ViewJob& job, ViewResult* result) {
-  RenderViewJob(scene, material, view, render_options, request_options,
-                MakeParameterLayout(scene, material, num_lights), job, result);
+void UseFittedEnvironment(const ParameterLayout& layout, const EnvironmentMap* fitted,
+                          ViewSetup* view) {
+  if (layout.FitsEnvironment(view->environment_light_index)) view->environment = fitted;
 }
 
 void RenderViewJob(const RenderScene& scene, const Material& material, const ViewSetup& view,

@@ -59,9 +59,14 @@ struct RenderState {
   std::vector<double> light_scales;        // per dataset light.
   RenderOptions render;                    // spp, bounces, effects, threads, shading.
   DerivativeRequest request;               // derivative kinds and edge budgets (no weights).
-  int num_lights = 0;                      // the parameter layout's light count.
-  int image_scale_log2 = 0;                // RenderCacheOptions::image_scale_log2.
-  std::vector<int> view_indices;           // dataset view of each render-cache view.
+  // The index space of rows and gradients (SceneParameters::layout): vertices, texels, lights
+  // and a fitted environment's texels.
+  ParameterLayout layout;
+  int image_scale_log2 = 0;       // RenderCacheOptions::image_scale_log2.
+  std::vector<int> view_indices;  // dataset view of each render-cache view.
+  // A fitted environment's texels at this point (SceneParameters::EnvironmentTexels: the map of
+  // dataset light layout.environment_light, RGB); empty without one.
+  Image environment;
 };
 
 // View `dataset_view` of `views` as the fit renders it: its camera downscaled by
@@ -69,13 +74,14 @@ struct RenderState {
 ViewSetup ScaledViewSetup(const DatasetViews& views, int dataset_view, int image_scale_log2,
                           const std::vector<double>& light_scales);
 
-// Renders `job` of `view` (its ScaledViewSetup) on `scene` with `material` and the options; the
-// request's jacobian_rows and adjoint_weights follow the job's pass.
-void RenderViewJob(const RenderScene& scene, const Material& material, const ViewSetup& view,
-                   const RenderOptions& render, const DerivativeRequest& request, int num_lights,
-                   const ViewJob& job, ViewResult* result);
-// The same with the parameter index space given (RenderViewWithDerivatives' layout form: a fitted
-// environment's texels).
+// Makes a view render with the fitted environment `fitted` (the map of the state's texels) when
+// its environment light is the one whose texels `layout` fits.
+void UseFittedEnvironment(const ParameterLayout& layout, const EnvironmentMap* fitted,
+                          ViewSetup* view);
+
+// Renders `job` of `view` (its ScaledViewSetup, UseFittedEnvironment) on `scene` with `material`
+// and the options, its rows or gradient in `layout`'s index space; the request's jacobian_rows
+// and adjoint_weights follow the job's pass.
 void RenderViewJob(const RenderScene& scene, const Material& material, const ViewSetup& view,
                    const RenderOptions& render, const DerivativeRequest& request,
                    const ParameterLayout& layout, const ViewJob& job, ViewResult* result);

@@ -1,5 +1,6 @@
 // `mpirun -np N sft reconstruct` (src/optim/mpi_views.h): the same mesh and material to the last
-// bit as one process, with LM (Jacobian rows) and with Adam (adjoint gradients); wrong usage is
+// bit as one process, with LM (Jacobian rows) and with Adam (adjoint gradients), also under
+// unknown lighting (a fitted environment, whose texels the other rank receives); wrong usage is
 // one line and a non-zero exit; a rank that dies mid-run ends it with one line and a checkpoint
 // that one process resumes. Skipped when sft was built without MPI or mpirun is absent.
 #include <gmock/gmock.h>
@@ -7,7 +8,9 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cstdint>
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <set>
 #include <string>
 
@@ -60,34 +63,48 @@ class ReconstructMpiTest : public ::testing::Test {
         << out;
   }
 
-  // One process, then 2 ranks: every result file must be identical.
-  void ExpectSameAcrossRanks(const std::string& solver) {
-    const std::string args = "reconstruct --quiet --no-report --dataset " + tmp_.Join("ds") +
+  // The dataset of SetUp with its lights removed, as "ds_unlit": unknown lighting, which sft
+  // reconstruct fits as an environment map (src/optim/fitted_environment.h).
+  void MakeUnlitDataset() {
+    fs::copy(tmp_.Join("ds"), tmp_.Join("ds_unlit"), fs::copy_options::recursive);
+    nlohmann::json scene =
+        nlohmann::json::parse(testing::ReadTestFile(tmp_.Join("ds_unlit/scene.json")));
+    scene["lights"] = nlohmann::json::array();
+    for (nlohmann::json& view : scene["views"]) view["lights"] = nlohmann::json::array();
+    testing::WriteTestFile(tmp_.Join("ds_unlit/scene.json"), scene.dump(1));
+  }
+
+  // One process, then 2 ranks, on `dataset` (a folder of tmp_): every result file must be
+  // identical, and rank 1 must have rendered some of the views.
+  void ExpectSameAcrossRanks(const std::string& solver, const std::string& dataset = "ds") {
+    const std::string args = "reconstruct --quiet --no-report --dataset " + tmp_.Join(dataset) +
                              " --init " + tmp_.Join("init.ply") +
                              " --spp 4 --bounces 1 --steps 2 --outer 1 --phases alternate"
                              " --threads 1 --solver " +
                              solver + " --out ";
+    const std::string one_dir = tmp_.Join(dataset + "_" + solver + "1");
+    const std::string two_dir = tmp_.Join(dataset + "_" + solver + "2");
     std::string out;
-    ASSERT_EQ(testing::RunSft(args + tmp_.Join(solver + "1"), &out), 0) << out;
-    ASSERT_EQ(testing::RunCommand(
-                  mpirun_ + " -np 2 " + testing::SftBinary() + " " + args + tmp_.Join(solver + "2"),
-                  &out),
+    ASSERT_EQ(testing::RunSft(args + one_dir, &out), 0) << out;
+    ASSERT_EQ(testing::RunCommand(mpirun_ + " -np 2 " + testing::SftBinary() + " " + args + two_dir,
+                                  &out),
               0)
         << out;
-    const std::set<std::string> files = ResultFiles(tmp_.Join(solver + "1"));
-    EXPECT_EQ(files, ResultFiles(tmp_.Join(solver + "2")));
+    const std::set<std::string> files = ResultFiles(one_dir);
+    EXPECT_EQ(files, ResultFiles(two_dir));
     for (const char* file : {"mesh.ply", "material.json"}) EXPECT_EQ(files.count(file), 1u) << file;
     for (const std::string& file : files) {
-      const std::string one = testing::ReadTestFile(tmp_.Join(solver + "1/" + file));
+      const std::string one = testing::ReadTestFile(one_dir + "/" + file);
       EXPECT_FALSE(one.empty()) << file;
-      EXPECT_TRUE(one == testing::ReadTestFile(tmp_.Join(solver + "2/" + file)))
-          << solver << ": " << file << " differs between 1 and 2 ranks";
+      EXPECT_TRUE(one == testing::ReadTestFile(two_dir + "/" + file))
+          << solver << " on " << dataset << ": " << file << " differs between 1 and 2 ranks";
     }
     // Rank 0 reports where its time went; the other rank rendered views.
-    const std::string metrics = testing::ReadTestFile(tmp_.Join(solver + "2/metrics.json"));
-    EXPECT_THAT(metrics, HasSubstr("\"mpi\""));
-    EXPECT_THAT(metrics, HasSubstr("\"imbalance\""));
-    EXPECT_THAT(metrics, ::testing::Not(HasSubstr("\"remote_jobs\":0")));
+    const nlohmann::json metrics = nlohmann::json::parse(
+        testing::ReadTestFile(two_dir + "/metrics.json"), nullptr, /*allow_exceptions=*/false);
+    ASSERT_TRUE(metrics.is_object() && metrics.contains("mpi")) << metrics.dump(1);
+    EXPECT_TRUE(metrics["mpi"]["seconds"].contains("imbalance")) << metrics["mpi"].dump(1);
+    EXPECT_GT(metrics["mpi"].value("remote_jobs", int64_t{0}), 0) << metrics["mpi"].dump(1);
   }
 
   testing::TempDir tmp_;
@@ -99,6 +116,17 @@ TEST_F(ReconstructMpiTest, LevenbergMarquardtIsBitIdenticalOnTwoRanks) {
 }
 
 TEST_F(ReconstructMpiTest, AdamIsBitIdenticalOnTwoRanks) { ExpectSameAcrossRanks("adam"); }
+
+// Unknown lighting: the fitted environment's texels travel with the state, rank 1 renders its
+// share under them (rows and adjoint gradients of the texels included), and the fitted map
+// (environment.exr) is one of the identical files.
+TEST_F(ReconstructMpiTest, FittedEnvironmentIsBitIdenticalOnTwoRanks) {
+  MakeUnlitDataset();
+  ExpectSameAcrossRanks("lm", "ds_unlit");
+  ExpectSameAcrossRanks("adam", "ds_unlit");
+  EXPECT_TRUE(fs::exists(tmp_.Join("ds_unlit_lm2/environment.exr")));
+  EXPECT_TRUE(fs::exists(tmp_.Join("ds_unlit_adam2/environment.exr")));
+}
 
 // More ranks than views, and a worker that cannot read the dataset (its working directory has
 // no "ds"): one error line on rank 0, a non-zero exit, nothing hangs, nothing is written.

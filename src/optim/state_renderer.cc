@@ -1,0 +1,70 @@
+#include "src/optim/state_renderer.h"
+
+#include <string>
+
+#include "src/optim/fitted_environment.h"
+
+namespace sft {
+namespace {
+
+bool SameImage(const Image& a, const Image& b) {
+  return a.width == b.width && a.height == b.height && a.channels == b.channels &&
+         a.data == b.data;
+}
+
+}  // namespace
+
+Status StateRenderer::Create(const Dataset& dataset, std::unique_ptr<StateRenderer>* renderer) {
+  std::unique_ptr<StateRenderer> r(new StateRenderer());
+  r->dataset_ = dataset;
+  SFT_RETURN_IF_ERROR(MakeDatasetViews(r->dataset_, &r->views_));
+  *renderer = std::move(r);
+  return Status::Ok();
+}
+
+Status StateRenderer::Update(const RenderState& state) {
+  if (state.scene_id != scene_id_) {
+    scene_ = std::make_unique<RenderScene>(state.build_positions, state.faces);
+    scene_positions_ = state.build_positions;
+    scene_id_ = state.scene_id;
+  }
+  if (state.positions != scene_positions_) {
+    scene_->SetVertices(state.positions);
+    scene_positions_ = state.positions;
+  }
+  if (state.layout.num_environment_texels > 0) SFT_RETURN_IF_ERROR(UpdateEnvironment(state));
+  return Status::Ok();
+}
+
+Status StateRenderer::UpdateEnvironment(const RenderState& state) {
+  if (FittedEnvironmentLight(dataset_) < 0) {
+    // The map the views are set up with is replaced by the state's below.
+    SFT_RETURN_IF_ERROR(AddFittedEnvironment(state.environment, &dataset_));
+    SFT_RETURN_IF_ERROR(MakeDatasetViews(dataset_, &views_));
+  }
+  const int light = FittedEnvironmentLight(dataset_);
+  if (light != state.layout.environment_light ||
+      state.layout.num_environment_texels != state.environment.width * state.environment.height) {
+    return Status::Error("the fitted environment is light " + std::to_string(light) +
+                         " of this rank's dataset but light " +
+                         std::to_string(state.layout.environment_light) +
+                         " of rank 0's (the ranks read different datasets)");
+  }
+  if (!fitted_environment_ || !SameImage(state.environment, fitted_texels_)) {
+    const LightSpec& spec = dataset_.lights[light];
+    fitted_environment_ =
+        std::make_unique<EnvironmentMap>(state.environment, spec.world_from_env, spec.scale);
+    fitted_texels_ = state.environment;
+  }
+  return Status::Ok();
+}
+
+void StateRenderer::Render(const RenderState& state, const ViewJob& job, ViewResult* result) const {
+  ViewSetup view = ScaledViewSetup(views_, state.view_indices[job.view], state.image_scale_log2,
+                                   state.light_scales);
+  UseFittedEnvironment(state.layout, fitted_environment_.get(), &view);
+  RenderViewJob(*scene_, state.material, view, state.render, state.request, state.layout, job,
+                result);
+}
+
+}  // namespace sft
