@@ -539,9 +539,8 @@ bool RenderCache::AddAdjointGradientWith(int v, const Image& weights, const Effe
 }
 
 bool RenderCache::AddAdjointGradientsWith(const std::vector<int>& views,
-                                          const std::vector<Image>& weights,
-                                          const EffectPlan& plan, uint64_t seed,
-                                          std::vector<double>* gradient) {
+                                          const std::vector<Image>& weights, const EffectPlan& plan,
+                                          uint64_t seed, std::vector<double>* gradient) {
   RenderOptions render = options_.render;
   DerivativeRequest request = ActiveRequest();
   plan.ApplyTo(&render, &request);

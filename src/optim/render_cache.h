@@ -206,8 +206,8 @@ class RenderCache : public ceres::EvaluationCallback {
   // The adjoint jobs of `views` (weights ungained) under `render` and `request` with `seed`, their
   // gradients added to *gradient in the order of `views`. False when any is not finite.
   bool RunAdjointJobs(const std::vector<int>& views, const std::vector<Image>& weights,
-                      const RenderOptions& render, const DerivativeRequest& request,
-                      uint64_t seed, std::vector<double>* gradient);
+                      const RenderOptions& render, const DerivativeRequest& request, uint64_t seed,
+                      std::vector<double>* gradient);
   DerivativeRequest ActiveRequest() const;
   // Adds view v's adjoint result (of `weights`, ungained) to *gradient: light entries divided by
   // their scales, the exposure gains' part from the result's image. False when not finite.

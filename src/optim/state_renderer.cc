@@ -8,8 +8,7 @@ namespace sft {
 namespace {
 
 bool SameImage(const Image& a, const Image& b) {
-  return a.width == b.width && a.height == b.height && a.channels == b.channels &&
-         a.data == b.data;
+  return a.width == b.width && a.height == b.height && a.channels == b.channels && a.data == b.data;
 }
 
 }  // namespace
