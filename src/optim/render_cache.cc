@@ -543,11 +543,13 @@ bool RenderCache::AddAdjointGradients(const std::vector<int>& views,
 }
 
 bool RenderCache::AddAdjointGradientWith(int v, const Image& weights, const EffectPlan& plan,
-                                         uint64_t seed, std::vector<double>* gradient) {
+                                         uint64_t seed, std::vector<double>* gradient,
+                                         GradientParts* parts) {
   UpdateScene();
   RenderOptions render = options_.render;
   DerivativeRequest request = ActiveRequest();
   plan.ApplyTo(&render, &request);
+  request.gradient_parts = parts != nullptr;
   ViewJob job;
   job.view = v;
   job.pass = ViewPass::kAdjoint;
@@ -559,20 +561,26 @@ bool RenderCache::AddAdjointGradientWith(int v, const Image& weights, const Effe
                 &result);
   render_seconds_ += Seconds(start);
   ++renders_;
-  return AddGradientResult(v, weights, result, gradient);
+  return AddGradientResult(v, weights, result, gradient, parts);
 }
 
 bool RenderCache::AddGradientResult(int v, const Image& weights, const ViewResult& result,
-                                    std::vector<double>* gradient) const {
+                                    std::vector<double>* gradient, GradientParts* parts) const {
   const ParameterLayout& layout = params_->layout();
   bool finite = result.non_finite == 0;
   for (int i = 0; i < layout.size(); ++i) {
-    double g = result.gradient[i];
-    if (layout.KindOf(i) == ParameterKind::kLight) {
-      g /= params_->LightScale(i - layout.LightOffset());
-    }
+    const bool light = layout.KindOf(i) == ParameterKind::kLight;
+    // The renderer's entry at light scale 1·s_l, as the derivative at the fitted scale.
+    const auto unscaled = [&](double g) {
+      return light ? g / params_->LightScale(i - layout.LightOffset()) : g;
+    };
+    const double g = unscaled(result.gradient[i]);
     finite = finite && std::isfinite(g);
     (*gradient)[i] += g;
+    if (parts == nullptr) continue;
+    for (int t = 0; t < kNumDerivativeTerms; ++t) {
+      parts->parts[t][i] += unscaled(result.gradient_parts.parts[t][i]);
+    }
   }
   if (active_.exposure && params_->GainFitted(v)) {
     // ∂/∂g_c Σ_p w_pc g_c I_pc = Σ_p w_pc I_pc, with I this pass's own (ungained) render, so that
@@ -586,6 +594,7 @@ bool RenderCache::AddGradientResult(int v, const Image& weights, const ViewResul
     for (int c = 0; c < 3; ++c) {
       finite = finite && std::isfinite(sum[c]);
       (*gradient)[params_->GainIndex(v, c)] += sum[c];
+      if (parts != nullptr) parts->part(DerivativeTerm::kRest)[params_->GainIndex(v, c)] += sum[c];
     }
   }
   return finite;

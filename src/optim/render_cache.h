@@ -130,9 +130,12 @@ class RenderCache : public ceres::EvaluationCallback {
   // For measurements at the fit's scale (the effect planner): view v's colour image (RGB, level
   // 0) under `plan` with `seed`, not stored. False when the render is not finite.
   bool RenderWith(int v, const EffectPlan& plan, uint64_t seed, Image* image);
-  // Like AddAdjointGradient, under `plan` with `seed`.
+  // Like AddAdjointGradient, under `plan` with `seed`. With `parts` (each part the size of
+  // *gradient), the same pass also adds its gradient split by derivative term (GradientParts; the
+  // exposure gains' entries go to DerivativeTerm::kRest), so that Σ parts grows by what *gradient
+  // grows by.
   bool AddAdjointGradientWith(int v, const Image& weights, const EffectPlan& plan, uint64_t seed,
-                              std::vector<double>* gradient);
+                              std::vector<double>* gradient, GradientParts* parts = nullptr);
 
   int num_views() const { return static_cast<int>(levels_.size()); }
   int num_levels(int v) const { return static_cast<int>(levels_[v].size()); }
@@ -194,8 +197,9 @@ class RenderCache : public ceres::EvaluationCallback {
   DerivativeRequest ActiveRequest() const;
   // Adds view v's adjoint result (of `weights`, ungained) to *gradient: light entries divided by
   // their scales, the exposure gains' part from the result's image. False when not finite.
+  // With `parts`, adds the result's gradient parts there alike (the gains' part to kRest).
   bool AddGradientResult(int v, const Image& weights, const ViewResult& result,
-                         std::vector<double>* gradient) const;
+                         std::vector<double>* gradient, GradientParts* parts = nullptr) const;
 
   const Dataset* dataset_ = nullptr;
   const DatasetViews* views_ = nullptr;
