@@ -1,6 +1,7 @@
 #include "src/optim/effect_planner.h"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -30,6 +31,8 @@ const std::vector<std::string>& StepSwitches() {
 // The values a measurement compares, for two seeds: images (RGB of the measured views' active
 // pixels, scaled by the loss's pixel weights) or vertex gradients.
 using Sample = std::vector<double>;
+// A vertex gradient split by derivative term (GradientParts), indexed by DerivativeTerm.
+using Parts = std::array<Sample, kNumDerivativeTerms>;
 
 // The two-seed estimates of the file comment for a reference A and a variant B.
 struct Comparison {
@@ -105,14 +108,20 @@ class Measurer {
     for (int v : views_) weights_.push_back(cache_->AdjointWeights(v));
   }
 
-  Status Gradients(const EffectPlan& plan, Sample (&out)[2]) {
+  // The vertex gradients under `plan` at both seeds, and from the same passes their parts.
+  Status Gradients(const EffectPlan& plan, Sample (&out)[2], Parts (&parts)[2]) {
     const int n = 3 * cache_->params().layout().num_vertices;
     for (int k = 0; k < 2; ++k) {
       std::vector<double> gradient(cache_->params().size(), 0.0);
-      if (!cache_->AddAdjointGradientsWith(views_, weights_, plan, seeds_[k], &gradient)) {
+      GradientParts split;
+      split.Reset(gradient.size());
+      if (!cache_->AddAdjointGradientsWith(views_, weights_, plan, seeds_[k], &gradient, &split)) {
         return Status::Error("effect planner: a gradient was not finite (" + plan.Summary() + ")");
       }
       out[k].assign(gradient.begin(), gradient.begin() + n);
+      for (int t = 0; t < kNumDerivativeTerms; ++t) {
+        parts[k][t].assign(split.parts[t].begin(), split.parts[t].begin() + n);
+      }
     }
     return Status::Ok();
   }
@@ -148,21 +157,46 @@ std::string Unmeasured(const std::string& name, const EffectPlan& plan,
   return "";
 }
 
-// The current plan's samples (images and gradients at both seeds), computed on demand and
-// carried over when a drop makes a variant the current plan.
+// The current plan's samples (images, and gradients with their parts, at both seeds), computed
+// on demand and carried over when a drop makes a variant the current plan.
 struct References {
   Sample image[2], step[2];
+  Parts step_parts[2];
   bool have_image = false, have_step = false;
   void Invalidate() { have_image = have_step = false; }
+  // Switches derivative term `term` off: at the same seed the gradient without it is the
+  // gradient minus its part (GradientParts: the edge terms draw from streams of their own). The
+  // images do not depend on derivative terms and stay.
+  void DropTerm(DerivativeTerm term) {
+    if (!have_step) return;
+    for (int k = 0; k < 2; ++k) {
+      Sample& part = step_parts[k][static_cast<int>(term)];
+      for (size_t i = 0; i < step[k].size(); ++i) step[k][i] -= part[i];
+      std::fill(part.begin(), part.end(), 0.0);
+    }
+  }
 };
+
+// The derivative term a switch turns off, or null for an image effect.
+const DerivativeTerm* TermOf(const std::string& name) {
+  static const DerivativeTerm kTerms[] = {DerivativeTerm::kPrimaryEdges,
+                                          DerivativeTerm::kShadowEdges, DerivativeTerm::kTexelEdges,
+                                          DerivativeTerm::kSecondaryEdges};
+  for (const DerivativeTerm& term : kTerms) {
+    if (name == DerivativeTermName(term)) return &term;
+  }
+  return nullptr;
+}
 
 // Compares `plan` with `variant` on the images (when `image`), then on the gradients (when
 // `step` and the images did not already show that the switch matters); afterwards
-// `variant_refs` holds the variant's samples. Returns whether the switch matters.
+// `variant_refs` holds the variant's samples. A variant that only switches derivative term
+// `term` off (non-null) needs no passes of its own: its gradients are the plan's minus the
+// term's part (References::DropTerm). Returns whether the switch matters.
 Status Measure(const EffectPlannerOptions& options, const PlannerContext& context,
-               const EffectPlan& plan, const EffectPlan& variant, bool image, bool step,
-               Measurer* measurer, References* refs, References* variant_refs,
-               EffectDecision* decision, bool* matters) {
+               const EffectPlan& plan, const EffectPlan& variant, const DerivativeTerm* term,
+               bool image, bool step, Measurer* measurer, References* refs,
+               References* variant_refs, EffectDecision* decision, bool* matters) {
   auto fill = [&](const Sample(&a)[2], const Sample(&b)[2], double scale, EffectMeasurement* m) {
     const Comparison c = Compare(a, b);
     m->measured = true;
@@ -187,9 +221,17 @@ Status Measure(const EffectPlannerOptions& options, const PlannerContext& contex
   }
   *matters = decision->image.Matters();
   if (step && !*matters) {
-    if (!refs->have_step) SFT_RETURN_IF_ERROR(measurer->Gradients(plan, refs->step));
+    if (!refs->have_step) {
+      SFT_RETURN_IF_ERROR(measurer->Gradients(plan, refs->step, refs->step_parts));
+    }
     refs->have_step = true;
-    SFT_RETURN_IF_ERROR(measurer->Gradients(variant, variant_refs->step));
+    if (term != nullptr) {
+      *variant_refs = *refs;
+      variant_refs->DropTerm(*term);
+    } else {
+      SFT_RETURN_IF_ERROR(
+          measurer->Gradients(variant, variant_refs->step, variant_refs->step_parts));
+    }
     variant_refs->have_step = true;
     fill(refs->step, variant_refs->step, context.step_signal_scale, &decision->step);
     *matters = decision->step.Matters();
@@ -212,7 +254,11 @@ bool DecideWithoutMeasuring(const std::string& name, const EffectPlannerOptions&
   }
   if (!decision->on && plan->IsOn(name)) {
     *plan = plan->Without(name);
-    refs->Invalidate();
+    if (const DerivativeTerm* term = TermOf(name)) {
+      refs->DropTerm(*term);
+    } else {
+      refs->Invalidate();
+    }
   }
   return true;
 }
@@ -235,7 +281,7 @@ Status DecideSwitch(const std::string& name, const std::string& kind,
   const EffectPlan without = plan->Without(name);
   References variant;
   bool matters = false;
-  SFT_RETURN_IF_ERROR(Measure(options, context, *plan, without, kind == "image",
+  SFT_RETURN_IF_ERROR(Measure(options, context, *plan, without, TermOf(name), kind == "image",
                               context.geometry_phase, measurer, refs, &variant, decision,
                               &matters));
   decision->on = matters;
@@ -258,8 +304,9 @@ Status DecideBounces(const EffectPlannerOptions& options, const PlannerContext& 
       --fewer.bounces;
       References variant;
       bool matters = false;
-      SFT_RETURN_IF_ERROR(Measure(options, context, *plan, fewer, true, context.geometry_phase,
-                                  measurer, refs, &variant, decision, &matters));
+      SFT_RETURN_IF_ERROR(Measure(options, context, *plan, fewer, nullptr, true,
+                                  context.geometry_phase, measurer, refs, &variant, decision,
+                                  &matters));
       if (matters) break;
       *plan = fewer;
       *refs = std::move(variant);

@@ -36,6 +36,12 @@
 // dropped. The bounce count goes down from the configured one while the last bounce does not
 // matter.
 //
+// Derivative terms cost no passes of their own: every gradient pass of the planner returns its
+// parts per term (GradientParts), and since each edge term draws its own random numbers, the
+// gradient without term T at a seed is the gradient minus T's part from the same pass. The
+// derivative terms are therefore measured on the current plan's two reference passes, and after
+// a drop the next reference is again that gradient minus the dropped parts.
+//
 // An effect whose parameters the stage fits is kept (specular when fit_specular: without the
 // lobe its weight has no derivative); an effect absent from the scene (no environment light, a
 // specular weight of 0 everywhere) is off without a measurement; pins override everything.

@@ -291,7 +291,7 @@ void RenderCache::RunJobs(const std::vector<ViewJob>& jobs, const RenderOptions&
     consume_seconds += Seconds(start);
   };
   const auto start = std::chrono::steady_clock::now();
-  if (runner_ == nullptr) {
+  if (runner_ == nullptr || request.gradient_parts) {
     for (size_t k = 0; k < jobs.size(); ++k) {
       ViewResult result;
       local(jobs[k], &result);
@@ -540,16 +540,19 @@ bool RenderCache::AddAdjointGradientWith(int v, const Image& weights, const Effe
 
 bool RenderCache::AddAdjointGradientsWith(const std::vector<int>& views,
                                           const std::vector<Image>& weights, const EffectPlan& plan,
-                                          uint64_t seed, std::vector<double>* gradient) {
+                                          uint64_t seed, std::vector<double>* gradient,
+                                          GradientParts* parts) {
   RenderOptions render = options_.render;
   DerivativeRequest request = ActiveRequest();
   plan.ApplyTo(&render, &request);
-  return RunAdjointJobs(views, weights, render, request, seed, gradient);
+  request.gradient_parts = parts != nullptr;
+  return RunAdjointJobs(views, weights, render, request, seed, gradient, parts);
 }
 
 bool RenderCache::RunAdjointJobs(const std::vector<int>& views, const std::vector<Image>& weights,
                                  const RenderOptions& render, const DerivativeRequest& request,
-                                 uint64_t seed, std::vector<double>* gradient) {
+                                 uint64_t seed, std::vector<double>* gradient,
+                                 GradientParts* parts) {
   CHECK_EQ(views.size(), weights.size());
   std::vector<ViewJob> jobs(views.size());
   for (size_t k = 0; k < views.size(); ++k) {
@@ -560,22 +563,28 @@ bool RenderCache::RunAdjointJobs(const std::vector<int>& views, const std::vecto
   }
   bool finite = true;
   RunJobs(jobs, render, request, [&](size_t k, ViewResult* result) {
-    finite = AddGradientResult(views[k], weights[k], *result, gradient) && finite;
+    finite = AddGradientResult(views[k], weights[k], *result, gradient, parts) && finite;
   });
   return finite;
 }
 
 bool RenderCache::AddGradientResult(int v, const Image& weights, const ViewResult& result,
-                                    std::vector<double>* gradient) const {
+                                    std::vector<double>* gradient, GradientParts* parts) const {
   const ParameterLayout& layout = params_->layout();
   bool finite = result.non_finite == 0;
   for (int i = 0; i < layout.size(); ++i) {
-    double g = result.gradient[i];
-    if (layout.KindOf(i) == ParameterKind::kLight) {
-      g /= params_->LightScale(i - layout.LightOffset());
-    }
+    const bool light = layout.KindOf(i) == ParameterKind::kLight;
+    // The renderer's entry at light scale 1·s_l, as the derivative at the fitted scale.
+    const auto unscaled = [&](double g) {
+      return light ? g / params_->LightScale(i - layout.LightOffset()) : g;
+    };
+    const double g = unscaled(result.gradient[i]);
     finite = finite && std::isfinite(g);
     (*gradient)[i] += g;
+    if (parts == nullptr) continue;
+    for (int t = 0; t < kNumDerivativeTerms; ++t) {
+      parts->parts[t][i] += unscaled(result.gradient_parts.parts[t][i]);
+    }
   }
   if (active_.exposure && params_->GainFitted(v)) {
     // ∂/∂g_c Σ_p w_pc g_c I_pc = Σ_p w_pc I_pc, with I this pass's own (ungained) render, so that
@@ -589,6 +598,7 @@ bool RenderCache::AddGradientResult(int v, const Image& weights, const ViewResul
     for (int c = 0; c < 3; ++c) {
       finite = finite && std::isfinite(sum[c]);
       (*gradient)[params_->GainIndex(v, c)] += sum[c];
+      if (parts != nullptr) parts->part(DerivativeTerm::kRest)[params_->GainIndex(v, c)] += sum[c];
     }
   }
   return finite;

@@ -139,9 +139,13 @@ class RenderCache : public ceres::EvaluationCallback {
                               std::vector<double>* gradient);
   // AddAdjointGradientWith of every view in `views` with its `weights`, added to *gradient in the
   // order of `views` (the views' renders may run on other ranks). False when any is not finite.
+  // With `parts` (each part the size of *gradient), the same passes also add their gradient split
+  // by derivative term (GradientParts; the exposure gains' entries go to DerivativeTerm::kRest),
+  // so that Σ parts grows by what *gradient grows by; such passes run in this process, because
+  // the parts do not travel between ranks.
   bool AddAdjointGradientsWith(const std::vector<int>& views, const std::vector<Image>& weights,
                                const EffectPlan& plan, uint64_t seed,
-                               std::vector<double>* gradient);
+                               std::vector<double>* gradient, GradientParts* parts = nullptr);
 
   int num_views() const { return static_cast<int>(levels_.size()); }
   int num_levels(int v) const { return static_cast<int>(levels_[v].size()); }
@@ -198,7 +202,8 @@ class RenderCache : public ceres::EvaluationCallback {
   void StoreRender(int v, const Image& image, const JacobianRows* rows);
   // Runs `jobs` at the current parameters through the runner (or here) and hands each result to
   // `consume` in job order; render_seconds_ gets the wall time outside `consume`. The renders use
-  // the cache's options and ActiveRequest, or `render` and `request` (a plan's).
+  // the cache's options and ActiveRequest, or `render` and `request` (a plan's). A request for
+  // gradient parts runs here: the parts do not travel between ranks.
   void RunJobs(const std::vector<ViewJob>& jobs, const ViewRunner::Consume& consume);
   void RunJobs(const std::vector<ViewJob>& jobs, const RenderOptions& render,
                const DerivativeRequest& request, const ViewRunner::Consume& consume);
@@ -207,12 +212,13 @@ class RenderCache : public ceres::EvaluationCallback {
   // gradients added to *gradient in the order of `views`. False when any is not finite.
   bool RunAdjointJobs(const std::vector<int>& views, const std::vector<Image>& weights,
                       const RenderOptions& render, const DerivativeRequest& request, uint64_t seed,
-                      std::vector<double>* gradient);
+                      std::vector<double>* gradient, GradientParts* parts = nullptr);
   DerivativeRequest ActiveRequest() const;
   // Adds view v's adjoint result (of `weights`, ungained) to *gradient: light entries divided by
   // their scales, the exposure gains' part from the result's image. False when not finite.
+  // With `parts`, adds the result's gradient parts there alike (the gains' part to kRest).
   bool AddGradientResult(int v, const Image& weights, const ViewResult& result,
-                         std::vector<double>* gradient) const;
+                         std::vector<double>* gradient, GradientParts* parts = nullptr) const;
 
   const Dataset* dataset_ = nullptr;
   const DatasetViews* views_ = nullptr;

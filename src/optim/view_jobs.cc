@@ -44,6 +44,7 @@ void RenderViewJob(const RenderScene& scene, const Material& material, const Vie
                               &output, &stats);
     result->rows = std::move(output.rows);
     result->gradient = std::move(output.gradient);
+    result->gradient_parts = std::move(output.gradient_parts);
   }
   result->non_finite = stats.NonFinite();
   result->seconds = stats.seconds;

@@ -41,8 +41,12 @@ struct ViewResult {
   Image image;                   // the render as RenderView returns it (RGBA, ungained).
   JacobianRows rows;             // kRows: the renderer's rows (light entries at scale 1·s_l).
   std::vector<double> gradient;  // kAdjoint: layout-size Jᵀw (light entries at scale 1·s_l).
-  int64_t non_finite = 0;        // RenderStats::NonFinite() of the render.
-  double seconds = 0.0;          // the render's wall time on the rank that ran it.
+  // kAdjoint with the request's gradient_parts: the gradient split by derivative term. Filled in
+  // the process that renders the job only (the effect planner's own renders); not sent between
+  // ranks.
+  GradientParts gradient_parts;
+  int64_t non_finite = 0;  // RenderStats::NonFinite() of the render.
+  double seconds = 0.0;    // the render's wall time on the rank that ran it.
 };
 
 // The point every job of one evaluation is rendered at.

@@ -103,6 +103,36 @@ bool ParameterSelection::Selected(ParameterKind kind) const {
   return false;
 }
 
+const char* DerivativeTermName(DerivativeTerm term) {
+  switch (term) {
+    case DerivativeTerm::kRest:
+      return "rest";
+    case DerivativeTerm::kPrimaryEdges:
+      return "primary_edges";
+    case DerivativeTerm::kShadowEdges:
+      return "shadow_edges";
+    case DerivativeTerm::kTexelEdges:
+      return "texel_edges";
+    case DerivativeTerm::kSecondaryEdges:
+      return "secondary_edges";
+  }
+  return "?";
+}
+
+bool DerivativeTermFromName(const std::string& name, DerivativeTerm* term) {
+  for (int t = 0; t < kNumDerivativeTerms; ++t) {
+    if (name == DerivativeTermName(static_cast<DerivativeTerm>(t))) {
+      *term = static_cast<DerivativeTerm>(t);
+      return true;
+    }
+  }
+  return false;
+}
+
+void GradientParts::Reset(size_t size) {
+  for (std::vector<double>& part : parts) part.assign(size, 0.0);
+}
+
 // Messages name the fields as the CLI flags do (primary-edge-ratio, ...).
 bool DerivativeRequest::Check(std::string* why) const {
   for (const auto& [name, ratio] :

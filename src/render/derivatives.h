@@ -61,6 +61,7 @@
 #ifndef SFT_RENDER_DERIVATIVES_H_
 #define SFT_RENDER_DERIVATIVES_H_
 
+#include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -175,15 +176,50 @@ struct DerivativeRequest {
   // most of the variance (docs/design-notes.md, "Smooth shading"). false: left out (biased,
   // quieter).
   bool normal_sliding = true;
+  // With adjoint_weights: also fill DerivativeOutput::gradient_parts, the gradient split by
+  // derivative term (GradientParts). Off, the pass does no per-term work.
+  bool gradient_parts = false;
 
   // True when valid; else *why names the field.
   bool Check(std::string* why) const;
+};
+
+// The terms of the vertex derivatives that DerivativeRequest switches separately: the interior
+// terms together with everything that is not a vertex derivative (kRest), and each edge term.
+enum class DerivativeTerm { kRest, kPrimaryEdges, kShadowEdges, kTexelEdges, kSecondaryEdges };
+constexpr int kNumDerivativeTerms = 5;
+// "rest", "primary_edges", "shadow_edges", "texel_edges", "secondary_edges" (the edge terms'
+// names are the effect planner's switches).
+const char* DerivativeTermName(DerivativeTerm term);
+// The term of a name of DerivativeTermName; false for any other name.
+bool DerivativeTermFromName(const std::string& name, DerivativeTerm* term);
+
+// One adjoint gradient split by term: part(t)[i] is term t's share of gradient entry i, so the
+// parts sum to the gradient (up to rounding: the gradient sums each pixel's derivatives as floats,
+// the edge parts in double; kRest is the gradient minus the edge parts, so it takes that
+// rounding). An edge term's part is the change of the gradient when that term's budget is 0 at
+// the same seed: every edge term draws its random numbers from streams of its own (primary,
+// shadow and texel edges from per-sample keys, secondary edges from forks of the path's sampler
+// that do not advance it), so switching one off changes no other term's samples. The exception
+// is a camera sample dropped as not finite (RenderStats::nonfinite_samples), which takes its
+// secondary edge terms with it.
+struct GradientParts {
+  std::array<std::vector<double>, kNumDerivativeTerms> parts;  // layout.size() entries each.
+
+  std::vector<double>& part(DerivativeTerm term) { return parts[static_cast<int>(term)]; }
+  const std::vector<double>& part(DerivativeTerm term) const {
+    return parts[static_cast<int>(term)];
+  }
+  bool empty() const { return parts[0].empty(); }
+  // Every part with `size` zero entries.
+  void Reset(size_t size);
 };
 
 struct DerivativeOutput {
   ParameterLayout layout;
   JacobianRows rows;
   std::vector<double> gradient;  // layout.size() entries when requested.
+  GradientParts gradient_parts;  // DerivativeRequest::gradient_parts (with the gradient).
 };
 
 }  // namespace sft

@@ -19,6 +19,7 @@
 #include <cmath>
 #include <memory>
 #include <optional>
+#include <utility>
 
 #include "src/core/rng.h"
 #include "src/render/internal/context.h"
@@ -62,6 +63,13 @@ struct TileJob {
   tbb::enumerable_thread_specific<RenderStats> thread_stats;
   tbb::enumerable_thread_specific<std::array<RowAccumulator, kTile>> thread_rows;
   tbb::enumerable_thread_specific<ParamSums<double>> thread_tile_sums;  // the running tile's.
+  // DerivativeRequest::gradient_parts: the edge terms' parts (the image curves' filled before the
+  // tiles run), and per tile its secondary edge terms w·∂RGB/spp summed per parameter, reduced in
+  // tile order like tile_gradients.
+  bool want_parts = false;
+  GradientParts parts;
+  std::vector<std::vector<std::pair<int, double>>> tile_secondary;
+  tbb::enumerable_thread_specific<ParamSums<double>> thread_secondary_sums;
 };
 
 // Writes pixel (x, y)'s value and coverage, and merges its derivatives (path terms in `rows`,
@@ -95,6 +103,13 @@ void FinishPixel(TileJob* job, int x, int y, const Eigen::Vector3d& sum, int hit
   if (job->want_rows) job->pixel_rows[static_cast<size_t>(y) * width + x] = *merged;
 }
 
+// The weight of pixel (x, y)'s secondary edge terms in their part of the gradient: the adjoint
+// weight over spp (FinishPixel weighs the pixel's sums, which it divides by spp).
+Eigen::Vector3d SecondaryPartWeight(const TileJob& job, int x, int y) {
+  const Image& w = *job.weights;
+  return Eigen::Vector3d(w.at(x, y, 0), w.at(x, y, 1), w.at(x, y, 2)) / job.ctx.options.spp;
+}
+
 // One 8×8 tile; each tile row is one packet of camera rays per sample.
 void RenderTile(TileJob* job, int tile) {
   const render_internal::ScopedTracingFpMode fp_mode;
@@ -110,6 +125,8 @@ void RenderTile(TileJob* job, int tile) {
   if (job->want_derivatives) path.emplace(ctx);
   std::vector<JacobianEntry> merged;
   ParamSums<double>& tile_sums = job->thread_tile_sums.local();
+  ParamSums<double>* secondary_sums =
+      job->want_parts ? &job->thread_secondary_sums.local() : nullptr;
   for (int y = y0; y < std::min(y0 + kTile, height); ++y) {
     Eigen::Vector3d sums[kTile];
     int hits[kTile] = {0};
@@ -125,7 +142,11 @@ void RenderTile(TileJob* job, int tile) {
       ctx.scene.Intersect8(job->center, dirs, count, first_hits);
       local.camera_rays += count;
       for (int i = 0; i < count; ++i) {
-        if (path) path->Reset(&rows[i]);
+        if (secondary_sums != nullptr) {
+          path->Reset(&rows[i], secondary_sums, SecondaryPartWeight(*job, x0 + i, y));
+        } else if (path) {
+          path->Reset(&rows[i]);
+        }
         const Eigen::Vector3d value =
             options.pass == RenderPass::kColor
                 ? render_internal::TraceRadiance(ctx, &samplers[i], dirs[i], first_hits[i], &local,
@@ -146,7 +167,26 @@ void RenderTile(TileJob* job, int tile) {
     }
   }
   if (job->weights != nullptr) tile_sums.MoveTo(&job->tile_gradients[tile]);
+  if (secondary_sums != nullptr) secondary_sums->MoveTo(&job->tile_secondary[tile]);
   if (options.on_tile_done) options.on_tile_done();
+}
+
+// Moves the job's gradient parts into *output (after its gradient): the secondary edges' tile
+// sums in tile order, and the rest as the gradient minus the edge parts.
+void CollectGradientParts(TileJob* job, DerivativeOutput* output) {
+  GradientParts& parts = job->parts;
+  std::vector<double>& secondary = parts.part(DerivativeTerm::kSecondaryEdges);
+  for (const auto& list : job->tile_secondary) {
+    for (const auto& [param, g] : list) secondary[param] += g;
+  }
+  std::vector<double>& rest = parts.part(DerivativeTerm::kRest);
+  rest = output->gradient;
+  for (int t = 0; t < kNumDerivativeTerms; ++t) {
+    if (t == static_cast<int>(DerivativeTerm::kRest)) continue;
+    const std::vector<double>& part = parts.parts[t];
+    for (size_t i = 0; i < rest.size(); ++i) rest[i] -= part[i];
+  }
+  output->gradient_parts = std::move(parts);
 }
 
 // Moves the job's per-pixel rows and per-tile gradient terms into *output; counts the gradient
@@ -176,6 +216,7 @@ void CollectDerivatives(TileJob* job, const ParameterLayout& layout, DerivativeO
       for (const auto& [param, g] : list) output->gradient[param] += g;
     }
   }
+  if (job->want_parts) CollectGradientParts(job, output);
 }
 
 // The candidates of secondary edge samples, when the request needs them.
@@ -241,9 +282,15 @@ void RenderImpl(const RenderScene& scene, const Material& material, const ViewSe
   const int num_tiles = job.tiles_x * ((height + kTile - 1) / kTile);
   if (job.want_rows) job.pixel_rows.resize(static_cast<size_t>(width) * height);
   if (job.weights != nullptr) job.tile_gradients.resize(num_tiles);
+  job.want_parts = job.weights != nullptr && request->gradient_parts;
+  if (job.want_parts) {
+    job.parts.Reset(layout->size());
+    job.tile_secondary.resize(num_tiles);
+  }
   if (job.want_derivatives && request->params.vertices && options.pass == RenderPass::kColor) {
     job.edge_lists.resize(static_cast<size_t>(width) * height);
-    render_internal::AddEdgeTerms(ctx, &job.edge_lists, &edge_stats);
+    render_internal::AddEdgeTerms(ctx, &job.edge_lists, &edge_stats,
+                                  job.want_parts ? &job.parts : nullptr);
   }
   tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
   arena.execute(

@@ -121,14 +121,17 @@ class EffectPlannerTest : public ::testing::Test {
     dir_ = nullptr;
   }
 
-  // Plans at the true mesh and material of dataset `name` with `config` keys.
+  // Plans at the true mesh and material of dataset `name` with `config` keys; *renders gets the
+  // number of renders the planner made.
   EffectPlanReport Plan(const std::string& name, const std::string& config,
-                        EffectPlan* cache_plan = nullptr) {
-    return PlanAt(dir_->Join(name), dir_->Join(name + "/gt/material.json"), config, cache_plan);
+                        EffectPlan* cache_plan = nullptr, int64_t* renders = nullptr) {
+    return PlanAt(dir_->Join(name), dir_->Join(name + "/gt/material.json"), config, cache_plan,
+                  renders);
   }
   // Plans at the true mesh of the dataset in `dir` with material `material` (file or JSON).
   EffectPlanReport PlanAt(const std::string& dir, const std::string& material_spec,
-                          const std::string& config, EffectPlan* cache_plan = nullptr) {
+                          const std::string& config, EffectPlan* cache_plan = nullptr,
+                          int64_t* renders = nullptr) {
     Dataset dataset;
     EXPECT_TRUE(ReadDataset(dir, &dataset).ok());
     TriMesh mesh;
@@ -141,9 +144,11 @@ class EffectPlannerTest : public ::testing::Test {
     std::unique_ptr<Reconstruction> reconstruction;
     EXPECT_TRUE(Reconstruction::Create(dataset, mesh, material, {}, options, &reconstruction).ok());
     EffectPlanReport report;
+    const int64_t renders_before = reconstruction->cache().renders();
     const Status status = reconstruction->PlanEffects(0, &report);
     EXPECT_TRUE(status.ok()) << status.message();
     if (cache_plan != nullptr) *cache_plan = reconstruction->cache().plan();
+    if (renders != nullptr) *renders = reconstruction->cache().renders() - renders_before;
     return report;
   }
 
@@ -182,6 +187,24 @@ TEST_F(EffectPlannerTest, ConvexDiffuseFlashLitObjectNeedsNeitherBouncesNorShado
   EXPECT_EQ(report.plan.Summary(), "direct 1seg | edges: primary");
   EXPECT_GT(report.seconds, 0.0);
   EXPECT_EQ(report.views, 2);
+}
+
+// The derivative terms are measured on the reference passes' own parts (GradientParts): the
+// planner renders as much when it measures them as when they are pinned on. The decisions are
+// those of the test above.
+TEST_F(EffectPlannerTest, MeasuringDerivativeTermsCostsNoRenders) {
+  int64_t measured_renders = 0, pinned_renders = 0;
+  const EffectPlanReport measured = Plan("sphere", R"({"spp": 16})", nullptr, &measured_renders);
+  EXPECT_EQ(Find(measured, "primary_edges").reason, "measured");
+  EXPECT_EQ(Find(measured, "texel_edges").reason, "measured");
+  const EffectPlanReport pinned =
+      Plan("sphere", R"({"spp": 16, "pin": {"primary_edges": true, "texel_edges": true}})", nullptr,
+           &pinned_renders);
+  EXPECT_EQ(Find(pinned, "primary_edges").reason, "pinned");
+  EXPECT_GT(measured_renders, 0);
+  EXPECT_EQ(measured_renders, pinned_renders);
+  // Texel edges of a constant albedo change the gradient by exactly nothing.
+  EXPECT_EQ(Find(measured, "texel_edges").step.change, 0.0);
 }
 
 // Lit by a studio probe (Cycles dataset), a convex sphere: the environment is all of the image;

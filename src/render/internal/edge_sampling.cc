@@ -1,5 +1,7 @@
 #include "src/render/internal/edge_sampling.h"
 
+#include <utility>
+
 #include "src/render/internal/integrator.h"
 
 namespace sft {
@@ -115,13 +117,39 @@ bool EmitBoundary(int pixel, const Eigen::Vector3d& jump, double scale, const Bo
   return true;
 }
 
-void AddEdgeTerms(const Context& ctx, std::vector<DerivativeList>* pixel_lists,
-                  RenderStats* stats) {
+namespace {
+
+// Adds Σ w_pixel·d/spp of entries [first, end) to *part (the adjoint gradient of those entries,
+// as the tiles weigh the pixels' sums).
+void AddWeightedEntries(const Context& ctx, const std::vector<EdgeEntry>& entries, size_t first,
+                        std::vector<double>* part) {
+  const Image& weights = *ctx.request->adjoint_weights;
+  const int width = ctx.view.camera.width;
+  const double inv_spp = 1.0 / ctx.options.spp;
+  for (size_t i = first; i < entries.size(); ++i) {
+    const EdgeEntry& e = entries[i];
+    const int x = e.pixel % width, y = e.pixel / width;
+    const Eigen::Vector3d w(weights.at(x, y, 0), weights.at(x, y, 1), weights.at(x, y, 2));
+    (*part)[e.param] += w.dot(e.d) * inv_spp;
+  }
+}
+
+}  // namespace
+
+void AddEdgeTerms(const Context& ctx, std::vector<DerivativeList>* pixel_lists, RenderStats* stats,
+                  GradientParts* parts) {
   const EdgeView view(ctx);
   std::vector<EdgeEntry> entries;
-  AddPrimaryEdgeTerms(view, &entries);
-  AddShadowEdgeTerms(view, &entries);
-  AddTexelEdgeTerms(view, &entries);
+  using AddTerms = void (*)(const EdgeView&, std::vector<EdgeEntry>*);
+  const std::pair<DerivativeTerm, AddTerms> terms[] = {
+      {DerivativeTerm::kPrimaryEdges, AddPrimaryEdgeTerms},
+      {DerivativeTerm::kShadowEdges, AddShadowEdgeTerms},
+      {DerivativeTerm::kTexelEdges, AddTexelEdgeTerms}};
+  for (const auto& [term, add_terms] : terms) {
+    const size_t first = entries.size();
+    add_terms(view, &entries);
+    if (parts != nullptr) AddWeightedEntries(ctx, entries, first, &parts->part(term));
+  }
   for (const EdgeEntry& entry : entries) {
     (*pixel_lists)[entry.pixel].emplace_back(entry.param, entry.d);
   }

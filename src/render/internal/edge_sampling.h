@@ -201,8 +201,11 @@ void SampleCandidates(const RenderOptions& options, const std::vector<Candidate>
 }
 
 // Boundary terms of one view seen directly by the camera (primary edges, point-light shadow
-// edges, texel boundaries), added to per-pixel lists scaled for the caller's 1/spp.
-void AddEdgeTerms(const Context& ctx, std::vector<DerivativeList>* pixel_lists, RenderStats* stats);
+// edges, texel boundaries), added to per-pixel lists scaled for the caller's 1/spp. With `parts`
+// (each part layout-sized; the request has adjoint weights), each term's entries weighted by the
+// adjoint weights of their pixel and 1/spp are also added to the term's part.
+void AddEdgeTerms(const Context& ctx, std::vector<DerivativeList>* pixel_lists, RenderStats* stats,
+                  GradientParts* parts = nullptr);
 
 // The parts of AddEdgeTerms (primary_edges.cc, shadow_edges.cc, texel_edges.cc).
 void AddPrimaryEdgeTerms(const EdgeView& view, std::vector<EdgeEntry>* entries);

@@ -108,14 +108,17 @@ void PathDerivatives::AddBoundary(const Eigen::Vector3d& weight, const int* vert
     Add(count > 0 ? 3 * vertices[0] : 0, weight);  // marks the path not finite.
     return;
   }
+  const size_t first = pending_.size();
   for (int j = 0; j < count; ++j) {
     for (int k = 0; k < 3; ++k) Emit(3 * vertices[j] + k, weight * rows[j][k]);
   }
-  if (!point_.valid) return;
-  for (int e = 0; e < point_.count; ++e) {
-    const Eigen::RowVector3d g = x_row.transpose() * point_.m[e];
-    for (int k = 0; k < 3; ++k) Emit(3 * point_.vertex[e] + k, weight * g[k]);
+  if (point_.valid) {
+    for (int e = 0; e < point_.count; ++e) {
+      const Eigen::RowVector3d g = x_row.transpose() * point_.m[e];
+      for (int k = 0; k < 3; ++k) Emit(3 * point_.vertex[e] + k, weight * g[k]);
+    }
   }
+  if (boundary_out_ != nullptr) boundary_ranges_.emplace_back(first, pending_.size());
 }
 
 void PathDerivatives::AddScatter(const Eigen::Vector3d& prefix, const SurfaceMaterial& surface,

@@ -150,10 +150,16 @@ class PathDerivatives {
       : ctx_(ctx), vertices_(ctx.request->params.vertices) {}
 
   // Starts a new path (camera sample) whose derivatives go to `out` once committed. (One object
-  // serves many paths: its per-scatter storage is large and needs no initialization.)
-  void Reset(RowAccumulator* out) {
+  // serves many paths: its per-scatter storage is large and needs no initialization.) With
+  // `boundary_out` (the adjoint pass's secondary-edge part, DerivativeRequest::gradient_parts),
+  // the boundary terms (AddBoundary) also go there as boundary_weight·∂RGB.
+  void Reset(RowAccumulator* out, ParamSums<double>* boundary_out = nullptr,
+             const Eigen::Vector3d& boundary_weight = Eigen::Vector3d::Zero()) {
     out_ = out;
+    boundary_out_ = boundary_out;
+    boundary_weight_ = boundary_weight;
     pending_.clear();
+    boundary_ranges_.clear();
     count_ = 0;
     point_.count = 0;
     point_.valid = true;
@@ -178,7 +184,16 @@ class PathDerivatives {
   // the same as if they had been added directly).
   void Commit() {
     for (const auto& [param, d] : pending_) out_->Add(param, d);
+    if (boundary_out_ != nullptr) {
+      for (const auto& [first, last] : boundary_ranges_) {
+        for (size_t i = first; i < last; ++i) {
+          const double g = boundary_weight_.dot(pending_[i].second);
+          if (g != 0.0) boundary_out_->Add(pending_[i].first, g);
+        }
+      }
+    }
     pending_.clear();
+    boundary_ranges_.clear();
   }
 
   // The path reached a new vertex on face `face` (hit barycentrics `barycentrics`, ray direction
@@ -248,6 +263,11 @@ class PathDerivatives {
   const Context& ctx_;
   RowAccumulator* out_ = nullptr;
   DerivativeList pending_;  // the current path's terms, until Commit.
+  // Reset's boundary_out and its weight; the ranges of pending_ that AddBoundary added (only
+  // recorded when boundary_out_ is set).
+  ParamSums<double>* boundary_out_ = nullptr;
+  Eigen::Vector3d boundary_weight_ = Eigen::Vector3d::Zero();
+  std::vector<std::pair<size_t, size_t>> boundary_ranges_;
   const bool vertices_;
   int count_ = 0;
   Scatter scatters_[kMaxScatters];
