@@ -150,6 +150,27 @@ TEST(EdgeTreeTest, FiniteAtTinyAndHugeScales) {
   }
 }
 
+// A cut prepared once serves every draw at its point: the draws and probabilities equal those of
+// single draws at (x, n), on a tree deep enough to descend below the cut.
+TEST(EdgeTreeTest, OneCutServesEveryDrawAtItsPoint) {
+  const Segments s = RandomSegments(5000, 1.0f, 6);
+  const EdgeTree tree(s.a, s.b, s.lengths);
+  const Eigen::Vector3d x(0.3, 0.6, 0.4), n = Eigen::Vector3d(0.2, -1, 0.4).normalized();
+  EdgeTree::Cut cut;
+  tree.PrepareCut(x, n, &cut);
+  ASSERT_GT(cut.count, 4);
+  ASSERT_LE(cut.count, EdgeTree::Cut::kMaxEntries);
+  for (int i = 0; i < 1000; ++i) {
+    const double u = (i + 0.25) / 1000.0;
+    double p_cut = -1.0, p_single = -1.0;
+    const int j = tree.Sample(cut, u, &p_cut);
+    EXPECT_EQ(j, tree.Sample(x, n, u, &p_single));
+    EXPECT_EQ(p_cut, p_single);
+    if (j >= 0) EXPECT_EQ(tree.Probability(cut, j), p_cut);
+  }
+  ExpectConsistent(tree, x, n);
+}
+
 }  // namespace
 }  // namespace render_internal
 }  // namespace sft

@@ -86,13 +86,12 @@ class NearEdgeMixture {
   NearEdgeMixture(const MeshEdgeTable& table, int face, const Eigen::Vector3d& x,
                   const Eigen::Vector3d& n)
       : table_(table),
-        x_(x),
-        n_(n),
         near_begin_(table.near_begin(face)),
         near_end_(table.near_end(face)) {
     const int count = static_cast<int>(near_end_ - near_begin_);
     near_fraction_ = count > 0 ? kNearFraction : 0.0;
     near_probability_ = near_fraction_ > 0 ? kNearFraction / count : 0.0;
+    table.tree().PrepareCut(x, n, &cut_);  // shared by every candidate drawn at x.
   }
 
   void SampleBatch(const double* u, int n, int* out, double* inverse_probability) const {
@@ -101,11 +100,11 @@ class NearEdgeMixture {
       double p = 0.0;
       if (u[k] < near_fraction_) {
         out[k] = near_begin_[std::min(static_cast<int>(u[k] / near_fraction_ * count), count - 1)];
-        p = near_probability_ + (1.0 - near_fraction_) * table_.tree().Probability(x_, n_, out[k]);
+        p = near_probability_ + (1.0 - near_fraction_) * table_.tree().Probability(cut_, out[k]);
       } else {
         double p_tree = 0.0;
         out[k] =
-            table_.tree().Sample(x_, n_, (u[k] - near_fraction_) / (1.0 - near_fraction_), &p_tree);
+            table_.tree().Sample(cut_, (u[k] - near_fraction_) / (1.0 - near_fraction_), &p_tree);
         if (out[k] < 0) {
           inverse_probability[k] = 0.0;
           continue;
@@ -120,7 +119,7 @@ class NearEdgeMixture {
   // 1 / the probability of record c (tests; the sampler's own draws carry theirs).
   double InverseProbability(int c) const {
     return 1.0 /
-           ((1.0 - near_fraction_) * table_.tree().Probability(x_, n_, c) + NearProbability(c));
+           ((1.0 - near_fraction_) * table_.tree().Probability(cut_, c) + NearProbability(c));
   }
 
  private:
@@ -131,11 +130,11 @@ class NearEdgeMixture {
   }
 
   const MeshEdgeTable& table_;
-  const Eigen::Vector3d x_, n_;
   const int* near_begin_;
   const int* near_end_;
   double near_fraction_ = 0.0;
   double near_probability_ = 0.0;
+  EdgeTree::Cut cut_;
 };
 
 }  // namespace render_internal

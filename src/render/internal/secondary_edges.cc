@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <mutex>
 
 #include "src/render/bsdf.h"
 #include "src/render/internal/integrator.h"
@@ -40,10 +41,11 @@ constexpr int kShadowPoolCandidates = 8;
 constexpr uint64_t kShadowPoolKey = 0x5AD0B001ull << 20;
 
 // Texel boundaries with a positive weight (3D length × material jump), and the weights.
-void AddSecondaryTexels(const RenderScene& scene, const Material& material, bool glossy,
-                        SecondaryEdges* out) {
+SecondaryTexels BuildSecondaryTexels(const RenderScene& scene,
+                                     const std::vector<TexelSegment>& all) {
+  SecondaryTexels out;
   std::vector<double> weights;
-  for (const TexelSegment& segment : *TexelSegments(scene, material, glossy)) {
+  for (const TexelSegment& segment : all) {
     const Eigen::Vector3i& corners = scene.faces()[segment.face];
     Eigen::Vector3d along = Eigen::Vector3d::Zero();
     for (int k = 0; k < 3; ++k) {
@@ -51,10 +53,32 @@ void AddSecondaryTexels(const RenderScene& scene, const Material& material, bool
     }
     const double weight = along.norm() * segment.size;
     if (!(weight > 0.0) || !std::isfinite(weight)) continue;
-    out->texels.push_back(segment);
+    out.segments.push_back(segment);
     weights.push_back(weight);
   }
-  if (!out->texels.empty()) out->texels_by_weight = DiscreteDistribution(weights);
+  if (!out.segments.empty()) out.by_weight = DiscreteDistribution(weights);
+  return out;
+}
+
+// The secondary texel boundaries of the mesh state and material: the last set is kept while
+// TexelSegments returns the same set (its key covers the faces, positions and material), so the
+// views of a pass share one build instead of copying every segment per view.
+std::shared_ptr<const SecondaryTexels> SecondaryTexelsOf(const RenderScene& scene,
+                                                         const Material& material, bool glossy) {
+  static std::mutex mutex;
+  static std::shared_ptr<const std::vector<TexelSegment>> cached_key;
+  static std::shared_ptr<const SecondaryTexels> cached;
+  const std::shared_ptr<const std::vector<TexelSegment>> all =
+      TexelSegments(scene, material, glossy);
+  {
+    std::lock_guard<std::mutex> lock(mutex);
+    if (cached != nullptr && cached_key == all) return cached;
+  }
+  auto built = std::make_shared<const SecondaryTexels>(BuildSecondaryTexels(scene, *all));
+  std::lock_guard<std::mutex> lock(mutex);
+  cached_key = all;
+  cached = built;
+  return built;
 }
 
 // A path vertex x where secondary edges are sampled, and what its samples share.
@@ -247,17 +271,17 @@ void SampleTexelBoundary(const SecondaryVertex& v, Sampler* texel_sampler, PathD
   const SecondaryEdges& secondary = *v.ctx.secondary;
   const RenderScene& scene = v.ctx.scene;
   auto texel_ends = [&](int c, Eigen::Vector3d* y0, Eigen::Vector3d* y1) {
-    const TexelSegment& segment = secondary.texels[c];
+    const TexelSegment& segment = secondary.texels->segments[c];
     if (segment.face == v.face || segment.other == v.face) return false;  // x's plane: cos = 0.
     TexelSegmentEnds(scene, segment, y0, y1);
     return std::max(v.n.dot(*y0 - v.x), v.n.dot(*y1 - v.x)) > 0.0;
   };
   const double u_index = texel_sampler->Next1D(), u_point = texel_sampler->Next1D();
   const ResampledPoint kept = ResampleSegmentPoint(
-      secondary.texels_by_weight, kTexelCandidates, v.x, u_index, u_point, texel_sampler,
+      secondary.texels->by_weight, kTexelCandidates, v.x, u_index, u_point, texel_sampler,
       texel_ends, [&](const Eigen::Vector3d& omega) { return v.BsdfCosine(omega); });
   if (kept.index < 0) return;
-  const TexelSegment& segment = secondary.texels[kept.index];
+  const TexelSegment& segment = secondary.texels->segments[kept.index];
   Eigen::Vector3d y0, y1;
   TexelSegmentEnds(scene, segment, &y0, &y1);
   SphereCurvePoint point;
@@ -399,7 +423,8 @@ SecondaryEdges BuildSecondaryEdges(const RenderScene& scene, const Material& mat
                                    int max_segments, RenderStats* stats) {
   SecondaryEdges out;
   if (max_segments > 1) {
-    AddSecondaryTexels(scene, material, options.effects.specular && material.specular > 0.0, &out);
+    out.texels =
+        SecondaryTexelsOf(scene, material, options.effects.specular && material.specular > 0.0);
   }
   out.environment = environment && options.effects.shadows;
   out.mesh_edges = MeshEdgeTable::Of(scene);
@@ -451,7 +476,7 @@ void AddSecondaryEdgeSamples(const Context& ctx, const Sampler& path_sampler, in
     sampler.Next2D(&u3, &u4);
     SampleMeshEdge(v, u1, u2, &sampler, path, stats);  // (A)
     Sampler texel_sampler = sampler.Fork(1);
-    if (v.indirect && !secondary.texels.empty() &&
+    if (v.indirect && secondary.texels != nullptr && !secondary.texels->segments.empty() &&
         texel_sampler.Next1D() < kSecondaryTexelProbability) {
       SampleTexelBoundary(v, &texel_sampler, path, stats);  // (C)
     }

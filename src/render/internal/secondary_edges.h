@@ -69,15 +69,21 @@ struct ShadowPool {
   std::vector<ShadowPoolEntry> entries;  // parallel to points.
 };
 
+// The texel boundaries a further bounce can see, with a distribution over them ∝ 3D length ×
+// material jump. They depend on the mesh state and the material, not on the view.
+struct SecondaryTexels {
+  std::vector<TexelSegment> segments;
+  DiscreteDistribution by_weight;
+};
+
 // The candidates of one view's secondary edge samples.
 struct SecondaryEdges {
   // Mesh edges where radiance can jump for some viewpoint (per mesh state).
   std::shared_ptr<const MeshEdgeTable> mesh_edges;
   bool environment = false;  // the environment is lit with visibility (shadows on).
-  // Texel boundaries (when a further bounce is traced and the material has any), and a
-  // distribution over them ∝ 3D length × material jump.
-  std::vector<TexelSegment> texels;
-  DiscreteDistribution texels_by_weight;
+  // Texel boundaries (when a further bounce is traced and the material has any), per mesh
+  // state and material (shared by every view).
+  std::shared_ptr<const SecondaryTexels> texels;
   // Per point light of the view (when shadows and a further bounce exist): shadow points its
   // silhouette edges cast, drawn once per view (ShadowPool) and shared by the view's (B) samples.
   std::vector<ShadowPool> shadow_pools;

@@ -19,9 +19,7 @@ constexpr double kTexelSideOffset = 1e-6;
 // b(s) = b0 + s·(b1 − b0), over s ∈ [s0, s1] (the part in view); `other` is the face across it
 // (`face` itself for a grid line inside the face, the neighbour for a coplanar mesh edge).
 struct TexelCandidate {
-  int face, other;
-  Eigen::Vector3d b0, b1;
-  Eigen::Vector3d c0, c1;  // the same points as barycentrics of `other`.
+  const TexelSegment* segment;  // in the TexelSegments set, which outlives the candidates.
   double s0, s1;
   double weight;
 };
@@ -287,12 +285,12 @@ namespace {
 
 // Texel boundaries in view (those not on primary edges), clipped to the frustum, weighted by
 // projected length × material jump.
-std::vector<TexelCandidate> TexelCandidates(const EdgeView& view) {
+std::vector<TexelCandidate> TexelCandidates(const EdgeView& view,
+                                            const std::vector<TexelSegment>& segments) {
   const RenderScene& scene = view.ctx.scene;
-  const Material& material = view.ctx.material;
-  const bool glossy = material.specular * view.ctx.specular_scale > 0.0;
   std::vector<TexelCandidate> candidates;
-  for (const TexelSegment& segment : *TexelSegments(scene, material, glossy)) {
+  candidates.reserve(segments.size());
+  for (const TexelSegment& segment : segments) {
     // A coplanar edge seen edge-on from the camera is a primary edge there.
     if (segment.edge >= 0 &&
         IsDiscontinuityEdge(scene, scene.edges()[segment.edge], view.center,
@@ -305,8 +303,7 @@ std::vector<TexelCandidate> TexelCandidates(const EdgeView& view) {
     if (!view.ClippedImageLength(y0, y1, &s0, &s1, &length)) continue;
     const double weight = length * segment.size;
     if (!(weight > 0.0) || !std::isfinite(weight)) continue;
-    candidates.push_back({segment.face, segment.other, segment.b0, segment.b1, segment.c0,
-                          segment.c1, s0, s1, weight});
+    candidates.push_back({&segment, s0, s1, weight});
   }
   return candidates;
 }
@@ -320,8 +317,9 @@ void AddTexelEdgeTerms(const EdgeView& view, std::vector<EdgeEntry>* entries) {
   const RenderScene& scene = ctx.scene;
   const RenderOptions& options = ctx.options;
   const auto& positions = scene.positions();
-  const auto sample_texel = [&](const TexelCandidate& candidate, double s, double inv_pdf,
+  const auto sample_texel = [&](const TexelCandidate& texel_candidate, double s, double inv_pdf,
                                 const Sampler& sampler, std::vector<EdgeEntry>* out) {
+    const TexelSegment& candidate = *texel_candidate.segment;
     RenderStats& local = view.thread_stats.local();
     const Eigen::Vector3i& corners = scene.faces()[candidate.face];
     const Eigen::Vector3d b = candidate.b0 + s * (candidate.b1 - candidate.b0);
@@ -345,8 +343,11 @@ void AddTexelEdgeTerms(const EdgeView& view, std::vector<EdgeEntry>* entries) {
         &local, out);
   };
   const int64_t num_samples = static_cast<int64_t>(std::ceil(ratio * options.spp * view.pixels));
-  SampleCandidates(options, TexelCandidates(view), num_samples, kTexelEdgeKey, ctx.view.view_index,
-                   sample_texel, entries);
+  // Held for the candidates, which point into the set.
+  const std::shared_ptr<const std::vector<TexelSegment>> segments =
+      TexelSegments(scene, ctx.material, ctx.material.specular * ctx.specular_scale > 0.0);
+  SampleCandidates(options, TexelCandidates(view, *segments), num_samples, kTexelEdgeKey,
+                   ctx.view.view_index, sample_texel, entries);
 }
 
 }  // namespace render_internal
