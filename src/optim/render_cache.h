@@ -144,8 +144,8 @@ class RenderCache : public ceres::EvaluationCallback {
   // so that Σ parts grows by what *gradient grows by; such passes run in this process, because
   // the parts do not travel between ranks.
   bool AddAdjointGradientsWith(const std::vector<int>& views, const std::vector<Image>& weights,
-                               const EffectPlan& plan, uint64_t seed,
-                               std::vector<double>* gradient, GradientParts* parts = nullptr);
+                               const EffectPlan& plan, uint64_t seed, std::vector<double>* gradient,
+                               GradientParts* parts = nullptr);
 
   int num_views() const { return static_cast<int>(levels_.size()); }
   int num_levels(int v) const { return static_cast<int>(levels_[v].size()); }

@@ -208,8 +208,9 @@ int EdgeTree::Sample(const Cut& cut, double u, double* probability) const {
   if (!(cut.total > 0.0)) return -1;
   const int e = PickWeighted(cut.importance, cut.count, cut.total, &u);
   double p = cut.importance[e] / cut.total;
-  const int position = cut.node[e] >= 0 ? Descend(cut.node[e], u, cut.x, cut.n, &p)
-                                        : PickInLeaf(e == 0 ? 0 : cut.end[e - 1], cut.end[e], u, &p);
+  const int position = cut.node[e] >= 0
+                           ? Descend(cut.node[e], u, cut.x, cut.n, &p)
+                           : PickInLeaf(e == 0 ? 0 : cut.end[e - 1], cut.end[e], u, &p);
   if (position >= 0) *probability = p;
   return position;
 }

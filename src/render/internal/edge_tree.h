@@ -33,10 +33,10 @@ class EdgeTree {
     static constexpr int kMaxEntries = 16;
     Eigen::Vector3f x, n;  // the point and its normal, in float as the tree scores them.
     int count = 0;
-    int node[kMaxEntries];   // the cluster's node, or −1 for a leaf.
-    int end[kMaxEntries];    // its tree positions end; they begin where the previous ends.
+    int node[kMaxEntries];           // the cluster's node, or −1 for a leaf.
+    int end[kMaxEntries];            // its tree positions end; they begin where the previous ends.
     double importance[kMaxEntries];  // the cluster's importance at (x, n).
-    double total = 0.0;      // Σ importances; ≤ 0 when every segment is below x's plane.
+    double total = 0.0;              // Σ importances; ≤ 0 when every segment is below x's plane.
   };
 
   EdgeTree() = default;

@@ -85,9 +85,7 @@ class NearEdgeMixture {
 
   NearEdgeMixture(const MeshEdgeTable& table, int face, const Eigen::Vector3d& x,
                   const Eigen::Vector3d& n)
-      : table_(table),
-        near_begin_(table.near_begin(face)),
-        near_end_(table.near_end(face)) {
+      : table_(table), near_begin_(table.near_begin(face)), near_end_(table.near_end(face)) {
     const int count = static_cast<int>(near_end_ - near_begin_);
     near_fraction_ = count > 0 ? kNearFraction : 0.0;
     near_probability_ = near_fraction_ > 0 ? kNearFraction / count : 0.0;
@@ -118,8 +116,7 @@ class NearEdgeMixture {
 
   // 1 / the probability of record c (tests; the sampler's own draws carry theirs).
   double InverseProbability(int c) const {
-    return 1.0 /
-           ((1.0 - near_fraction_) * table_.tree().Probability(cut_, c) + NearProbability(c));
+    return 1.0 / ((1.0 - near_fraction_) * table_.tree().Probability(cut_, c) + NearProbability(c));
   }
 
  private:
