@@ -14,7 +14,6 @@ namespace {
 constexpr int kMaxViewRows = 4;
 constexpr int kMaxHeldOutRows = 2;
 constexpr int kHeldOutSpp = 32;  // the held-out rows' renders (sft eval --held-out's scores: 64).
-constexpr int kDifferenceGain = 4;
 
 double MeanPsnr(const IterationRecord& r) {
   double sum = 0.0;

@@ -6,13 +6,13 @@
 #include <utility>
 
 #include "src/core/file_util.h"
+#include "src/eval/report.h"
 #include "src/image/image_io.h"
 
 namespace sft {
 namespace {
 
 constexpr char kReportFiles[] = "report_files";  // the report's PNGs, under OUT/.
-constexpr int kDifferenceGain = 4;               // |difference| thumbnails are this much brighter.
 
 // 1 where channel 3 of `image` (RGBA) is > 0.5, else 0.
 Image AlphaMask(const Image& image) {

@@ -121,6 +121,9 @@ Image ScaledRgb(const Image& image, double scale);
 // |a − b| per RGB channel times `scale`; `a` and `b` have equal sizes and ≥ 3 channels (or 1).
 Image AbsDifferenceRgb(const Image& a, const Image& b, double scale);
 
+// The reports' |render − target| thumbnails are this much brighter than the images they compare.
+constexpr int kDifferenceGain = 4;
+
 }  // namespace sft
 
 #endif  // SFT_EVAL_REPORT_H_
