@@ -130,7 +130,7 @@ TEST(ReconstructHoldoutTest, PrintScheduleShowsTheFittedViews) {
   std::string out;
   const std::string base = "reconstruct --dataset " + tmp.Join("ds") + " --print-schedule";
   ASSERT_EQ(RunSft(base + " --holdout 2", &out), 0) << out;  // the hull list: a carved start.
-  const int stages = CountLines(out) - 2;                     // the header, the held-out line.
+  const int stages = CountLines(out) - 2;                    // the header, the held-out line.
   ASSERT_GE(stages, 4) << out;
   EXPECT_EQ(Occurrences(out, "  2 of 4: 1,3\n"), stages) << out;
   EXPECT_THAT(out, HasSubstr("held out (--holdout 2): 2 of 4: 0,2\n"));
@@ -175,10 +175,10 @@ TEST(ReconstructHoldoutTest, CarvedStartIgnoresHeldOutMasks) {
   EXPECT_TRUE(start == testing::ReadTestFile(tmp.Join("r_bad/initial_mesh.ply")))
       << "the held-out masks changed the carved start";
   // Not held out, the empty mask is refused (the corruption is real).
-  EXPECT_EQ(RunSft("reconstruct --dataset " + tmp.Join("bad") + " --out " + tmp.Join("r_all") +
-                       flags,
-                   &out),
-            1);
+  EXPECT_EQ(
+      RunSft("reconstruct --dataset " + tmp.Join("bad") + " --out " + tmp.Join("r_all") + flags,
+             &out),
+      1);
   EXPECT_THAT(out, HasSubstr("views[0]"));
 }
 

@@ -26,8 +26,8 @@ std::string CorruptMask(const std::string& dir, int view, bool hole) {
   if (!status.ok()) return status.message();
   for (int y = 0; y < mask.height; ++y) {
     for (int x = 0; x < mask.width; ++x) {
-      const bool centre = std::abs(2 * x - mask.width) < mask.width / 2 &&
-                          std::abs(2 * y - mask.height) < mask.height / 2;
+      const bool centre = std::abs(2 * x - mask.width) < mask.width / 4 &&
+                          std::abs(2 * y - mask.height) < mask.height / 4;
       if (!hole || centre) mask.at(x, y) = 0.f;
     }
   }
