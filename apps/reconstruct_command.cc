@@ -130,8 +130,15 @@ Status ScoreAgainstReference(const TriMesh& reference, double tolerance, const T
   return Status::Ok();
 }
 
-Status PrintSchedule(const std::vector<StageOptions>& stages) {
-  std::printf("%s", FormatSchedule(stages).c_str());
+// --print-schedule: the stages with the views each fits, then the held-out views, if any.
+Status PrintSchedule(const std::vector<StageOptions>& stages, const Dataset& dataset, int holdout,
+                     const std::vector<int>& held_out) {
+  const int views = static_cast<int>(dataset.views.size());
+  std::printf("%s", FormatSchedule(stages, views).c_str());
+  if (!held_out.empty()) {
+    std::printf("held out (--holdout %d): %s\n", holdout,
+                DescribeStageViews(held_out, views).c_str());
+  }
   return Status::Ok();
 }
 
@@ -166,7 +173,9 @@ Status PrepareSchedule(ReconstructCommandOptions* cli, Dataset* dataset,
     if (cli->dataset.empty()) cli->dataset = state.dataset();
     SFT_RETURN_IF_ERROR(ReadDataset(cli->dataset, dataset));
     SFT_RETURN_IF_ERROR(ResumedStages(*cli, state, *dataset, &stages));
-    if (cli->print_schedule) return PrintSchedule(stages);
+    if (cli->print_schedule) {
+      return PrintSchedule(stages, *dataset, state.holdout, state.held_out_views);
+    }
     SFT_RETURN_IF_ERROR(CheckOutputDirectory(cli->out, {{cli->dataset}, {}}, "--resume"));
     SFT_RETURN_IF_ERROR(UnknownLighting(cli->resume, *cli, dataset));
     if (before_start) SFT_RETURN_IF_ERROR(before_start(cli->dataset, *dataset, stages));
@@ -186,7 +195,7 @@ Status PrepareSchedule(ReconstructCommandOptions* cli, Dataset* dataset,
   std::vector<int> held_out;
   SFT_RETURN_IF_ERROR(ApplyHoldout(config.holdout, config.flat.value("views", std::vector<int>()),
                                    static_cast<int>(dataset->views.size()), &stages, &held_out));
-  if (cli->print_schedule) return PrintSchedule(stages);
+  if (cli->print_schedule) return PrintSchedule(stages, *dataset, config.holdout, held_out);
   const RunInputs inputs{{cli->dataset},
                          {start.path, MaterialFile(cli->material), cli->config, cli->reference}};
   SFT_RETURN_IF_ERROR(CheckOutputDirectory(cli->out, inputs, "--out"));

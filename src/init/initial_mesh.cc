@@ -46,10 +46,21 @@ bool InitialMeshOptions::Check(std::string* why) const {
 }
 
 Status LoadCarvingViews(const Dataset& dataset, std::vector<CarvingView>* views) {
+  std::vector<int> all(dataset.views.size());
+  for (size_t v = 0; v < all.size(); ++v) all[v] = static_cast<int>(v);
+  return LoadCarvingViews(dataset, all, views);
+}
+
+Status LoadCarvingViews(const Dataset& dataset, const std::vector<int>& indices,
+                        std::vector<CarvingView>* views) {
   const std::string scene = JoinPath(dataset.root, "scene.json");
-  const int n = static_cast<int>(dataset.views.size());
-  if (n == 0) return Status::Error(scene + ": the dataset has no views");
-  for (int v = 0; v < n; ++v) {
+  if (dataset.views.empty()) return Status::Error(scene + ": the dataset has no views");
+  const int n = static_cast<int>(indices.size());
+  if (n == 0) return Status::Error(scene + ": no views to carve from");
+  for (int v : indices) {
+    if (v < 0 || v >= static_cast<int>(dataset.views.size())) {
+      return Status::Error(scene + ": no view " + std::to_string(v) + " to carve from");
+    }
     if (dataset.views[v].mask.empty()) {
       return Status::Error(scene + ": views[" + std::to_string(v) +
                            "] has no mask; sft init needs a mask for every view (8-bit PNG, > 127 "
@@ -58,14 +69,15 @@ Status LoadCarvingViews(const Dataset& dataset, std::vector<CarvingView>* views)
   }
   std::vector<CarvingView> result(n);
   std::vector<Status> statuses(n);
-  tbb::parallel_for(0, n, [&](int v) {
+  tbb::parallel_for(0, n, [&](int i) {
+    const int v = indices[i];
     Image mask;
-    statuses[v] = LoadViewMask(dataset, v, &mask);
-    if (!statuses[v].ok()) return;
+    statuses[i] = LoadViewMask(dataset, v, &mask);
+    if (!statuses[i].ok()) return;
     const ViewSpec& spec = dataset.views[v];
-    statuses[v] = MakeCarvingView(
+    statuses[i] = MakeCarvingView(
         "views[" + std::to_string(v) + "] (" + JoinPath(dataset.root, spec.mask) + ")",
-        dataset.cameras[spec.camera], spec.cam_from_world, mask, &result[v]);
+        dataset.cameras[spec.camera], spec.cam_from_world, mask, &result[i]);
   });
   for (const Status& status : statuses) SFT_RETURN_IF_ERROR(status);
   *views = std::move(result);

@@ -63,6 +63,10 @@ struct InitialMeshReport {
 // mask ("... sft init needs a mask for every view ..."), an unreadable or wrongly sized mask, an
 // empty mask (naming the view).
 Status LoadCarvingViews(const Dataset& dataset, std::vector<CarvingView>* views);
+// The same for the listed dataset views only (in that order): the masks of the others are neither
+// read nor checked.
+Status LoadCarvingViews(const Dataset& dataset, const std::vector<int>& indices,
+                        std::vector<CarvingView>* views);
 
 // Carves, extracts, cleans and decimates; compares `sparse_points` (may be empty) with the hull.
 Status MakeInitialMesh(const std::vector<CarvingView>& views, const InitialMeshOptions& options,

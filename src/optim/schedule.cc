@@ -257,9 +257,9 @@ Status Schedule::ChangeTopology(TopologyChange change, const ScheduleCallbacks& 
                                               views, stage.fit.cache.image_scale_log2),
                        &current_.material);
   }
-  SFT_RETURN_IF_ERROR(ApplyTopologyChange(change, stage.topology, *dataset_, views,
-                                          stage.fit.cache.image_scale_log2, stage.texel_resolution,
-                                          &current_.mesh, &current_.material, &record));
+  SFT_RETURN_IF_ERROR(ApplyTopologyChange(
+      change, stage.topology, *dataset_, views, stage.fit.cache.image_scale_log2,
+      stage.texel_resolution, &current_.mesh, &current_.material, &record, held_out_views_));
   record["stage"] = stage.name;
   record["outer"] = progress_.outer_done;
   record["seconds"] = NowSeconds() - start;

@@ -324,12 +324,45 @@ Status StagesFromJson(const json& list, const std::string& source,
   return Status::Ok();
 }
 
-std::string FormatSchedule(const std::vector<StageOptions>& stages) {
+namespace {
+
+// At most this many view indices are listed in a stage's views column.
+constexpr size_t kListedViews = 16;
+// The width of the "before" column ("remesh isotropic, resample"), so that "views" aligns.
+constexpr int kBeforeWidth = 26;
+
+std::string JoinIndices(const std::vector<int>& views, size_t begin, size_t end) {
+  std::string text;
+  for (size_t i = begin; i < end; ++i) text += (i > begin ? "," : "") + std::to_string(views[i]);
+  return text;
+}
+
+}  // namespace
+
+std::string DescribeStageViews(const std::vector<int>& views, int dataset_views) {
+  const std::string of = dataset_views > 0 ? " of " + std::to_string(dataset_views) : "";
+  if (views.empty()) return dataset_views > 0 ? "all " + std::to_string(dataset_views) : "all";
+  const std::string count = std::to_string(views.size()) + of + ": ";
+  if (views.size() <= kListedViews) return count + JoinIndices(views, 0, views.size());
+  // Many views: the ones left out when they are few (a holdout's), else the ends of the list.
+  std::vector<int> others;
+  for (int v = 0; v < dataset_views; ++v) {
+    if (std::find(views.begin(), views.end(), v) == views.end()) others.push_back(v);
+  }
+  if (dataset_views > 0 && others.size() <= kListedViews) {
+    return count + "all but " + (others.empty() ? "none" : JoinIndices(others, 0, others.size()));
+  }
+  return count + JoinIndices(views, 0, 3) + ",...," +
+         JoinIndices(views, views.size() - 3, views.size());
+}
+
+std::string FormatSchedule(const std::vector<StageOptions>& stages, int dataset_views) {
   // The name column is as wide as the longest name (at least 10), so that columns stay aligned.
   size_t width = 10;
   for (const StageOptions& s : stages) width = std::max(width, s.name.size());
   std::string text = "stage  " + std::string("name") + std::string(width - 2, ' ') +
-                     "phases     scale   spp  levels  outer  steps  texels  solver  before\n";
+                     "phases     scale   spp  levels  outer  steps  texels  solver  before" +
+                     std::string(kBeforeWidth - 4, ' ') + "views\n";
   for (size_t k = 0; k < stages.size(); ++k) {
     const StageOptions& s = stages[k];
     const ReconstructOptions& f = s.fit;
@@ -337,9 +370,10 @@ std::string FormatSchedule(const std::vector<StageOptions>& stages) {
     if (s.topology.remesh != "none") before += "remesh " + s.topology.remesh;
     if (s.topology.resample) before += std::string(before.empty() ? "" : ", ") + "resample";
     if (before.empty()) before = "-";
-    char line[256];
+    const std::string views = DescribeStageViews(f.views, dataset_views);
+    char line[512];
     std::snprintf(line, sizeof(line),
-                  "%5zu  %-*s  %-9s  1/%-4d %4d  %6d  %5d  %5d  %6s  %-6s  %s\n", k,
+                  "%5zu  %-*s  %-9s  1/%-4d %4d  %6d  %5d  %5d  %6s  %-6s  %-*s  %s\n", k,
                   static_cast<int>(width), s.name.c_str(), PhaseScheduleName(f.phases),
                   1 << f.cache.image_scale_log2, f.cache.render.spp, f.cache.pyramid_levels,
                   f.outer_iterations, f.solver.steps,
@@ -347,7 +381,7 @@ std::string FormatSchedule(const std::vector<StageOptions>& stages) {
                   : s.texel_resolution > 0 ? std::to_string(s.texel_resolution).c_str()
                   : s.texel_resolution == kTexelResolutionAuto ? "auto"
                                                                : "keep",
-                  SolverKindName(f.solver.kind), before.c_str());
+                  SolverKindName(f.solver.kind), kBeforeWidth, before.c_str(), views.c_str());
     text += line;
   }
   return text;

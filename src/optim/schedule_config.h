@@ -51,8 +51,14 @@ nlohmann::json StageJson(const StageOptions& stage);
 Status StagesFromJson(const nlohmann::json& list, const std::string& source,
                       std::vector<StageOptions>* stages);
 
-// The effective stage list as a table (`sft reconstruct --print-schedule`).
-std::string FormatSchedule(const std::vector<StageOptions>& stages);
+// The effective stage list as a table (`sft reconstruct --print-schedule`), with the views each
+// stage fits; `dataset_views` (0 = unknown) is the dataset's view count.
+std::string FormatSchedule(const std::vector<StageOptions>& stages, int dataset_views = 0);
+
+// A stage's views for that table: "all N" (empty list), the count and the indices when there are
+// at most 16, else the count and the views left out when those are at most 16 ("all but 0,8"),
+// else the list's first and last three.
+std::string DescribeStageViews(const std::vector<int>& views, int dataset_views);
 
 }  // namespace sft
 

@@ -43,15 +43,16 @@ Status LoadStartMesh(const Dataset& dataset, const StartChoice& choice,
                      const InitialMeshOptions& carve, TriMesh* mesh,
                      const std::vector<int>& excluded_views) {
   if (choice.kind != StartKind::kCarved) return ReadMesh(choice.path, mesh);
-  std::vector<CarvingView> all;
-  SFT_RETURN_IF_ERROR(LoadCarvingViews(dataset, &all));
-  std::vector<CarvingView> views;  // LoadCarvingViews gives one per dataset view, in order.
-  for (size_t v = 0; v < all.size(); ++v) {
-    if (std::find(excluded_views.begin(), excluded_views.end(), static_cast<int>(v)) ==
-        excluded_views.end()) {
-      views.push_back(std::move(all[v]));
+  // Held-out masks are not even read: neither their content nor their absence may change the
+  // start.
+  std::vector<int> carved;
+  for (int v = 0; v < static_cast<int>(dataset.views.size()); ++v) {
+    if (std::find(excluded_views.begin(), excluded_views.end(), v) == excluded_views.end()) {
+      carved.push_back(v);
     }
   }
+  std::vector<CarvingView> views;
+  SFT_RETURN_IF_ERROR(LoadCarvingViews(dataset, carved, &views));
   InitialMeshReport report;
   return MakeInitialMesh(views, carve, /*sparse_points=*/{}, mesh, &report);
 }

@@ -32,8 +32,8 @@ struct StartChoice {
 // which view lacks it and what to pass instead.
 Status ChooseStart(const Dataset& dataset, const std::string& init_path, StartChoice* choice);
 
-// Loads (or carves, with `carve` options) the start mesh. Carving leaves out the masks of
-// `excluded_views` (held-out views, src/optim/holdout.h).
+// Loads (or carves, with `carve` options) the start mesh. Carving neither reads nor uses the masks
+// of `excluded_views` (held-out views, src/optim/holdout.h).
 Status LoadStartMesh(const Dataset& dataset, const StartChoice& choice,
                      const InitialMeshOptions& carve, TriMesh* mesh,
                      const std::vector<int>& excluded_views = {});

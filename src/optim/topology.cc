@@ -1,5 +1,6 @@
 #include "src/optim/topology.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "src/geometry/mesh_colors_resample.h"
@@ -44,8 +45,8 @@ Status Remesh(const TopologyOptions& options, double edge_length, TriMesh* mesh,
 }
 
 Status Resample(const TopologyOptions& options, const Dataset& dataset,
-                const std::vector<int>& view_indices, int image_scale_log2, TriMesh* mesh,
-                json* record) {
+                const std::vector<int>& view_indices, const std::vector<int>& held_out,
+                int image_scale_log2, TriMesh* mesh, json* record) {
   DatasetViews views;
   SFT_RETURN_IF_ERROR(MakeDatasetViews(dataset, &views));
   std::vector<ViewSetup> setups;
@@ -53,11 +54,17 @@ Status Resample(const TopologyOptions& options, const Dataset& dataset,
     setups.push_back(views.views[v]);
     setups.back().camera = DownscaledCamera(setups.back().camera, image_scale_log2);
   }
-  // The visual hull bounds the Poisson surface when every view has a mask.
+  // The visual hull of every view but the held-out ones bounds the Poisson surface when each of
+  // them has a mask.
+  std::vector<int> hull_views;
   bool all_masks = true;
-  for (const auto& view : dataset.views) all_masks = all_masks && !view.mask.empty();
+  for (int v = 0; v < static_cast<int>(dataset.views.size()); ++v) {
+    if (std::find(held_out.begin(), held_out.end(), v) != held_out.end()) continue;
+    hull_views.push_back(v);
+    all_masks = all_masks && !dataset.views[v].mask.empty();
+  }
   std::vector<CarvingView> hull;
-  if (all_masks) SFT_RETURN_IF_ERROR(LoadCarvingViews(dataset, &hull));
+  if (all_masks) SFT_RETURN_IF_ERROR(LoadCarvingViews(dataset, hull_views, &hull));
   ResampleOptions resample;
   resample.faces = std::min<int>(options.max_faces, static_cast<int>(mesh->n_faces()));
   TriMesh out;
@@ -131,14 +138,15 @@ int ResolveTexelResolution(int requested, int current, const TriMesh& mesh, cons
 Status ApplyTopologyChange(TopologyChange change, const TopologyOptions& options,
                            const Dataset& dataset, const std::vector<int>& view_indices,
                            int image_scale_log2, int texel_resolution, TriMesh* mesh,
-                           Material* material, json* record) {
+                           Material* material, json* record, const std::vector<int>& held_out) {
   const TriMesh old_mesh = *mesh;
   if (change == TopologyChange::kRemesh) {
     const double edge =
         options.remesh_edge_pixels * PixelFootprint(*mesh, dataset, view_indices, image_scale_log2);
     SFT_RETURN_IF_ERROR(Remesh(options, edge, mesh, record));
   } else {
-    SFT_RETURN_IF_ERROR(Resample(options, dataset, view_indices, image_scale_log2, mesh, record));
+    SFT_RETURN_IF_ERROR(
+        Resample(options, dataset, view_indices, held_out, image_scale_log2, mesh, record));
   }
   const int resolution = ResolveTexelResolution(texel_resolution, material->albedo.resolution(),
                                                 *mesh, dataset, view_indices, image_scale_log2);

@@ -61,12 +61,14 @@ int ResolveTexelResolution(int requested, int current, const TriMesh& mesh, cons
 
 // Applies `change` to `mesh` and carries `material` across (texel resolution resolved by
 // ResolveTexelResolution on the new mesh). `views` are the fitted views (ray casting, footprint);
-// the dataset's masks bound resampling (visual hull) when every view has one. `record` receives
-// what was done (kind, faces before and after, seconds, the parts' reports).
+// the masks of every dataset view but the `held_out` ones (never read) bound resampling (visual
+// hull) when each of those views has one. `record` receives what was done (kind, faces before
+// and after, seconds, the parts' reports).
 Status ApplyTopologyChange(TopologyChange change, const TopologyOptions& options,
                            const Dataset& dataset, const std::vector<int>& view_indices,
                            int image_scale_log2, int texel_resolution, TriMesh* mesh,
-                           Material* material, nlohmann::json* record);
+                           Material* material, nlohmann::json* record,
+                           const std::vector<int>& held_out = {});
 
 // The material at another mesh-colours resolution on the same mesh (values read at the new
 // texels' representative points).

@@ -18,6 +18,7 @@ using testing::RunSft;
 
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
+using ::testing::Not;
 
 nlohmann::json ReadJson(const std::string& path) {
   return nlohmann::json::parse(testing::ReadTestFile(path));
@@ -32,6 +33,12 @@ int ViewPsnrCount(const nlohmann::json& metrics) {
     if (count != -2 && n != count) return -1;
     count = n;
   }
+  return count;
+}
+
+int Occurrences(const std::string& text, const std::string& part) {
+  int count = 0;
+  for (size_t at = text.find(part); at != std::string::npos; at = text.find(part, at + 1)) ++count;
   return count;
 }
 
@@ -114,6 +121,65 @@ TEST(ReconstructHoldoutTest, HeldOutViewsAreKeptOutAndScored) {
                    &out),
             1);
   EXPECT_EQ(CountLines(out), 1) << out;
+}
+
+// --print-schedule names the views each stage fits and the held-out ones.
+TEST(ReconstructHoldoutTest, PrintScheduleShowsTheFittedViews) {
+  testing::TempDir tmp;
+  ASSERT_EQ(testing::SynthIcosphere(tmp.Join("ds"), "--cameras 4 --zooms 1 --res 8 --spp 2"), "");
+  std::string out;
+  const std::string base = "reconstruct --dataset " + tmp.Join("ds") + " --print-schedule";
+  ASSERT_EQ(RunSft(base + " --holdout 2", &out), 0) << out;  // the hull list: a carved start.
+  const int stages = CountLines(out) - 2;                    // the header, the held-out line.
+  ASSERT_GE(stages, 4) << out;
+  EXPECT_EQ(Occurrences(out, "  2 of 4: 1,3\n"), stages) << out;
+  EXPECT_THAT(out, HasSubstr("held out (--holdout 2): 2 of 4: 0,2\n"));
+  // A stage's own views lose the held-out ones; without --holdout, every stage fits all views.
+  testing::WriteTestFile(tmp.Join("cfg.json"),
+                         R"({"stages": [{"name": "a"}, {"name": "b", "views": [0, 1, 3]}]})");
+  ASSERT_EQ(RunSft(base + " --holdout 2 --config " + tmp.Join("cfg.json"), &out), 0) << out;
+  EXPECT_EQ(Occurrences(out, "  2 of 4: 1,3\n"), 2) << out;  // b's {0, 1, 3} loses view 0.
+  ASSERT_EQ(RunSft(base + " --config " + tmp.Join("cfg.json"), &out), 0) << out;
+  EXPECT_THAT(out, HasSubstr("  all 4\n"));
+  EXPECT_THAT(out, HasSubstr("  3 of 4: 0,1,3\n"));
+  EXPECT_THAT(out, Not(HasSubstr("held out")));
+}
+
+// A carved start (no --init) never reads a held-out view's mask: with view 0's mask empty (which
+// carving refuses) and view 3's cut through by a hole, --holdout 3 starts from the same hull as on
+// the intact dataset.
+TEST(ReconstructHoldoutTest, CarvedStartIgnoresHeldOutMasks) {
+  testing::TempDir tmp;
+  ASSERT_EQ(testing::SynthIcosphere(tmp.Join("ds"), "--cameras 6 --zooms 1 --res 24 --spp 4"), "");
+  fs::copy(tmp.Join("ds"), tmp.Join("bad"), fs::copy_options::recursive);
+  ASSERT_EQ(testing::CorruptMask(tmp.Join("bad"), 0, /*hole=*/false), "");
+  ASSERT_EQ(testing::CorruptMask(tmp.Join("bad"), 3, /*hole=*/true), "");
+  testing::WriteTestFile(tmp.Join("cfg.json"), R"({"stages": [{"name": "m", "phases": "texture",
+      "outer_iterations": 1, "steps": 1, "spp": 1, "bounces": 1}]})");
+  const std::string flags = " --quiet --no-report --config " + tmp.Join("cfg.json");
+  std::string out;
+  ASSERT_EQ(RunSft("reconstruct --dataset " + tmp.Join("ds") + " --out " + tmp.Join("r_ds") +
+                       " --holdout 3" + flags,
+                   &out),
+            0)
+      << out;
+  ASSERT_EQ(RunSft("reconstruct --dataset " + tmp.Join("bad") + " --out " + tmp.Join("r_bad") +
+                       " --holdout 3" + flags,
+                   &out),
+            0)
+      << out;
+  EXPECT_EQ(ReadJson(tmp.Join("r_bad/state.json"))["run"]["start"], "carved hull");
+  EXPECT_EQ(ReadJson(tmp.Join("r_bad/state.json"))["held_out_views"], nlohmann::json({0, 3}));
+  const std::string start = testing::ReadTestFile(tmp.Join("r_ds/initial_mesh.ply"));
+  EXPECT_GT(start.size(), 1000u);
+  EXPECT_TRUE(start == testing::ReadTestFile(tmp.Join("r_bad/initial_mesh.ply")))
+      << "the held-out masks changed the carved start";
+  // Not held out, the empty mask is refused (the corruption is real).
+  EXPECT_EQ(
+      RunSft("reconstruct --dataset " + tmp.Join("bad") + " --out " + tmp.Join("r_all") + flags,
+             &out),
+      1);
+  EXPECT_THAT(out, HasSubstr("views[0]"));
 }
 
 TEST(ReconstructHoldoutTest, BadHoldoutIsOneLineAndWritesNothing) {

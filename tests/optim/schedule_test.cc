@@ -76,6 +76,40 @@ TEST(ScheduleConfigTest, LongStageNamesKeepColumnsAligned) {
   }
 }
 
+// The table names the views each stage fits: all, a short list, the few left out of a long one,
+// or the ends of a long list; the views column stays aligned after a long "before".
+TEST(ScheduleConfigTest, TableShowsEachStagesViews) {
+  EXPECT_EQ(DescribeStageViews({}, 8), "all 8");
+  EXPECT_EQ(DescribeStageViews({}, 0), "all");
+  EXPECT_EQ(DescribeStageViews({1, 3, 5, 7}, 8), "4 of 8: 1,3,5,7");
+  std::vector<int> most;  // 40 views, every 8th held out.
+  for (int v = 0; v < 40; ++v) {
+    if (v % 8 != 0) most.push_back(v);
+  }
+  EXPECT_EQ(DescribeStageViews(most, 40), "35 of 40: all but 0,8,16,24,32");
+  std::vector<int> even;
+  for (int v = 0; v < 80; v += 2) even.push_back(v);
+  EXPECT_EQ(DescribeStageViews(even, 80), "40 of 80: 0,2,4,...,74,76,78");
+
+  std::vector<StageOptions> stages(2);
+  stages[0].name = "all";
+  stages[0].topology.remesh = "isotropic";
+  stages[0].topology.resample = true;
+  stages[1].name = "some";
+  stages[1].fit.views = {1, 3};
+  const std::string table = FormatSchedule(stages, 4);
+  std::vector<std::string> lines;
+  for (size_t start = 0, end; (end = table.find('\n', start)) != std::string::npos;
+       start = end + 1) {
+    lines.push_back(table.substr(start, end - start));
+  }
+  ASSERT_EQ(lines.size(), 3u);
+  const size_t column = lines[0].find("views");
+  ASSERT_NE(column, std::string::npos);
+  EXPECT_EQ(lines[1].find("all 4"), column) << table;
+  EXPECT_EQ(lines[2].find("2 of 4: 1,3"), column) << table;
+}
+
 // The shipped glossy-refine schedule (data/example/glossy_refine.json, docs/reconstruct.md) parses
 // and alternates LM texture stages with Adam large-steps geometry stages that do not simulate the
 // specular lobe, with the step size falling from stage to stage, and ends with an Adam texture

@@ -11,6 +11,11 @@ namespace testing {
 // command's output on failure (for the assertion message) and "" on success.
 std::string SynthIcosphere(const std::string& dir, const std::string& args);
 
+// Overwrites view `view`'s mask in the dataset at `dir`: with `hole`, a centred square of a quarter
+// of the image's size becomes background (carving would cut a tunnel through the hull); without,
+// every pixel does (an empty mask, which carving refuses). Returns "" on success, else the error.
+std::string CorruptMask(const std::string& dir, int view, bool hole);
+
 }  // namespace testing
 }  // namespace sft
 
