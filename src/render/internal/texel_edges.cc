@@ -15,9 +15,8 @@ namespace {
 // far above MeshColors' lattice snap of 1e-9 texels, far below a texel).
 constexpr double kTexelSideOffset = 1e-6;
 
-// A texel boundary segment to sample: the points Σ_k b_k(s)·p_k of face `face` (corners p_k),
-// b(s) = b0 + s·(b1 − b0), over s ∈ [s0, s1] (the part in view); `other` is the face across it
-// (`face` itself for a grid line inside the face, the neighbour for a coplanar mesh edge).
+// A texel boundary segment to sample over s ∈ [s0, s1] (the part in view): the points
+// Σ_k b_k(s)·p_k of the segment's face (corners p_k), b(s) = b0 + s·(b1 − b0) (TexelSegment).
 struct TexelCandidate {
   const TexelSegment* segment;  // in the TexelSegments set, which outlives the candidates.
   double s0, s1;
@@ -328,13 +327,13 @@ void AddTexelEdgeTerms(const EdgeView& view, std::vector<EdgeEntry>* entries) {
   const RenderScene& scene = ctx.scene;
   const RenderOptions& options = ctx.options;
   const auto& positions = scene.positions();
-  const auto sample_texel = [&](const TexelCandidate& texel_candidate, double s, double inv_pdf,
+  const auto sample_texel = [&](const TexelCandidate& candidate, double s, double inv_pdf,
                                 const Sampler& sampler, std::vector<EdgeEntry>* out) {
-    const TexelSegment& candidate = *texel_candidate.segment;
+    const TexelSegment& segment = *candidate.segment;
     RenderStats& local = view.thread_stats.local();
-    const Eigen::Vector3i& corners = scene.faces()[candidate.face];
-    const Eigen::Vector3d b = candidate.b0 + s * (candidate.b1 - candidate.b0);
-    const Eigen::Vector3d db_ds = candidate.b1 - candidate.b0;
+    const Eigen::Vector3i& corners = scene.faces()[segment.face];
+    const Eigen::Vector3d b = segment.b0 + s * (segment.b1 - segment.b0);
+    const Eigen::Vector3d db_ds = segment.b1 - segment.b0;
     Eigen::Vector3d y = Eigen::Vector3d::Zero(), dy_ds = Eigen::Vector3d::Zero();
     for (int k = 0; k < 3; ++k) {
       y += b[k] * positions[corners[k]];
@@ -344,12 +343,12 @@ void AddTexelEdgeTerms(const EdgeView& view, std::vector<EdgeEntry>* entries) {
         view, y, inv_pdf, options.spp,
         [&](const Eigen::Matrix<double, 2, 3>& d_q) { return (d_q * dy_ds).eval(); },
         [&](const Eigen::Vector2d& q, const Eigen::Vector2d& m) {
-          return TexelJump(view, q, m, candidate.face, candidate.other, sampler, &local);
+          return TexelJump(view, q, m, segment.face, segment.other, sampler, &local);
         },
         [&](const Eigen::Vector3d& m_row, BoundaryRows* rows) {
           // ∂y/∂p_k = b_k·I.
-          const Eigen::Vector3d c = candidate.c0 + s * (candidate.c1 - candidate.c0);
-          AddTexelPointRows(scene, candidate.face, candidate.other, b, c, m_row, rows);
+          const Eigen::Vector3d c = segment.c0 + s * (segment.c1 - segment.c0);
+          AddTexelPointRows(scene, segment.face, segment.other, b, c, m_row, rows);
         },
         &local, out);
   };
