@@ -49,9 +49,10 @@ struct ReconstructCommandOptions {
   int outer = 0, steps = 0, spp = 0, bounces = 0, threads = 0;
   int64_t seed = 0;
   std::vector<int> views;
-  int holdout = 0;              // every K-th selected view is held out of the fit; 0 = off.
-  std::set<std::string> given;  // config keys whose flag was on the command line.
-  std::string reference;        // ground-truth mesh: F1 and Chamfer after every outer iteration.
+  int holdout = 0;                // every K-th selected view is held out of the fit; 0 = off.
+  std::string environment_frame;  // unknown lighting's fitted map: "world" or "camera".
+  std::set<std::string> given;    // config keys whose flag was on the command line.
+  std::string reference;          // ground-truth mesh: F1 and Chamfer after every outer iteration.
   double reference_tolerance = 0.005;  // F1 tolerance, fraction of the reference's diagonal.
   bool print_schedule = false;
   bool quiet = false;
@@ -66,17 +67,25 @@ using BeforeStart = std::function<Status(const std::string& dataset, const Datas
 
 // The flat keys of the command line (flags override the config file's keys in every stage).
 Status FlagKeys(const ReconstructCommandOptions& cli, ScheduleConfig* config) {
-  const nlohmann::json all = {
-      {"phases", cli.phases},   {"solver", cli.solver},  {"outer_iterations", cli.outer},
-      {"steps", cli.steps},     {"spp", cli.spp},        {"bounces", cli.bounces},
-      {"threads", cli.threads}, {"seed", cli.seed},      {"views", cli.views},
-      {"effects", cli.effects}, {"holdout", cli.holdout}};
+  const nlohmann::json all = {{"phases", cli.phases},
+                              {"solver", cli.solver},
+                              {"outer_iterations", cli.outer},
+                              {"steps", cli.steps},
+                              {"spp", cli.spp},
+                              {"bounces", cli.bounces},
+                              {"threads", cli.threads},
+                              {"seed", cli.seed},
+                              {"views", cli.views},
+                              {"effects", cli.effects},
+                              {"holdout", cli.holdout},
+                              {"environment_frame", cli.environment_frame}};
   for (const auto& [key, value] : all.items()) {
     if (cli.given.count(key) == 0) continue;
     const Status status = MergeScheduleConfig({{key, value}}, "flag", config);
     if (!status.ok()) {  // name the flag: "--steps: expected ...".
       std::string message = status.message().substr(status.message().find(": ") + 2);
       if (message.rfind("outer_iterations", 0) == 0) message.replace(0, 16, "outer");
+      if (message.rfind("environment_frame", 0) == 0) message.replace(0, 17, "environment-frame");
       return Status::Error("--" + message);
     }
   }
@@ -109,6 +118,15 @@ Status ResumedStages(const ReconstructCommandOptions& cli, const RunState& state
     return Status::Error("--holdout " + std::to_string(overrides.holdout) + ": the run in " +
                          cli.resume + " was started with --holdout " +
                          std::to_string(state.holdout) + " and keeps its held-out views");
+  }
+  if (overrides.environment_frame_given && LightingUnknown(dataset)) {
+    LightFrame frame = LightFrame::kWorld;
+    SFT_RETURN_IF_ERROR(ReadFittedEnvironmentFrame(cli.resume, &frame));
+    if (overrides.environment_frame != LightFrameName(frame)) {
+      return Status::Error("environment_frame " + overrides.environment_frame + ": the run in " +
+                           cli.resume + " fits a " + LightFrameName(frame) +
+                           "-fixed environment and keeps it");
+    }
   }
   for (StageOptions& stage : *stages) {
     SFT_RETURN_IF_ERROR(ApplyStageConfig(overrides.flat, "overrides", &stage));
@@ -144,10 +162,15 @@ Status PrintSchedule(const std::vector<StageOptions>& stages, const Dataset& dat
 
 // Unknown lighting (no view lists lights) is estimated as a fitted environment
 // (src/optim/fitted_environment.h), said in one line; `run` is the resumed folder ("" fresh).
+// A fresh run's map is fixed in `frame` ("world" or "camera"); a resumed one keeps its own.
 Status UnknownLighting(const std::string& run, const ReconstructCommandOptions& cli,
-                       Dataset* dataset) {
+                       const std::string& frame, Dataset* dataset) {
+  EnvironmentEstimateOptions options;
+  if (!LightFrameFromName(frame, &options.frame)) {
+    return Status::Error("environment_frame: expected \"world\" or \"camera\"");
+  }
   std::string note;
-  SFT_RETURN_IF_ERROR(PrepareUnknownLighting(run, EnvironmentEstimateOptions(), dataset, &note));
+  SFT_RETURN_IF_ERROR(PrepareUnknownLighting(run, options, dataset, &note));
   if (!note.empty() && !cli.quiet) {
     std::printf("%s\n", note.c_str());
     std::fflush(stdout);  // before the progress lines on stderr.
@@ -177,7 +200,7 @@ Status PrepareSchedule(ReconstructCommandOptions* cli, Dataset* dataset,
       return PrintSchedule(stages, *dataset, state.holdout, state.held_out_views);
     }
     SFT_RETURN_IF_ERROR(CheckOutputDirectory(cli->out, {{cli->dataset}, {}}, "--resume"));
-    SFT_RETURN_IF_ERROR(UnknownLighting(cli->resume, *cli, dataset));
+    SFT_RETURN_IF_ERROR(UnknownLighting(cli->resume, *cli, "world", dataset));
     if (before_start) SFT_RETURN_IF_ERROR(before_start(cli->dataset, *dataset, stages));
     SFT_RETURN_IF_ERROR(Schedule::Resume(*dataset, cli->out, stages, state.run_info, state.progress,
                                          state.view_gains, schedule));
@@ -204,7 +227,7 @@ Status PrepareSchedule(ReconstructCommandOptions* cli, Dataset* dataset,
                          ": holds an earlier reconstruction (continue it with --resume " +
                          cli->out + ", or choose another folder)");
   }
-  SFT_RETURN_IF_ERROR(UnknownLighting("", *cli, dataset));
+  SFT_RETURN_IF_ERROR(UnknownLighting("", *cli, config.environment_frame, dataset));
   ScheduleStart state;
   SFT_RETURN_IF_ERROR(LoadStartMesh(*dataset, start, InitialMeshOptions(), &state.mesh, held_out));
   SFT_RETURN_IF_ERROR(LoadMaterial(cli->material.empty() ? kInitialMaterial : cli->material,
@@ -414,6 +437,10 @@ CommandRunner SetupReconstructCommand(CLI::App* app) {
                            "Keep every K-th selected view (0, K, 2K, ...) out of the fit, for "
                            "sft eval --held-out; 0 = off"),
            "holdout");
+  key_flag(app->add_option("--environment-frame", opts->environment_frame,
+                           "Unknown lighting: fit an environment fixed in the world (lights in "
+                           "the room; default) or in the camera (lights riding with it)"),
+           "environment_frame");
   app->add_option("--reference", opts->reference,
                   "Ground-truth mesh: F1 and Chamfer after every outer iteration (metrics.json)");
   app->add_option("--reference-tolerance", opts->reference_tolerance,

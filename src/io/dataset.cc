@@ -56,7 +56,7 @@ constexpr Keys kTopLevelKeys = {
 constexpr Keys kSimilarityKeys = {"scale", "rotation", "translation"};
 constexpr Keys kCameraKeys = {"id", "model", "width", "height", "params"};
 constexpr Keys kPointLightKeys = {"id", "type", "frame", "position", "intensity"};
-constexpr Keys kEnvironmentLightKeys = {"id", "type", "image", "world_from_env", "scale"};
+constexpr Keys kEnvironmentLightKeys = {"id", "type", "frame", "image", "world_from_env", "scale"};
 constexpr Keys kViewKeys = {"image", "mask", "camera", "lights", "cam_from_world"};
 constexpr Keys kPoseKeys = {"rotation", "translation"};
 
@@ -285,8 +285,8 @@ class SceneParser {
     return Status::Ok();
   }
 
-  Status ParsePointLight(const json& entry, const std::string& path, LightSpec* light) const {
-    light->type = LightType::kPoint;
+  // A light's optional "frame": "world" (the default) or "camera" (it moves with each view).
+  Status ParseLightFrame(const json& entry, const std::string& path, LightSpec* light) const {
     if (const json* frame = Find(entry, "frame")) {
       std::string name;
       SFT_RETURN_IF_ERROR(String(*frame, Field(path, "frame"), false, &name));
@@ -299,6 +299,12 @@ class SceneParser {
                      "expected \"world\" or \"camera\", got \"" + name + "\"");
       }
     }
+    return Status::Ok();
+  }
+
+  Status ParsePointLight(const json& entry, const std::string& path, LightSpec* light) const {
+    light->type = LightType::kPoint;
+    SFT_RETURN_IF_ERROR(ParseLightFrame(entry, path, light));
     const json* value = nullptr;
     SFT_RETURN_IF_ERROR(Require(entry, path, "position", &value));
     SFT_RETURN_IF_ERROR(Vector3(*value, Field(path, "position"), &light->position));
@@ -319,6 +325,7 @@ class SceneParser {
 
   Status ParseEnvironmentLight(const json& entry, const std::string& path, LightSpec* light) const {
     light->type = LightType::kEnvironment;
+    SFT_RETURN_IF_ERROR(ParseLightFrame(entry, path, light));
     SFT_RETURN_IF_ERROR(RequiredString(entry, path, "image", &light->image));
     SFT_RETURN_IF_ERROR(ContainedPath(Field(path, "image"), light->image));
     if (const json* matrix = Find(entry, "world_from_env")) {

@@ -13,7 +13,8 @@
 // A read/write cycle reproduces scene.json exactly as JSON (key order and number formatting
 // aside) except for these normalizations of documented keys: a non-unit quaternion is normalized;
 // defaults are written out explicitly (point light "frame": "world", environment light
-// "world_from_env": identity and "scale": 1, view "lights": [], "background": "black"); a grey
+// "world_from_env": identity and "scale": 1, view "lights": [], "background": "black"; an
+// environment light's "frame": "world" is dropped, as files before that key had none); a grey
 // point-light intensity (one number) becomes [g, g, g]; a null "mask" or "ground_truth" is
 // dropped; an integral float such as a width of 16.0 is written as 16.
 #ifndef SFT_IO_DATASET_H_
@@ -32,7 +33,7 @@
 namespace sft {
 
 enum class LightType { kPoint, kEnvironment };
-enum class LightFrame { kWorld, kCamera };  // a point light's `position` frame.
+enum class LightFrame { kWorld, kCamera };  // where a light is fixed (LightSpec::frame).
 enum class Background { kBlack, kEnvironment };
 
 // Largest camera accepted on read: at most 65536 pixels per side and 2^30 pixels (a 32768²
@@ -45,8 +46,11 @@ constexpr int64_t kMaxCameraPixels = int64_t{1} << 30;
 struct LightSpec {
   std::string id;
   LightType type = LightType::kPoint;
-  // Point lights.
+  // The frame the light is fixed in: the world, or each view's camera (it moves with the camera,
+  // like a flash; for an environment, world_from_env then takes env directions to the camera
+  // frame).
   LightFrame frame = LightFrame::kWorld;
+  // Point lights.
   Eigen::Vector3d position = Eigen::Vector3d::Zero();   // in `frame`, scene units.
   Eigen::Vector3d intensity = Eigen::Vector3d::Zero();  // radiant intensity, W/sr, RGB.
   // Environment lights.

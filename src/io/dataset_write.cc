@@ -52,6 +52,7 @@ ojson LightsJson(const Dataset& dataset) {
       entry["intensity"] = {light.intensity.x(), light.intensity.y(), light.intensity.z()};
     } else {
       entry["type"] = "environment";
+      if (light.frame == LightFrame::kCamera) entry["frame"] = "camera";
       entry["image"] = light.image;
       ojson matrix = ojson::array();
       for (int r = 0; r < 3; ++r) {

@@ -32,10 +32,19 @@ Status CheckViewsFitInMemory(const Dataset& dataset) {
   return Status::Ok();
 }
 
+Eigen::Matrix3d ViewWorldFromEnv(const LightSpec& light, const Rigid3d& cam_from_world) {
+  if (light.frame != LightFrame::kCamera) return light.world_from_env;
+  return cam_from_world.rotation.conjugate().toRotationMatrix() * light.world_from_env;
+}
+
 Status MakeDatasetViews(const Dataset& dataset, DatasetViews* out) {
   SFT_RETURN_IF_ERROR(CheckViewsFitInMemory(dataset));
   out->environments.clear();
   out->environments.resize(dataset.lights.size());
+  out->view_environments.clear();
+  out->view_environments.resize(dataset.views.size());
+  std::vector<Image> probes(dataset.lights.size());  // each probe read once.
+  std::vector<bool> loaded(dataset.lights.size(), false);
   out->views.clear();
   for (size_t v = 0; v < dataset.views.size(); ++v) {
     const ViewSpec& spec = dataset.views[v];
@@ -60,13 +69,21 @@ Status MakeDatasetViews(const Dataset& dataset, DatasetViews* out) {
                              "].lights: more than one environment light in one view is not "
                              "supported");
       }
-      if (out->environments[l] == nullptr) {
-        Image probe;
-        SFT_RETURN_IF_ERROR(LoadProbe(dataset, l, &probe));
-        out->environments[l] =
-            std::make_unique<EnvironmentMap>(probe, light.world_from_env, light.scale);
+      if (!loaded[l]) {
+        SFT_RETURN_IF_ERROR(LoadProbe(dataset, l, &probes[l]));
+        loaded[l] = true;
       }
-      view.environment = out->environments[l].get();
+      if (light.frame == LightFrame::kCamera) {
+        out->view_environments[v] = std::make_unique<EnvironmentMap>(
+            probes[l], ViewWorldFromEnv(light, spec.cam_from_world), light.scale);
+        view.environment = out->view_environments[v].get();
+      } else {
+        if (out->environments[l] == nullptr) {
+          out->environments[l] =
+              std::make_unique<EnvironmentMap>(probes[l], light.world_from_env, light.scale);
+        }
+        view.environment = out->environments[l].get();
+      }
       view.environment_light_index = l;
     }
     view.environment_background =

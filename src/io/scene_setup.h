@@ -1,6 +1,7 @@
 // Turns a dataset's cameras, lights and views into the renderer's per-view setups: camera-attached
 // point lights are moved to the world frame (world position = C + Rᵀ·offset, C the camera centre),
-// environment probes are loaded once and shared by the views that use them.
+// environment probes are loaded once and shared by the views that use them (a camera-fixed
+// environment gets one map per view, turned with the camera).
 #ifndef SFT_IO_SCENE_SETUP_H_
 #define SFT_IO_SCENE_SETUP_H_
 
@@ -17,9 +18,19 @@
 namespace sft {
 
 struct DatasetViews {
-  std::vector<std::unique_ptr<EnvironmentMap>> environments;  // owned; indexed like lights.
-  std::vector<ViewSetup> views;                               // point into `environments`.
+  // World-fixed environment maps, owned; indexed like lights (null for other lights).
+  std::vector<std::unique_ptr<EnvironmentMap>> environments;
+  // Camera-fixed environment maps, owned; indexed like views (null when the view's environment,
+  // if any, is world-fixed): one per view, turned with its camera.
+  std::vector<std::unique_ptr<EnvironmentMap>> view_environments;
+  std::vector<ViewSetup> views;  // point into `environments` and `view_environments`.
 };
+
+// The rotation that takes `light`'s env directions to the world frame in the view whose pose is
+// `cam_from_world`: light.world_from_env for a world-fixed environment; for a camera-fixed one
+// (light.frame kCamera), whose world_from_env takes env directions to the camera frame, the
+// camera's world_from_cam rotation times it.
+Eigen::Matrix3d ViewWorldFromEnv(const LightSpec& light, const Rigid3d& cam_from_world);
 
 // What rendering one view holds at once, in RGBA float images of the camera's size: the render,
 // the target read back for comparison, and the report's difference and thumbnails (about one

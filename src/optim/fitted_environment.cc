@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <nlohmann/json.hpp>
 
 #include "src/core/file_util.h"
 #include "src/image/image_io.h"
@@ -62,7 +63,44 @@ Status InitialEnvironment(const Dataset& dataset, const EnvironmentEstimateOptio
   return Status::Ok();
 }
 
-Status AddFittedEnvironment(const Image& texels, Dataset* dataset) {
+bool LightFrameFromName(const std::string& name, LightFrame* frame) {
+  if (name == "world" || name == "camera") {
+    *frame = name == "camera" ? LightFrame::kCamera : LightFrame::kWorld;
+    return true;
+  }
+  return false;
+}
+
+const char* LightFrameName(LightFrame frame) {
+  return frame == LightFrame::kCamera ? "camera" : "world";
+}
+
+Status WriteFittedEnvironment(const std::string& run, const Image& texels, LightFrame frame) {
+  SFT_RETURN_IF_ERROR(WriteExr(JoinPath(run, kFittedEnvironmentFile), texels));
+  const nlohmann::json info = {{"format", "sft-fitted-environment/1"},
+                               {"frame", LightFrameName(frame)}};
+  return WriteTextFile(JoinPath(run, kFittedEnvironmentInfoFile), info.dump(1) + "\n");
+}
+
+Status ReadFittedEnvironmentFrame(const std::string& run, LightFrame* frame) {
+  *frame = LightFrame::kWorld;
+  const std::string path = JoinPath(run, kFittedEnvironmentInfoFile);
+  if (!FileExists(path)) return Status::Ok();
+  std::string text;
+  SFT_RETURN_IF_ERROR(ReadTextFile(path, &text));
+  const nlohmann::json info = nlohmann::json::parse(text, nullptr, /*allow_exceptions=*/false);
+  if (!info.is_object() || info.value("format", "") != "sft-fitted-environment/1") {
+    return Status::Error(path + ": not a fitted environment's info (expected format " +
+                         "\"sft-fitted-environment/1\")");
+  }
+  const nlohmann::json& name = info.contains("frame") ? info["frame"] : nlohmann::json();
+  if (!name.is_string() || !LightFrameFromName(name.get<std::string>(), frame)) {
+    return Status::Error(path + ": frame: expected \"world\" or \"camera\"");
+  }
+  return Status::Ok();
+}
+
+Status AddFittedEnvironment(const Image& texels, LightFrame frame, Dataset* dataset) {
   if (!LightingUnknown(*dataset)) {
     return Status::Error(
         "a fitted environment replaces unknown lighting only: the dataset's views have lights");
@@ -73,6 +111,7 @@ Status AddFittedEnvironment(const Image& texels, Dataset* dataset) {
   LightSpec light;
   light.id = kFittedEnvironmentId;
   light.type = LightType::kEnvironment;
+  light.frame = frame;
   light.pixels = texels;
   const int index = static_cast<int>(dataset->lights.size());
   dataset->lights.push_back(std::move(light));
@@ -97,8 +136,10 @@ Status PrepareUnknownLighting(const std::string& run, const EnvironmentEstimateO
   note->clear();
   if (!LightingUnknown(*dataset)) return Status::Ok();
   Image texels;
+  LightFrame frame = options.frame;
   const std::string saved = run.empty() ? "" : JoinPath(run, kFittedEnvironmentFile);
   if (!saved.empty() && FileExists(saved)) {
+    SFT_RETURN_IF_ERROR(ReadFittedEnvironmentFrame(run, &frame));
     Image image;
     SFT_RETURN_IF_ERROR(ReadImage(saved, &image));
     if (image.width < 2 || image.height < 1 || image.channels < 3) {
@@ -113,16 +154,17 @@ Status PrepareUnknownLighting(const std::string& run, const EnvironmentEstimateO
                              ") is negative or not finite (radiance must be finite and >= 0)");
       }
     }
-    *note = "lighting: unknown in the dataset; continuing the fitted " +
-            std::to_string(texels.width) + "×" + std::to_string(texels.height) +
-            " environment of " + saved;
+    *note = std::string("lighting: unknown in the dataset; continuing the fitted ") +
+            std::to_string(texels.width) + "×" + std::to_string(texels.height) + " " +
+            LightFrameName(frame) + "-fixed environment of " + saved;
   } else {
     SFT_RETURN_IF_ERROR(InitialEnvironment(*dataset, options, &texels));
-    *note = "lighting: unknown in the dataset (no view lists lights); fitting a world-fixed " +
+    *note = std::string("lighting: unknown in the dataset (no view lists lights); fitting a ") +
+            (frame == LightFrame::kCamera ? "camera-fixed " : "world-fixed ") +
             std::to_string(texels.width) + "×" + std::to_string(texels.height) +
             " environment with the material (albedo is then known up to one scale per channel)";
   }
-  return AddFittedEnvironment(texels, dataset);
+  return AddFittedEnvironment(texels, frame, dataset);
 }
 
 }  // namespace sft

@@ -26,11 +26,18 @@ namespace sft {
 
 constexpr char kFittedEnvironmentId[] = "fitted_environment";
 constexpr char kFittedEnvironmentFile[] = "environment.exr";
+// Beside it: {"format": "sft-fitted-environment/1", "frame": "world" | "camera"}. A run folder
+// without it (runs before camera-fixed maps) holds a world-fixed map.
+constexpr char kFittedEnvironmentInfoFile[] = "environment.json";
 
 struct EnvironmentEstimateOptions {
   int width = 32;               // texels around the horizon (u), [2, 512].
   int height = 16;              // texels from pole to pole (v), [1, 256].
   double assumed_albedo = 0.5;  // the gauge (above), (0, 1].
+  // Where the map is fixed: kWorld (lights in the room, the default) or kCamera (lights that ride
+  // with the camera: a ring light, a lamp on the gantry's camera arm, a turntable capture; the
+  // map's frame is then each view's camera frame, z-up in the env convention).
+  LightFrame frame = LightFrame::kWorld;
 
   bool Check(std::string* why) const;
 };
@@ -43,17 +50,29 @@ bool LightingUnknown(const Dataset& dataset);
 Status InitialEnvironment(const Dataset& dataset, const EnvironmentEstimateOptions& options,
                           Image* texels);
 
-// Adds the light kFittedEnvironmentId with map `texels` (world frame = env frame, scale 1) to
-// `dataset` and makes it every view's only light. Refuses a dataset whose views have lights.
-Status AddFittedEnvironment(const Image& texels, Dataset* dataset);
+// Adds the light kFittedEnvironmentId with map `texels` (fixed in `frame`, whose axes are the
+// env frame's; scale 1) to `dataset` and makes it every view's only light. Refuses a dataset
+// whose views have lights.
+Status AddFittedEnvironment(const Image& texels, LightFrame frame, Dataset* dataset);
+
+// Writes the fitted map and its frame into run folder `run` (kFittedEnvironmentFile,
+// kFittedEnvironmentInfoFile).
+Status WriteFittedEnvironment(const std::string& run, const Image& texels, LightFrame frame);
+// The frame of the map in run folder `run` (world when it has no kFittedEnvironmentInfoFile).
+// Errors name the file.
+Status ReadFittedEnvironmentFrame(const std::string& run, LightFrame* frame);
+// "world" or "camera"; false for other names.
+bool LightFrameFromName(const std::string& name, LightFrame* frame);
+const char* LightFrameName(LightFrame frame);
 
 // Index of the fitted environment light in dataset.lights, -1 when there is none.
 int FittedEnvironmentLight(const Dataset& dataset);
 
 // What `sft reconstruct` does with a dataset before fitting it: when its lighting is unknown
 // (LightingUnknown), adds the fitted environment — the checkpoint's `run`/kFittedEnvironmentFile
-// when `run` is a run folder holding one (--resume), else InitialEnvironment — and sets *note to
-// the one console line saying so; otherwise changes nothing (*note empty). Errors name the file.
+// in its recorded frame when `run` is a run folder holding one (--resume, sft eval), else
+// InitialEnvironment in options.frame — and sets *note to the one console line saying so;
+// otherwise changes nothing (*note empty). Errors name the file.
 Status PrepareUnknownLighting(const std::string& run, const EnvironmentEstimateOptions& options,
                               Dataset* dataset, std::string* note);
 

@@ -110,6 +110,7 @@ std::vector<std::vector<char> > StateParts(const RenderState& s) {
   settings.Put(s.image_scale_log2);
   settings.PutVector(s.view_indices);
   PutImage(s.environment, &environment);
+  environment.Put(s.environment_frame);
   parts[kScenePart] = std::move(scene.bytes());
   parts[kPositionsPart] = std::move(positions.bytes());
   parts[kMaterialPart] = std::move(material.bytes());
@@ -145,6 +146,7 @@ void ApplyStatePart(int part, const std::vector<char>& bytes, RenderState* s) {
       break;
     case kEnvironmentPart:
       s->environment = GetImage(&r);
+      s->environment_frame = r.Get<LightFrame>();
       break;
   }
 }

@@ -229,20 +229,15 @@ void RenderCache::UpdateScene() {
   }
   params_->WriteMaterial(&material_);
   if (params_->has_environment()) {
-    Image texels = params_->EnvironmentTexels();
-    if (!fitted_environment_ || texels.data != fitted_texels_.data) {
-      const LightSpec& light = dataset_->lights.at(params_->layout().environment_light);
-      fitted_environment_ =
-          std::make_unique<EnvironmentMap>(texels, light.world_from_env, light.scale);
-      fitted_texels_ = std::move(texels);
-    }
+    fitted_environment_.Update(params_->EnvironmentTexels(), *dataset_,
+                               params_->layout().environment_light);
   }
 }
 
 ViewSetup RenderCache::ScaledView(int v) const {
   ViewSetup view =
       ScaledViewSetup(*views_, view_indices_[v], options_.image_scale_log2, params_->LightScales());
-  UseFittedEnvironment(params_->layout(), fitted_environment_.get(), &view);
+  UseFittedEnvironment(params_->layout(), fitted_environment_, view_indices_[v], &view);
   return view;
 }
 
@@ -268,7 +263,10 @@ RenderState RenderCache::CurrentState(const RenderOptions& render,
   state.layout = params_->layout();
   state.image_scale_log2 = options_.image_scale_log2;
   state.view_indices = view_indices_;
-  if (params_->has_environment()) state.environment = fitted_texels_;
+  if (params_->has_environment()) {
+    state.environment = fitted_environment_.texels();
+    state.environment_frame = dataset_->lights.at(params_->layout().environment_light).frame;
+  }
   return state;
 }
 

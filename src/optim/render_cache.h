@@ -231,8 +231,8 @@ class RenderCache : public ceres::EvaluationCallback {
   std::vector<Eigen::Vector3d> scene_positions_;
   // The fitted environment at the current parameters (SceneParameters::has_environment): the map
   // views of that light render with instead of the dataset's, rebuilt when its texels change.
-  std::unique_ptr<EnvironmentMap> fitted_environment_;
-  Image fitted_texels_;  // the map's texels (SceneParameters::EnvironmentTexels).
+  // The maps of the fitted environment's texels (SceneParameters::EnvironmentTexels).
+  FittedEnvironmentMaps fitted_environment_;
   // The scene's identity for other ranks (RenderState::scene_id), its faces and first positions.
   int64_t scene_id_ = 0;
   std::vector<Eigen::Vector3i> faces_;

@@ -524,7 +524,8 @@ Status Schedule::Checkpoint() {
   SFT_RETURN_IF_ERROR(
       WriteRunSnapshot(out_, *dataset_, current_.mesh, current_.material, current_.light_scales));
   if (!current_.environment.empty()) {
-    SFT_RETURN_IF_ERROR(WriteExr(JoinPath(out_, kFittedEnvironmentFile), current_.environment));
+    const LightSpec& light = dataset_->lights.at(FittedEnvironmentLight(*dataset_));
+    SFT_RETURN_IF_ERROR(WriteFittedEnvironment(out_, current_.environment, light.frame));
   }
   // Before state.json (the commit point): see src/optim/adam_checkpoint.h.
   if (reconstruction_ && !reconstruction_->adam_state().m.empty()) {

@@ -4,7 +4,8 @@
 //   - "schedule": a built-in stage list, "auto" (default: "hull" when the run starts from a
 //     carved hull, "refine" otherwise), "refine" or "hull";
 //   - "stages": an explicit stage list (an array of objects) instead of a built-in one;
-//   - "holdout": K, every K-th selected view is kept out of the fit (src/optim/holdout.h).
+//   - "holdout": K, every K-th selected view is kept out of the fit (src/optim/holdout.h);
+//   - "environment_frame": "world" or "camera", where unknown lighting's fitted map is fixed.
 // A stage object holds any flat key plus "name", and the stage-only keys "texel_resolution",
 // "remesh", "remesh_edge_pixels", "resample", "resample_fold_fraction", "material_model" and
 // "texture_size" (the effect planner's keys, "effects": "auto" and "pin", are flat keys: config.h).
@@ -28,6 +29,10 @@ struct ScheduleConfig {
   nlohmann::json flat = nlohmann::json::object();  // keys that override every stage.
   int holdout = 0;             // "holdout": every K-th selected view held out; 0 = off, K >= 2.
   bool holdout_given = false;  // "holdout" was given (a resumed run must not change it).
+  // "environment_frame": where a fitted environment (unknown lighting) is fixed, "world" or
+  // "camera" (src/optim/fitted_environment.h).
+  std::string environment_frame = "world";
+  bool environment_frame_given = false;  // given (a resumed run must not change it).
 };
 
 // Adds `config`'s keys to *out (later calls override earlier ones key by key; "stages" and

@@ -5,14 +5,6 @@
 #include "src/optim/fitted_environment.h"
 
 namespace sft {
-namespace {
-
-bool SameImage(const Image& a, const Image& b) {
-  return a.width == b.width && a.height == b.height && a.channels == b.channels && a.data == b.data;
-}
-
-}  // namespace
-
 Status StateRenderer::Create(const Dataset& dataset, std::unique_ptr<StateRenderer>* renderer) {
   std::unique_ptr<StateRenderer> r(new StateRenderer());
   r->dataset_ = dataset;
@@ -38,7 +30,8 @@ Status StateRenderer::Update(const RenderState& state) {
 Status StateRenderer::UpdateEnvironment(const RenderState& state) {
   if (FittedEnvironmentLight(dataset_) < 0) {
     // The map the views are set up with is replaced by the state's below.
-    SFT_RETURN_IF_ERROR(AddFittedEnvironment(state.environment, &dataset_));
+    SFT_RETURN_IF_ERROR(
+        AddFittedEnvironment(state.environment, state.environment_frame, &dataset_));
     SFT_RETURN_IF_ERROR(MakeDatasetViews(dataset_, &views_));
   }
   const int light = FittedEnvironmentLight(dataset_);
@@ -49,19 +42,14 @@ Status StateRenderer::UpdateEnvironment(const RenderState& state) {
                          std::to_string(state.layout.environment_light) +
                          " of rank 0's (the ranks read different datasets)");
   }
-  if (!fitted_environment_ || !SameImage(state.environment, fitted_texels_)) {
-    const LightSpec& spec = dataset_.lights[light];
-    fitted_environment_ =
-        std::make_unique<EnvironmentMap>(state.environment, spec.world_from_env, spec.scale);
-    fitted_texels_ = state.environment;
-  }
+  fitted_environment_.Update(state.environment, dataset_, light);
   return Status::Ok();
 }
 
 void StateRenderer::Render(const RenderState& state, const ViewJob& job, ViewResult* result) const {
   ViewSetup view = ScaledViewSetup(views_, state.view_indices[job.view], state.image_scale_log2,
                                    state.light_scales);
-  UseFittedEnvironment(state.layout, fitted_environment_.get(), &view);
+  UseFittedEnvironment(state.layout, fitted_environment_, state.view_indices[job.view], &view);
   RenderViewJob(*scene_, state.material, view, state.render, state.request, state.layout, job,
                 result);
 }

@@ -44,8 +44,7 @@ class StateRenderer {
   std::unique_ptr<RenderScene> scene_;
   int64_t scene_id_ = -1;
   std::vector<Eigen::Vector3d> scene_positions_;
-  std::unique_ptr<EnvironmentMap> fitted_environment_;
-  Image fitted_texels_;
+  FittedEnvironmentMaps fitted_environment_;  // the maps of the state's environment texels.
 };
 
 }  // namespace sft

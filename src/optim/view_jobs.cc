@@ -1,5 +1,7 @@
 #include "src/optim/view_jobs.h"
 
+#include <glog/logging.h>
+
 #include "src/render/camera.h"
 
 namespace sft {
@@ -22,9 +24,37 @@ ViewSetup ScaledViewSetup(const DatasetViews& views, int dataset_view, int image
   return view;
 }
 
-void UseFittedEnvironment(const ParameterLayout& layout, const EnvironmentMap* fitted,
-                          ViewSetup* view) {
-  if (layout.FitsEnvironment(view->environment_light_index)) view->environment = fitted;
+void FittedEnvironmentMaps::Update(const Image& texels, const Dataset& dataset, int light) {
+  if (!maps_.empty() && texels.width == texels_.width && texels.height == texels_.height &&
+      texels.channels == texels_.channels && texels.data == texels_.data) {
+    return;
+  }
+  const LightSpec& spec = dataset.lights.at(light);
+  per_view_ = spec.frame == LightFrame::kCamera;
+  maps_.clear();
+  if (!per_view_) {
+    maps_.push_back(std::make_unique<EnvironmentMap>(texels, spec.world_from_env, spec.scale));
+  } else {
+    for (const ViewSpec& view : dataset.views) {
+      maps_.push_back(std::make_unique<EnvironmentMap>(
+          texels, ViewWorldFromEnv(spec, view.cam_from_world), spec.scale));
+    }
+  }
+  texels_ = texels;
+}
+
+const EnvironmentMap* FittedEnvironmentMaps::ForView(int dataset_view) const {
+  if (maps_.empty()) return nullptr;
+  if (!per_view_) return maps_[0].get();
+  CHECK(dataset_view >= 0 && dataset_view < static_cast<int>(maps_.size())) << dataset_view;
+  return maps_[dataset_view].get();
+}
+
+void UseFittedEnvironment(const ParameterLayout& layout, const FittedEnvironmentMaps& fitted,
+                          int dataset_view, ViewSetup* view) {
+  if (layout.FitsEnvironment(view->environment_light_index)) {
+    view->environment = fitted.ForView(dataset_view);
+  }
 }
 
 void RenderViewJob(const RenderScene& scene, const Material& material, const ViewSetup& view,

@@ -71,6 +71,8 @@ struct RenderState {
   // A fitted environment's texels at this point (SceneParameters::EnvironmentTexels: the map of
   // dataset light layout.environment_light, RGB); empty without one.
   Image environment;
+  // Where that map is fixed: the world, or each view's camera (LightSpec::frame).
+  LightFrame environment_frame = LightFrame::kWorld;
 };
 
 // View `dataset_view` of `views` as the fit renders it: its camera downscaled by
@@ -78,10 +80,27 @@ struct RenderState {
 ViewSetup ScaledViewSetup(const DatasetViews& views, int dataset_view, int image_scale_log2,
                           const std::vector<double>& light_scales);
 
-// Makes a view render with the fitted environment `fitted` (the map of the state's texels) when
-// its environment light is the one whose texels `layout` fits.
-void UseFittedEnvironment(const ParameterLayout& layout, const EnvironmentMap* fitted,
-                          ViewSetup* view);
+// The renderer's maps of a fitted environment's texels: one map when the light is world-fixed,
+// one per dataset view when it is camera-fixed (LightSpec::frame; ViewWorldFromEnv).
+class FittedEnvironmentMaps {
+ public:
+  // Rebuilds the maps when `texels` (RGB) differ from the last call's, for light `light` of
+  // `dataset`.
+  void Update(const Image& texels, const Dataset& dataset, int light);
+  // The map view `dataset_view` renders with; null before the first Update.
+  const EnvironmentMap* ForView(int dataset_view) const;
+  const Image& texels() const { return texels_; }
+
+ private:
+  Image texels_;
+  bool per_view_ = false;
+  std::vector<std::unique_ptr<EnvironmentMap>> maps_;  // one, or one per dataset view.
+};
+
+// Makes dataset view `dataset_view`'s setup render with the fitted environment (the maps of the
+// state's texels) when its environment light is the one whose texels `layout` fits.
+void UseFittedEnvironment(const ParameterLayout& layout, const FittedEnvironmentMaps& fitted,
+                          int dataset_view, ViewSetup* view);
 
 // Renders `job` of `view` (its ScaledViewSetup, UseFittedEnvironment) on `scene` with `material`
 // and the options, its rows or gradient in `layout`'s index space; the request's jacobian_rows

@@ -76,14 +76,16 @@ class ReconstructMpiTest : public ::testing::Test {
 
   // One process, then 2 ranks, on `dataset` (a folder of tmp_): every result file must be
   // identical, and rank 1 must have rendered some of the views.
-  void ExpectSameAcrossRanks(const std::string& solver, const std::string& dataset = "ds") {
+  // `flags` are added to both runs; `tag` names their folders (DATASET_SOLVERTAG1 and ..2).
+  void ExpectSameAcrossRanks(const std::string& solver, const std::string& dataset = "ds",
+                             const std::string& flags = "", const std::string& tag = "") {
     const std::string args = "reconstruct --quiet --no-report --dataset " + tmp_.Join(dataset) +
                              " --init " + tmp_.Join("init.ply") +
                              " --spp 4 --bounces 1 --steps 2 --outer 1 --phases alternate"
-                             " --threads 1 --solver " +
-                             solver + " --out ";
-    const std::string one_dir = tmp_.Join(dataset + "_" + solver + "1");
-    const std::string two_dir = tmp_.Join(dataset + "_" + solver + "2");
+                             " --threads 1 " +
+                             flags + " --solver " + solver + " --out ";
+    const std::string one_dir = tmp_.Join(dataset + "_" + solver + tag + "1");
+    const std::string two_dir = tmp_.Join(dataset + "_" + solver + tag + "2");
     std::string out;
     ASSERT_EQ(testing::RunSft(args + one_dir, &out), 0) << out;
     ASSERT_EQ(testing::RunCommand(mpirun_ + " -np 2 " + testing::SftBinary() + " " + args + two_dir,
@@ -126,6 +128,19 @@ TEST_F(ReconstructMpiTest, FittedEnvironmentIsBitIdenticalOnTwoRanks) {
   ExpectSameAcrossRanks("adam", "ds_unlit");
   EXPECT_TRUE(fs::exists(tmp_.Join("ds_unlit_lm2/environment.exr")));
   EXPECT_TRUE(fs::exists(tmp_.Join("ds_unlit_adam2/environment.exr")));
+}
+
+// A camera-fixed fitted map (--environment-frame camera): every view turns it with its camera, on
+// whichever rank renders the view, and the run records its frame.
+TEST_F(ReconstructMpiTest, CameraFixedEnvironmentIsBitIdenticalOnTwoRanks) {
+  MakeUnlitDataset();
+  ExpectSameAcrossRanks("lm", "ds_unlit", "--environment-frame camera", "_camera");
+  const std::string info = testing::ReadTestFile(tmp_.Join("ds_unlit_lm_camera2/environment.json"));
+  EXPECT_NE(info.find("\"camera\""), std::string::npos) << info;
+  // The same fit with the map fixed in the world gives another map.
+  ExpectSameAcrossRanks("lm", "ds_unlit", "", "_world");
+  EXPECT_NE(testing::ReadTestFile(tmp_.Join("ds_unlit_lm_camera1/environment.exr")),
+            testing::ReadTestFile(tmp_.Join("ds_unlit_lm_world1/environment.exr")));
 }
 
 // More ranks than views, and a worker that cannot read the dataset (its working directory has

@@ -109,8 +109,27 @@ TEST_F(FittedEnvironmentTest, BadSavedEnvironmentNamesTheFile) {
   ASSERT_TRUE(WriteExr(saved, map).ok());
   dataset = dataset_;
   ASSERT_TRUE(PrepareUnknownLighting(run.path(), options, &dataset, &note).ok());
-  EXPECT_THAT(note, HasSubstr("continuing the fitted 4×2 environment"));
+  EXPECT_THAT(note, HasSubstr("continuing the fitted 4×2 world-fixed environment"));
   EXPECT_FALSE(LightingUnknown(dataset));
+
+  // The map's frame comes from environment.json beside it (none: world-fixed, as runs before it).
+  const int light = FittedEnvironmentLight(dataset);
+  ASSERT_GE(light, 0);
+  EXPECT_EQ(dataset.lights[light].frame, LightFrame::kWorld);
+  ASSERT_TRUE(WriteFittedEnvironment(run.path(), map, LightFrame::kCamera).ok());
+  dataset = dataset_;
+  ASSERT_TRUE(PrepareUnknownLighting(run.path(), options, &dataset, &note).ok());
+  EXPECT_THAT(note, HasSubstr("camera-fixed environment"));
+  EXPECT_EQ(dataset.lights[FittedEnvironmentLight(dataset)].frame, LightFrame::kCamera);
+  const std::string info = run.Join(kFittedEnvironmentInfoFile);
+  for (const char* bad : {"{\"format\": \"sft-fitted-environment/1\", \"frame\": \"object\"}",
+                          "{\"format\": \"other\"}", "not json"}) {
+    testing::WriteTestFile(info, bad);
+    dataset = dataset_;
+    status = PrepareUnknownLighting(run.path(), options, &dataset, &note);
+    ASSERT_FALSE(status.ok()) << bad;
+    EXPECT_THAT(status.message(), HasSubstr(info)) << bad;
+  }
 }
 
 // The start map is constant: the photographs' mean over the masks over the assumed albedo; the
@@ -201,6 +220,99 @@ TEST_F(FittedEnvironmentTest, FitRecoversTheBrightSideOfAnUnknownProbe) {
   ASSERT_GT(right, 0.0);
   // Measured 7.2 (spp 8, two outer iterations); the start is 1.
   EXPECT_GT(left / right, 5.0) << "left " << left << " right " << right;
+}
+
+// Lights that ride with the camera (environment_frame "camera"): an icosphere lit only by a
+// flash far to the camera's upper right, seen from 6 views around it. In every photograph the
+// sphere is lit from the image's upper right, which no world-fixed map can give all views, and
+// which a camera-fixed map can: its fit must explain the photographs far better, with its bright
+// texels towards the flash.
+class CameraFixedEnvironmentTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = new testing::TempDir();
+    ASSERT_EQ(testing::SynthIcosphere(dir_->Join("ds"),
+                                      "--cameras 6 --zooms 1 --res 32 --spp 64 --bounces 1 "
+                                      "--shading flat --light-offset 3,-3,0 "
+                                      "--material '{\"albedo\": [0.6, 0.6, 0.6], "
+                                      "\"roughness\": 0.6, \"specular\": 0}'"),
+              "");
+  }
+  static void TearDownTestSuite() {
+    delete dir_;
+    dir_ = nullptr;
+  }
+
+  // The final cost of a 2-outer texture fit of an 8×4 map fixed in `frame` (and its map).
+  double Fit(LightFrame frame, Image* env) {
+    Dataset dataset;
+    EXPECT_TRUE(ReadDataset(dir_->Join("ds"), &dataset).ok());
+    dataset.lights.clear();
+    for (ViewSpec& view : dataset.views) {
+      view.lights.clear();
+      view.light_ids.clear();
+    }
+    TriMesh mesh;
+    EXPECT_TRUE(ReadMesh(dir_->Join("ds/gt/mesh.ply"), &mesh).ok());
+    EnvironmentEstimateOptions estimate;
+    estimate.width = 8;
+    estimate.height = 4;
+    estimate.frame = frame;
+    std::string note;
+    EXPECT_TRUE(PrepareUnknownLighting("", estimate, &dataset, &note).ok());
+    EXPECT_THAT(note, HasSubstr(frame == LightFrame::kCamera ? "camera-fixed" : "world-fixed"));
+    Material start;
+    EXPECT_TRUE(LoadMaterial(R"({"albedo": [0.5, 0.5, 0.5], "roughness": 0.6, "resolution": 1})",
+                             mesh, &start)
+                    .ok());
+    ReconstructOptions options;
+    options.phases = PhaseSchedule::kTexture;
+    options.cache.render.spp = 8;
+    options.cache.render.bounces = 1;
+    options.cache.pyramid_levels = 2;
+    options.planner.enabled = false;
+    options.regularizers.albedo_smoothness = 100.0;  // the shading must come from the lighting.
+    options.regularizers.environment_smoothness = 0.01;
+    std::unique_ptr<Reconstruction> r;
+    EXPECT_TRUE(Reconstruction::Create(dataset, mesh, start, {}, options, &r).ok());
+    if (r == nullptr) return std::numeric_limits<double>::infinity();
+    double cost = std::numeric_limits<double>::infinity();
+    for (int outer = 0; outer < 2; ++outer) {
+      EXPECT_TRUE(r->RunOuter(outer, [&](const IterationRecord& rec) {
+                     cost = rec.cost;
+                     return true;
+                   }).ok());
+    }
+    *env = r->EnvironmentTexels();
+    return cost;
+  }
+
+  static testing::TempDir* dir_;
+};
+
+testing::TempDir* CameraFixedEnvironmentTest::dir_ = nullptr;
+
+TEST_F(CameraFixedEnvironmentTest, ExplainsAFlashThatAWorldFixedMapCannot) {
+  Image world_env, camera_env;
+  const double world = Fit(LightFrame::kWorld, &world_env);
+  const double camera = Fit(LightFrame::kCamera, &camera_env);
+  std::printf("final cost: world-fixed %.4g, camera-fixed %.4g\n", world, camera);
+  EXPECT_LT(camera, 0.5 * world);
+  // The flash sits at camera (3, −3, 0) from a camera about 3 units from the sphere: from the
+  // sphere it is towards camera (+x, −y, −z), i.e. u in (0.5, 0.75) (atan2(y, x) < 0) and
+  // v > 0.5 (z < 0). The map's brightest texel must be in that quadrant.
+  int best_x = 0, best_y = 0;
+  for (int y = 0; y < camera_env.height; ++y) {
+    for (int x = 0; x < camera_env.width; ++x) {
+      if (camera_env.at(x, y, 1) > camera_env.at(best_x, best_y, 1)) {
+        best_x = x;
+        best_y = y;
+      }
+    }
+  }
+  EXPECT_GE(best_x, 4) << best_x << "," << best_y;
+  EXPECT_LE(best_x, 6) << best_x << "," << best_y;
+  EXPECT_GE(best_y, 2) << best_x << "," << best_y;
 }
 
 }  // namespace

@@ -38,6 +38,7 @@ RenderState SomeState() {
   s.view_indices = {0, 2, 3};
   s.environment = Image(4, 2, 3);
   for (size_t k = 0; k < s.environment.data.size(); ++k) s.environment.data[k] = 0.1f * k;
+  s.environment_frame = LightFrame::kCamera;
   return s;
 }
 
@@ -78,6 +79,7 @@ TEST(MpiWireTest, StateReadsBackAsWritten) {
   EXPECT_EQ(r.environment.height, 2);
   EXPECT_EQ(r.environment.channels, 3);
   EXPECT_EQ(r.environment.data, s.environment.data);
+  EXPECT_EQ(r.environment_frame, LightFrame::kCamera);
 }
 
 TEST(MpiWireTest, StateWithoutEnvironmentReadsBackEmpty) {

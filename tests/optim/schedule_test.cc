@@ -25,6 +25,24 @@ namespace {
 using json = nlohmann::json;
 using ::testing::HasSubstr;
 
+// "environment_frame" is a run-level key: "world" (default) or "camera"; anything else is one
+// error naming the file and the key.
+TEST(ScheduleConfigTest, EnvironmentFrameIsWorldOrCamera) {
+  ScheduleConfig config;
+  EXPECT_EQ(config.environment_frame, "world");
+  EXPECT_FALSE(config.environment_frame_given);
+  ASSERT_TRUE(MergeScheduleConfig({{"environment_frame", "camera"}}, "cfg", &config).ok());
+  EXPECT_EQ(config.environment_frame, "camera");
+  EXPECT_TRUE(config.environment_frame_given);
+  EXPECT_TRUE(config.flat.empty());  // not a stage key.
+  for (const json& bad : {json("object"), json(1)}) {
+    ScheduleConfig other;
+    const Status status = MergeScheduleConfig({{"environment_frame", bad}}, "cfg.json", &other);
+    ASSERT_FALSE(status.ok()) << bad;
+    EXPECT_EQ(status.message(), "cfg.json: environment_frame: expected \"world\" or \"camera\"");
+  }
+}
+
 TEST(ScheduleConfigTest, FlatKeysOverrideEveryStage) {
   ScheduleConfig config;
   ASSERT_TRUE(MergeScheduleConfig(json::parse(R"({
