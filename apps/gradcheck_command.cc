@@ -75,7 +75,10 @@ int RunConsistency(const GradcheckCommandOptions& opts, const GradcheckOptions& 
 
 int RunGradcheckCommand(const GradcheckCommandOptions& opts) {
   GradcheckOptions check = opts.check;
-  if (!ParameterKindFromName(opts.param, &check.kind)) {
+  if (!ParameterKindFromName(opts.param, &check.kind) ||
+      check.kind == ParameterKind::kEnvironment || check.kind == ParameterKind::kLightPosition) {
+    // Fitted environments and light positions are parameters of a fit only (their
+    // finite-difference tests are in tests/render/).
     return PrintError("gradcheck", Status::Error("--param: unknown parameter kind '" + opts.param +
                                                  "' (vertices, albedo, roughness, specular, "
                                                  "light)"));

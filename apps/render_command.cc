@@ -67,8 +67,10 @@ Status RunRender(const RenderCommandOptions& opts) {
   if (render.pass == RenderPass::kColor) SFT_RETURN_IF_ERROR(CheckViewsHaveLights(dataset));
   if (!opts.lights.empty()) {
     std::vector<double> scales;
-    SFT_RETURN_IF_ERROR(ReadLightScales(opts.lights, dataset, &scales));
+    std::vector<Eigen::Vector3d> positions;
+    SFT_RETURN_IF_ERROR(ReadLightScales(opts.lights, dataset, &scales, &positions));
     ApplyLightScales(scales, &dataset);
+    ApplyLightPositions(positions, &dataset);
   }
   TriMesh mesh;
   SFT_RETURN_IF_ERROR(ReadMesh(opts.mesh, &mesh));
