@@ -22,6 +22,9 @@
 #include "src/optim/config.h"
 #include "src/optim/parameters.h"
 #include "src/optim/reconstruct.h"
+#include "src/optim/run_outputs.h"
+#include "src/optim/schedule.h"
+#include "src/optim/schedule_config.h"
 #include "src/render/render.h"
 #include "src/render/scene.h"
 #include "tests/testing/synth_dataset.h"
@@ -201,6 +204,60 @@ TEST_F(LightPositionFitTest, WorldLightMovesTowardsTheTruth) {
   double before = 0.0, after = 0.0;
   Fit(dir_->Join("world"), kTrueWorld, &before, &after);
   EXPECT_LT(after, 0.5 * before);
+}
+
+// A schedule whose first stage fits the world light's position from a displaced start: the
+// checkpoint's lights.json holds the fitted position (not the dataset's), a stop in the second
+// stage (which no longer fits it) resumes from it, and the second stage keeps rendering with it.
+TEST_F(LightPositionFitTest, CheckpointAndResumeKeepTheFittedPosition) {
+  Dataset dataset;
+  ASSERT_TRUE(ReadDataset(dir_->Join("world"), &dataset).ok());
+  ScheduleStart start;
+  ASSERT_TRUE(ReadMesh(dir_->Join("world/gt/mesh.ply"), &start.mesh).ok());
+  ASSERT_TRUE(LoadMaterial(dir_->Join("world/gt/material.json"), start.mesh, &start.material).ok());
+  start.light_positions = {kTrueWorld + kDisplacement};
+  ScheduleConfig config;
+  ASSERT_TRUE(MergeScheduleConfig(nlohmann::json::parse(R"({"spp": 4, "bounces": 1, "steps": 3,
+      "phases": "texture", "shading": "flat", "effects": "direct,shadows",
+      "stages": [{"name": "a", "outer_iterations": 1, "fit_light_positions": true},
+                 {"name": "b", "outer_iterations": 2}]})"),
+                                  "test", &config)
+                  .ok());
+  std::vector<StageOptions> stages;
+  ASSERT_TRUE(ResolveStages(config, false, &stages).ok());
+  const std::string out = dir_->Join("run");
+  std::unique_ptr<Schedule> schedule;
+  ASSERT_TRUE(Schedule::Start(dataset, out, stages, start, {{"dataset", "world"}}, &schedule).ok());
+  ScheduleCallbacks callbacks;
+  callbacks.on_iteration = [](const IterationRecord& r) {
+    return !(r.stage == "b" && r.outer == 2);
+  };
+  ASSERT_TRUE(schedule->Run(callbacks).ok());
+  ASSERT_TRUE(schedule->stopped());
+  const std::vector<Eigen::Vector3d> fitted = schedule->reconstruction()->LightPositions();
+  ASSERT_EQ(fitted.size(), 1u);
+  EXPECT_LT((fitted[0] - kTrueWorld).norm(), 0.75 * kDisplacement.norm());
+
+  TriMesh mesh;
+  Material material;
+  std::vector<double> scales;
+  std::vector<Eigen::Vector3d> saved;
+  ASSERT_TRUE(ReadRunSnapshot(out, dataset, &mesh, &material, &scales, &saved).ok());
+  ASSERT_EQ(saved.size(), 1u);
+  EXPECT_EQ(saved[0], fitted[0]);
+
+  RunState state;
+  ASSERT_TRUE(ReadRunState(out, &state).ok());
+  std::unique_ptr<Schedule> resumed;
+  ASSERT_TRUE(Schedule::Resume(dataset, out, stages, state.run_info, state.progress,
+                               state.view_gains, &resumed)
+                  .ok());
+  callbacks.on_iteration = nullptr;
+  ASSERT_TRUE(resumed->Run(callbacks).ok());
+  ASSERT_TRUE(resumed->finished());
+  const std::vector<Eigen::Vector3d> after = resumed->reconstruction()->LightPositions();
+  ASSERT_EQ(after.size(), 1u);
+  EXPECT_EQ(after[0], fitted[0]) << "stage b does not fit the position but renders with it";
 }
 
 // Malformed positions in lights.json are refused with the file and the entry named.
