@@ -24,7 +24,7 @@ struct GradcheckCommandOptions {
   std::string dataset;           // dataset directory: cameras, lights, views.
   std::string mesh;              // mesh (OBJ, PLY, OFF).
   std::string material;          // material JSON file or inline JSON; "" = default material.
-  std::string param;             // vertices | albedo | roughness | specular | light.
+  std::string param;             // a ParameterKindName but "environment".
   std::string effects = "all";   // enabled effects (Effects::Parse).
   std::string shading = "auto";  // "auto" (the dataset's, DatasetShading), "flat" or "smooth".
   std::string json;              // optional JSON report path.
@@ -75,10 +75,12 @@ int RunConsistency(const GradcheckCommandOptions& opts, const GradcheckOptions& 
 
 int RunGradcheckCommand(const GradcheckCommandOptions& opts) {
   GradcheckOptions check = opts.check;
-  if (!ParameterKindFromName(opts.param, &check.kind)) {
+  if (!ParameterKindFromName(opts.param, &check.kind) ||
+      check.kind == ParameterKind::kEnvironment) {
+    // A fitted environment exists in a fit only (its finite-difference test is in tests/render/).
     return PrintError("gradcheck", Status::Error("--param: unknown parameter kind '" + opts.param +
                                                  "' (vertices, albedo, roughness, specular, "
-                                                 "light)"));
+                                                 "light, light_position)"));
   }
   std::string why;
   if (!Effects::Parse(opts.effects, &check.render.effects, &why)) {
@@ -188,8 +190,9 @@ CommandRunner SetupGradcheckCommand(CLI::App* app) {
       ->required();
   app->add_option("--mesh", opts->mesh, "Mesh (OBJ, PLY, OFF)")->required();
   app->add_option("--material", opts->material, "Material JSON file or inline JSON");
-  app->add_option("--param", opts->param,
-                  "Parameter kind: vertices | albedo | roughness | specular | light")
+  app->add_option(
+         "--param", opts->param,
+         "Parameter kind: vertices | albedo | roughness | specular | light | light_position")
       ->required();
   app->add_option("--spp", opts->check.render.spp,
                   "Samples per pixel (vertices: finite differences of moving edges need many: "

@@ -39,6 +39,11 @@ ViewSetup PerturbView(const ViewSetup& base, const ParameterLayout& layout,
   if (view.environment_light_index >= 0) {
     view.environment_scale *= 1.0 + t * delta[layout.LightOffset() + view.environment_light_index];
   }
+  for (PointLight& light : view.point_lights) {
+    if (!layout.FitsLightPosition(light.light_index)) continue;
+    const Eigen::Vector3d d(&delta[layout.LightPositionOffset() + 3 * light.light_index]);
+    light.position += t * (LightPositionJacobian(view, light) * d);
+  }
   return view;
 }
 
@@ -257,8 +262,11 @@ Status PrepareGradcheck(const Dataset& dataset, const GradcheckOptions& options,
   SFT_RETURN_IF_ERROR(MakeDatasetViews(dataset, &setup->views));
   SFT_RETURN_IF_ERROR(
       SelectViews(options.views, static_cast<int>(setup->views.views.size()), &setup->selected));
-  setup->block =
-      options.block > 0 ? options.block : (options.kind == ParameterKind::kVertex ? 8 : 1);
+  setup->block = options.block > 0 ? options.block
+                                   : (options.kind == ParameterKind::kVertex ||
+                                              options.kind == ParameterKind::kLightPosition
+                                          ? 8
+                                          : 1);
   return Status::Ok();
 }
 
@@ -271,8 +279,9 @@ Status RunGradcheck(const Dataset& dataset, const TriMesh& mesh, const Material&
   const std::vector<int>& selected = setup.selected;
   const int block = setup.block;
   const RenderScene scene(mesh);
-  const ParameterLayout layout =
+  ParameterLayout layout =
       MakeParameterLayout(scene, material, static_cast<int>(dataset.lights.size()));
+  layout.light_positions = options.kind == ParameterKind::kLightPosition;
   const bool vertices = options.kind == ParameterKind::kVertex;
 
   std::vector<double> delta =
@@ -293,7 +302,8 @@ Status RunGradcheck(const Dataset& dataset, const TriMesh& mesh, const Material&
     step = options.kind == ParameterKind::kRoughness ? 1e-4 * std::max(mean_roughness, 0.01)
            : vertices ? kAutomaticVertexStep * GlossyStepFactor(material, options.render.effects) *
                             scene.extent()
-                      : 1e-3;
+           : options.kind == ParameterKind::kLightPosition ? kAutomaticVertexStep * scene.extent()
+                                                           : 1e-3;
   }
 
   RenderOptions render = options.render;
@@ -333,8 +343,8 @@ Status RunGradcheck(const Dataset& dataset, const TriMesh& mesh, const Material&
     Image image, plus, minus;
     DerivativeOutput out;
     RenderStats stats[3];
-    RenderViewWithDerivatives(scene, material, view, render, request,
-                              static_cast<int>(dataset.lights.size()), &image, &out, &stats[0]);
+    RenderViewWithDerivatives(scene, material, view, render, request, layout, &image, &out,
+                              &stats[0]);
     RenderView(vertices ? *plus_scene : scene, plus_material,
                PerturbView(view, layout, delta, step), render, &plus, &stats[1]);
     RenderView(vertices ? *minus_scene : scene, minus_material,

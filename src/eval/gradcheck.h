@@ -24,7 +24,8 @@
 // lands at random pixels along the edges, while the finite difference counts the camera and shadow
 // samples that switch sides (its noise grows like 1/√(h·spp), its truncation error like h because
 // block sums kink as edges cross pixel and block boundaries). Both are noisy per pixel, so the
-// images are compared after summing over B×B pixel blocks (`block`, automatic 8 for vertices), and
+// images are compared after summing over B×B pixel blocks (`block`, automatic 8 for vertices and
+// light positions, whose shadow boundaries move too), and
 // the report adds `projection_error`, the relative error of three smooth global projections Σ_p Σ_c
 // w(p)·I_pc with w = 1, cos(π(x + ½)/W) and cos(π(y + ½)/H) (ill-conditioned when these sums nearly
 // cancel, e.g. an object moving sideways; informative, not part of the pass criterion). The pass
@@ -64,8 +65,11 @@ struct GradcheckOptions {
   std::vector<int> views;                       // view indices; empty = all.
   double step = 0.0;  // finite-difference step h; 0 = automatic per kind (1e-3, 1e-4·r for
                       // roughness r, 5e-3 × the bounding-box diagonal for vertices, times
-                      // clamp(2α, 1/16, 1) with a glossy lobe of width α = r²_min).
-  // Side B of the pixel blocks summed before comparing; 0 = automatic: 8 for vertices (edge
+                      // clamp(2α, 1/16, 1) with a glossy lobe of width α = r²_min; 5e-3 × the
+                      // diagonal for light positions, which move each point light by h·δ_l in
+                      // its own frame, ParameterLayout::light_positions).
+  // Side B of the pixel blocks summed before comparing; 0 = automatic: 8 for vertices and light
+  // positions (edge
   // sampling puts silhouette and shadow-boundary derivatives at random pixels along the edge, and
   // the finite difference of a moving edge is quantised by the camera samples that cross it:
   // both are unbiased but noisy per pixel, and agree on block sums), 1 (per pixel) otherwise.
@@ -124,8 +128,8 @@ Status RunGradcheck(const Dataset& dataset, const TriMesh& mesh, const Material&
 
 // What a check and a consistency measurement (derivative_consistency.h) both start from: the
 // derivative request of the options' kind (Jacobian rows, no adjoint weights), the dataset's
-// per-view setups, the selected views and the block side (0 in the options = 8 for vertices,
-// 1 otherwise).
+// per-view setups, the selected views and the block side (0 in the options = 8 for vertices
+// and light positions, 1 otherwise).
 struct GradcheckSetup {
   DerivativeRequest request;
   DatasetViews views;

@@ -1,10 +1,14 @@
-// The fitted light intensity scales of a reconstruction (`OUT/lights.json`), so that a re-render
-// reproduces the fit: {"format": "sft-light-scales/1", "lights": [{"id": ID, "scale": s}, ...]},
-// one entry per dataset light in dataset order (matched by id on reading). A point light's
-// intensity, or an environment light's scale, is multiplied by s.
+// The fitted lights of a reconstruction (`OUT/lights.json`), so that a re-render reproduces the
+// fit: {"format": "sft-light-scales/1", "lights": [{"id": ID, "scale": s}, ...]}, one entry per
+// dataset light in dataset order (matched by id on reading). A point light's intensity, or an
+// environment light's scale, is multiplied by s. When the run fitted point-light positions
+// (`fit_light_positions`), each point light's entry also has "frame" ("world" or "camera", the
+// dataset light's) and "position" [x, y, z]: the fitted position in that frame, which replaces
+// the dataset's. Readers that do not know the two keys ignore them (the format name stays).
 #ifndef SFT_IO_LIGHT_SCALES_H_
 #define SFT_IO_LIGHT_SCALES_H_
 
+#include <Eigen/Core>
 #include <string>
 #include <vector>
 
@@ -13,14 +17,21 @@
 
 namespace sft {
 
+// `positions`: empty, or one per dataset light (each point light's in its frame; the entries of
+// other lights are not written).
 Status WriteLightScales(const std::string& path, const Dataset& dataset,
-                        const std::vector<double>& scales);
+                        const std::vector<double>& scales,
+                        const std::vector<Eigen::Vector3d>& positions = {});
 // Reads scales for `dataset`'s lights (every dataset light must be listed, by id; scales finite
-// and > 0). Errors name the file and the entry.
-Status ReadLightScales(const std::string& path, const Dataset& dataset,
-                       std::vector<double>* scales);
+// and > 0). With `positions`: empty when no entry has a position, else one per dataset light,
+// the file's where it has one (a point light's only, its frame must be the dataset light's) and
+// the dataset's elsewhere. Errors name the file and the entry.
+Status ReadLightScales(const std::string& path, const Dataset& dataset, std::vector<double>* scales,
+                       std::vector<Eigen::Vector3d>* positions = nullptr);
 // Multiplies the dataset's light intensities (point) and scales (environment) by `scales`.
 void ApplyLightScales(const std::vector<double>& scales, Dataset* dataset);
+// Sets the dataset's point-light positions (in their frames) to `positions` (empty: no change).
+void ApplyLightPositions(const std::vector<Eigen::Vector3d>& positions, Dataset* dataset);
 
 }  // namespace sft
 

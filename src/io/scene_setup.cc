@@ -61,6 +61,7 @@ Status MakeDatasetViews(const Dataset& dataset, DatasetViews* out) {
             light.frame == LightFrame::kCamera ? world_from_cam * light.position : light.position;
         point.intensity = light.intensity;
         point.light_index = l;
+        point.camera_frame = light.frame == LightFrame::kCamera;
         view.point_lights.push_back(point);
         continue;
       }

@@ -104,6 +104,7 @@ std::vector<std::vector<char> > StateParts(const RenderState& s) {
   material.Put(s.material.specular);
   material.Put(s.material.fresnel);
   settings.PutVector(s.light_scales);
+  settings.PutVector(s.light_positions);
   PutRenderOptions(s.render, &settings);
   PutRequest(s.request, &settings);
   settings.Put(s.layout);
@@ -138,6 +139,7 @@ void ApplyStatePart(int part, const std::vector<char>& bytes, RenderState* s) {
       break;
     case kSettingsPart:
       s->light_scales = r.GetVector<double>();
+      s->light_positions = r.GetVector<Eigen::Vector3d>();
       s->render = GetRenderOptions(&r);
       s->request = GetRequest(&r);
       s->layout = r.Get<ParameterLayout>();

@@ -37,6 +37,7 @@ ParameterSelection ActiveParameters::ToSelection() const {
   selection.specular = specular;
   selection.lights = lights;
   selection.environment = environment;
+  selection.light_positions = light_positions;
   return selection;
 }
 
@@ -89,6 +90,32 @@ SceneParameters::SceneParameters(const std::vector<Eigen::Vector3d>& positions,
   }
 }
 
+void SceneParameters::AddLightPositions(const std::vector<Eigen::Vector3d>& positions) {
+  CHECK_EQ(static_cast<int>(positions.size()), layout_.num_lights);
+  std::vector<double> packed(3 * positions.size());
+  for (size_t l = 0; l < positions.size(); ++l) {
+    for (int k = 0; k < 3; ++k) packed[3 * l + k] = positions[l][k];
+  }
+  const auto first = values_.begin() + layout_.LightPositionOffset();
+  if (layout_.light_positions) {
+    std::copy(packed.begin(), packed.end(), first);
+    return;
+  }
+  // Inserted before the exposure gains (ExposureOffset() moves with the layout's size).
+  values_.insert(first, packed.begin(), packed.end());
+  layout_.light_positions = true;
+}
+
+std::vector<Eigen::Vector3d> SceneParameters::LightPositions() const {
+  std::vector<Eigen::Vector3d> positions;
+  if (!layout_.light_positions) return positions;
+  for (int l = 0; l < layout_.num_lights; ++l) {
+    const double* p = &values_[layout_.LightPositionOffset() + 3 * l];
+    positions.emplace_back(p[0], p[1], p[2]);
+  }
+  return positions;
+}
+
 Image SceneParameters::EnvironmentTexels() const {
   if (!has_environment()) return Image();
   Image texels(environment_width_, environment_height_, 3);
@@ -127,6 +154,9 @@ std::vector<BlockSpan> SceneParameters::Blocks() const {
   for (int t = 0; t < layout_.num_environment_texels; ++t) {
     blocks.push_back({layout_.EnvironmentOffset() + 3 * t, 3, ParameterKind::kEnvironment});
   }
+  for (int l = 0; layout_.light_positions && l < layout_.num_lights; ++l) {
+    blocks.push_back({layout_.LightPositionOffset() + 3 * l, 3, ParameterKind::kLightPosition});
+  }
   for (int v = 0; v < num_gain_views_; ++v) {
     blocks.push_back({GainIndex(v, 0), 3, ParameterKind::kLight, /*exposure=*/true});
   }
@@ -155,6 +185,10 @@ BlockSpan SceneParameters::BlockOf(int index) const {
     case ParameterKind::kEnvironment: {
       const int local = index - layout_.EnvironmentOffset();
       return {index - local % 3, 3, ParameterKind::kEnvironment};
+    }
+    case ParameterKind::kLightPosition: {
+      const int local = index - layout_.LightPositionOffset();
+      return {index - local % 3, 3, ParameterKind::kLightPosition};
     }
   }
   return {index, 1, ParameterKind::kLight};
@@ -186,6 +220,7 @@ double SceneParameters::Lower(int index, const ParameterBounds& bounds) const {
   if (IsExposure(index)) return bounds.gain_min;
   switch (layout_.KindOf(index)) {
     case ParameterKind::kVertex:
+    case ParameterKind::kLightPosition:
       return -std::numeric_limits<double>::infinity();
     case ParameterKind::kAlbedo:
     case ParameterKind::kSpecular:
@@ -204,6 +239,7 @@ double SceneParameters::Upper(int index, const ParameterBounds& bounds) const {
   if (IsExposure(index)) return bounds.gain_max;
   switch (layout_.KindOf(index)) {
     case ParameterKind::kVertex:
+    case ParameterKind::kLightPosition:
       return std::numeric_limits<double>::infinity();
     case ParameterKind::kLight:
       return bounds.light_scale_max;

@@ -1,12 +1,15 @@
 // The reconstruction's state as one flat vector in the renderer's parameter layout
 // (ParameterLayout, src/render/derivatives.h): x[i] is parameter i — vertex coordinates, albedo
 // texels (RGB), roughness texels, the specular weight, one intensity scale per dataset light, the
-// texels of a fitted environment (RGB radiance; src/optim/fitted_environment.h) —
+// texels of a fitted environment (RGB radiance; src/optim/fitted_environment.h), and with
+// AddLightPositions three position coordinates per dataset light (a point light's position in its
+// own frame: world, or the camera frame for a flash; ParameterLayout::light_positions) —
 // followed by the fit-only exposure gains: 3 per fitted view (R, G, B), which multiply that view's
 // rendered image before the residual (the renderer never sees them; docs/reconstruct.md,
 // "Exposure and white balance"). Ceres parameter blocks point into this vector: one block per
 // vertex (3), per albedo texel (3), per roughness texel (1), the specular weight (1), each light
-// scale (1), each environment texel (3) and each view's gains (3), so the mapping between Ceres
+// scale (1), each environment texel (3), each light position (3) and each view's gains (3), so
+// the mapping between Ceres
 // blocks and indices is the block's offset in the vector.
 #ifndef SFT_OPTIM_PARAMETERS_H_
 #define SFT_OPTIM_PARAMETERS_H_
@@ -50,14 +53,16 @@ struct ActiveParameters {
   bool roughness = true;
   bool specular = false;
   bool lights = false;
-  bool exposure = false;     // the per-view exposure gains (all views but the gauge view).
-  bool environment = false;  // the fitted environment's texels (when the parameters have them).
+  bool exposure = false;         // the per-view exposure gains (all views but the gauge view).
+  bool environment = false;      // the fitted environment's texels (when the parameters have them).
+  bool light_positions = false;  // point-light positions (when the parameters have them).
 
   // The renderer's kinds (exposure gains are applied by the render cache, not the renderer).
   ParameterSelection ToSelection() const;
   bool Includes(ParameterKind kind) const;
   bool Any() const {
-    return vertices || albedo || roughness || specular || lights || exposure || environment;
+    return vertices || albedo || roughness || specular || lights || exposure || environment ||
+           light_positions;
   }
 };
 
@@ -105,10 +110,19 @@ class SceneParameters {
   const std::vector<double>& values() const { return values_; }
   double* data() { return values_.data(); }
 
-  // Every block in order: vertices, albedo texels, roughness texels, specular, lights, gains.
+  // Every block in order: vertices, albedo texels, roughness texels, specular, lights,
+  // environment texels, light positions, gains.
   std::vector<BlockSpan> Blocks() const;
   // The block holding parameter `index`.
   BlockSpan BlockOf(int index) const;
+
+  // Makes the lights' positions parameters (ParameterLayout::light_positions), starting at
+  // `positions` (one per dataset light, each in its light's frame; entries of lights that are
+  // not point lights are kept but get no derivatives). The exposure gains keep their values.
+  void AddLightPositions(const std::vector<Eigen::Vector3d>& positions);
+  bool has_light_positions() const { return layout_.light_positions; }
+  // The lights' position parameters, one per dataset light (empty without them).
+  std::vector<Eigen::Vector3d> LightPositions() const;
 
   // Current state, for rendering and output. `material` must have the layout's texel counts;
   // its fresnel mode and resolutions are kept.
@@ -122,7 +136,7 @@ class SceneParameters {
   int environment_width() const { return environment_width_; }
   int environment_height() const { return environment_height_; }
 
-  // Lower/upper bound of parameter `index` (±infinity for vertices).
+  // Lower/upper bound of parameter `index` (±infinity for vertices and light positions).
   double Lower(int index, const ParameterBounds& bounds) const;
   double Upper(int index, const ParameterBounds& bounds) const;
   // Clamps every value into the bounds (projection onto the feasible set).

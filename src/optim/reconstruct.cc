@@ -25,6 +25,7 @@ ActiveParameters TexturePhase(const ReconstructOptions& options) {
   active.roughness = true;
   active.specular = options.fit_specular;
   active.lights = options.fit_lights;
+  active.light_positions = options.fit_light_positions;
   active.exposure = options.fit_exposure;
   active.environment = options.fit_environment;
   return active;
@@ -117,7 +118,8 @@ Status Reconstruction::Create(const Dataset& dataset, const TriMesh& mesh, const
                               const ReconstructOptions& options,
                               std::unique_ptr<Reconstruction>* out,
                               const std::vector<Eigen::Vector3d>& view_gains,
-                              const Image& environment) {
+                              const Image& environment,
+                              const std::vector<Eigen::Vector3d>& light_positions) {
   std::string why;
   if (!options.Check(&why)) return Status::Error(why);
   std::unique_ptr<Reconstruction> r(new Reconstruction());
@@ -163,6 +165,18 @@ Status Reconstruction::Create(const Dataset& dataset, const TriMesh& mesh, const
     for (int l = 0; l < num_lights; ++l) {
       r->params_.values()[r->params_.layout().LightOffset() + l] = light_scales[l];
     }
+  }
+  // Light positions are parameters whenever an earlier fit moved them or this fit fits them.
+  if (options.fit_light_positions || !light_positions.empty()) {
+    if (!light_positions.empty() && static_cast<int>(light_positions.size()) != num_lights) {
+      return Status::Error("light positions: " + std::to_string(light_positions.size()) +
+                           " given, the dataset has " + std::to_string(num_lights) + " lights");
+    }
+    std::vector<Eigen::Vector3d> start = light_positions;
+    if (start.empty()) {
+      for (const LightSpec& light : dataset.lights) start.push_back(light.position);
+    }
+    r->params_.AddLightPositions(start);
   }
   SFT_RETURN_IF_ERROR(RenderCache::Create(dataset, &r->views_, views, r->faces_, material,
                                           &r->params_, r->options_.cache, &r->cache_));

@@ -37,6 +37,10 @@ struct ReconstructOptions {
   int outer_iterations = 4;   // outer iterations (fresh seeds each), [1, 10000].
   bool fit_specular = false;  // the texture phase also fits the specular weight.
   bool fit_lights = false;    // the texture phase also fits the light intensity scales.
+  // The texture phase also fits the point lights' positions (3 per light: a world-frame light's
+  // world position, a camera-frame light's offset in the camera frame; docs/reconstruct.md,
+  // "Fitted point lights").
+  bool fit_light_positions = false;
   // The texture phase also fits per-view exposure gains (3 per fitted view, the first fitted view
   // the fixed gauge; src/optim/parameters.h, kExposureGaugeView).
   bool fit_exposure = false;
@@ -84,7 +88,8 @@ class Reconstruction {
                        const std::vector<double>& light_scales, const ReconstructOptions& options,
                        std::unique_ptr<Reconstruction>* out,
                        const std::vector<Eigen::Vector3d>& view_gains = {},
-                       const Image& environment = Image());
+                       const Image& environment = Image(),
+                       const std::vector<Eigen::Vector3d>& light_positions = {});
 
   // Runs the effect planner for outer iteration `outer` (its renders use the chosen plan from
   // now on). The ceiling is the configured effects and budgets; `image_signal_scale` and
@@ -100,6 +105,9 @@ class Reconstruction {
   TriMesh Mesh() const;
   Material CurrentMaterial() const;  // unsampled texels filled from their neighbours.
   std::vector<double> LightScales() const { return params_.LightScales(); }
+  // The point lights' position parameters per dataset light, each in its light's frame (empty
+  // when they are not parameters).
+  std::vector<Eigen::Vector3d> LightPositions() const { return params_.LightPositions(); }
   // The fitted environment's texels (empty without one).
   Image EnvironmentTexels() const { return params_.EnvironmentTexels(); }
   // The exposure gains per dataset view: the fitted views' current ones, the others' as given to

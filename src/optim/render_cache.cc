@@ -235,8 +235,8 @@ void RenderCache::UpdateScene() {
 }
 
 ViewSetup RenderCache::ScaledView(int v) const {
-  ViewSetup view =
-      ScaledViewSetup(*views_, view_indices_[v], options_.image_scale_log2, params_->LightScales());
+  ViewSetup view = ScaledViewSetup(*views_, view_indices_[v], options_.image_scale_log2,
+                                   params_->LightScales(), params_->LightPositions());
   UseFittedEnvironment(params_->layout(), fitted_environment_, view_indices_[v], &view);
   return view;
 }
@@ -258,6 +258,7 @@ RenderState RenderCache::CurrentState(const RenderOptions& render,
   state.positions = scene_positions_;
   state.material = material_;
   state.light_scales = params_->LightScales();
+  state.light_positions = params_->LightPositions();
   state.render = render;
   state.request = request;
   state.layout = params_->layout();

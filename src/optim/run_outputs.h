@@ -54,10 +54,14 @@ Status WriteRunState(const std::string& out, const RunState& state);
 Status ReadRunState(const std::string& out, RunState* state);
 
 // mesh.ply, mesh.obj, material.json (+ .mc files), lights.json.
+// `light_positions`: the fitted point-light positions (empty: none fitted; lights.json then has
+// no positions and ReadRunSnapshot returns them empty).
 Status WriteRunSnapshot(const std::string& out, const Dataset& dataset, const TriMesh& mesh,
-                        const Material& material, const std::vector<double>& light_scales);
+                        const Material& material, const std::vector<double>& light_scales,
+                        const std::vector<Eigen::Vector3d>& light_positions = {});
 Status ReadRunSnapshot(const std::string& out, const Dataset& dataset, TriMesh* mesh,
-                       Material* material, std::vector<double>* light_scales);
+                       Material* material, std::vector<double>* light_scales,
+                       std::vector<Eigen::Vector3d>* light_positions = nullptr);
 
 // exposure.json: {"format": "sft-exposure/1", "gauge_view": G, "views": [{"view": i, "image":
 // its image path in the dataset, "gains": [R, G, B]}, ...]} for every dataset view; gains

@@ -154,7 +154,7 @@ Status Schedule::Resume(const Dataset& dataset, const std::string& out,
     p.stage_prepared = true;
   }
   SFT_RETURN_IF_ERROR(ReadRunSnapshot(out, dataset, &s->current_.mesh, &s->current_.material,
-                                      &s->current_.light_scales));
+                                      &s->current_.light_scales, &s->current_.light_positions));
   if (!view_gains.empty() && view_gains.size() != dataset.views.size()) {
     return Status::Error(JoinPath(out, "state.json") +
                          ": exposure_gains: " + std::to_string(view_gains.size()) +
@@ -200,9 +200,9 @@ double Schedule::Elapsed() const { return seconds_at_start_ + NowSeconds() - ses
 
 Status Schedule::CreateReconstruction() {
   const StageOptions& stage = stages_[progress_.stage];
-  SFT_RETURN_IF_ERROR(Reconstruction::Create(*dataset_, current_.mesh, current_.material,
-                                             current_.light_scales, stage.fit, &reconstruction_,
-                                             current_.view_gains, current_.environment));
+  SFT_RETURN_IF_ERROR(Reconstruction::Create(
+      *dataset_, current_.mesh, current_.material, current_.light_scales, stage.fit,
+      &reconstruction_, current_.view_gains, current_.environment, current_.light_positions));
   reconstruction_->elapsed_offset = Elapsed();
   reconstruction_stage_ = progress_.stage;
   phases_seen_ = 0;
@@ -237,6 +237,8 @@ void Schedule::SyncCurrent() {
   current_.mesh = reconstruction_->Mesh();
   current_.material = reconstruction_->CurrentMaterial();
   current_.light_scales = reconstruction_->LightScales();
+  std::vector<Eigen::Vector3d> light_positions = reconstruction_->LightPositions();
+  if (!light_positions.empty()) current_.light_positions = std::move(light_positions);
   current_.view_gains = reconstruction_->ViewGains();
   Image environment = reconstruction_->EnvironmentTexels();
   if (!environment.empty()) current_.environment = std::move(environment);
@@ -521,8 +523,8 @@ Status Schedule::RunStageOuter(const ScheduleCallbacks& callbacks, bool* stop) {
 
 Status Schedule::Checkpoint() {
   progress_.seconds = Elapsed();
-  SFT_RETURN_IF_ERROR(
-      WriteRunSnapshot(out_, *dataset_, current_.mesh, current_.material, current_.light_scales));
+  SFT_RETURN_IF_ERROR(WriteRunSnapshot(out_, *dataset_, current_.mesh, current_.material,
+                                       current_.light_scales, current_.light_positions));
   if (!current_.environment.empty()) {
     const LightSpec& light = dataset_->lights.at(FittedEnvironmentLight(*dataset_));
     SFT_RETURN_IF_ERROR(WriteFittedEnvironment(out_, current_.environment, light.frame));

@@ -75,6 +75,9 @@ struct ScheduleStart {
   TriMesh mesh;
   Material material;
   std::vector<double> light_scales;  // empty = all 1.
+  // Fitted point-light positions per dataset light, in each light's frame (lights.json); empty =
+  // the dataset's (none fitted yet).
+  std::vector<Eigen::Vector3d> light_positions;
   // Exposure gains per dataset view (src/optim/parameters.h); empty = all 1.
   std::vector<Eigen::Vector3d> view_gains;
   // The fitted environment's texels (unknown lighting, src/optim/fitted_environment.h); empty =

@@ -48,7 +48,7 @@ Status StateRenderer::UpdateEnvironment(const RenderState& state) {
 
 void StateRenderer::Render(const RenderState& state, const ViewJob& job, ViewResult* result) const {
   ViewSetup view = ScaledViewSetup(views_, state.view_indices[job.view], state.image_scale_log2,
-                                   state.light_scales);
+                                   state.light_scales, state.light_positions);
   UseFittedEnvironment(state.layout, fitted_environment_, state.view_indices[job.view], &view);
   RenderViewJob(*scene_, state.material, view, state.render, state.request, state.layout, job,
                 result);

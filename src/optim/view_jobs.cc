@@ -12,11 +12,17 @@ ViewRunner* g_view_runner = nullptr;
 }  // namespace
 
 ViewSetup ScaledViewSetup(const DatasetViews& views, int dataset_view, int image_scale_log2,
-                          const std::vector<double>& light_scales) {
+                          const std::vector<double>& light_scales,
+                          const std::vector<Eigen::Vector3d>& light_positions) {
   ViewSetup view = views.views[dataset_view];
   view.camera = DownscaledCamera(view.camera, image_scale_log2);
+  const Rigid3d world_from_cam = view.cam_from_world.Inverse();
   for (PointLight& light : view.point_lights) {
-    if (light.light_index >= 0) light.intensity *= light_scales[light.light_index];
+    if (light.light_index < 0) continue;
+    light.intensity *= light_scales[light.light_index];
+    if (light_positions.empty()) continue;
+    const Eigen::Vector3d& p = light_positions.at(light.light_index);
+    light.position = light.camera_frame ? world_from_cam * p : p;
   }
   if (view.environment_light_index >= 0) {
     view.environment_scale *= light_scales[view.environment_light_index];

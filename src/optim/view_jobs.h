@@ -61,8 +61,11 @@ struct RenderState {
   std::vector<Eigen::Vector3d> positions;  // current vertex positions.
   Material material;                       // mesh colors (no UV textures).
   std::vector<double> light_scales;        // per dataset light.
-  RenderOptions render;                    // spp, bounces, effects, threads, shading.
-  DerivativeRequest request;               // derivative kinds and edge budgets (no weights).
+  // Fitted point-light positions per dataset light, each in its light's frame (world, or the
+  // camera frame of a flash); empty = the dataset's (SceneParameters::LightPositions).
+  std::vector<Eigen::Vector3d> light_positions;
+  RenderOptions render;       // spp, bounces, effects, threads, shading.
+  DerivativeRequest request;  // derivative kinds and edge budgets (no weights).
   // The index space of rows and gradients (SceneParameters::layout): vertices, texels, lights
   // and a fitted environment's texels.
   ParameterLayout layout;
@@ -76,9 +79,12 @@ struct RenderState {
 };
 
 // View `dataset_view` of `views` as the fit renders it: its camera downscaled by
-// 2^-image_scale_log2, its lights' intensities times their scales.
+// 2^-image_scale_log2, its lights' intensities times their scales and, when `light_positions` is
+// not empty (one per dataset light, in the light's frame), its point lights at those positions
+// (a camera-frame light at C + Rᵀ·offset).
 ViewSetup ScaledViewSetup(const DatasetViews& views, int dataset_view, int image_scale_log2,
-                          const std::vector<double>& light_scales);
+                          const std::vector<double>& light_scales,
+                          const std::vector<Eigen::Vector3d>& light_positions = {});
 
 // The renderer's maps of a fitted environment's texels: one map when the light is world-fixed,
 // one per dataset view when it is camera-fixed (LightSpec::frame; ViewWorldFromEnv).

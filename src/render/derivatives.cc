@@ -11,7 +11,8 @@ ParameterKind ParameterLayout::KindOf(int index) const {
   if (index < SpecularIndex()) return ParameterKind::kRoughness;
   if (index == SpecularIndex()) return ParameterKind::kSpecular;
   if (index < EnvironmentOffset()) return ParameterKind::kLight;
-  return ParameterKind::kEnvironment;
+  if (index < LightPositionOffset()) return ParameterKind::kEnvironment;
+  return ParameterKind::kLightPosition;
 }
 
 std::string ParameterLayout::Describe(int index) const {
@@ -34,6 +35,10 @@ std::string ParameterLayout::Describe(int index) const {
       const int local = index - EnvironmentOffset();
       return "environment[" + std::to_string(local / 3) + "]." + kChannel[local % 3];
     }
+    case ParameterKind::kLightPosition: {
+      const int local = index - LightPositionOffset();
+      return "light_position[" + std::to_string(local / 3) + "]." + kAxis[local % 3];
+    }
   }
   return "?";
 }
@@ -51,6 +56,8 @@ bool ParameterKindFromName(const std::string& name, ParameterKind* kind) {
     *kind = ParameterKind::kLight;
   else if (name == "environment")
     *kind = ParameterKind::kEnvironment;
+  else if (name == "light_position")
+    *kind = ParameterKind::kLightPosition;
   else
     return false;
   return true;
@@ -70,6 +77,8 @@ const char* ParameterKindName(ParameterKind kind) {
       return "light";
     case ParameterKind::kEnvironment:
       return "environment";
+    case ParameterKind::kLightPosition:
+      return "light_position";
   }
   return "?";
 }
@@ -82,6 +91,7 @@ ParameterSelection ParameterSelection::Only(ParameterKind kind) {
   s.specular = kind == ParameterKind::kSpecular;
   s.lights = kind == ParameterKind::kLight;
   s.environment = kind == ParameterKind::kEnvironment;
+  s.light_positions = kind == ParameterKind::kLightPosition;
   return s;
 }
 
@@ -99,6 +109,8 @@ bool ParameterSelection::Selected(ParameterKind kind) const {
       return lights;
     case ParameterKind::kEnvironment:
       return environment;
+    case ParameterKind::kLightPosition:
+      return light_positions;
   }
   return false;
 }

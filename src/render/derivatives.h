@@ -22,6 +22,15 @@
 //   albedo, roughness, specular: every BSDF factor of every path vertex, all effects; exact (no
 //     visibility depends on them);
 //   light scales: every contribution of that light;
+//   light positions (point lights, ParameterLayout::light_positions): every next-event
+//     contribution of that light at every path vertex, through wi = (L − x)/d, the factor
+//     c = (n·wi)/d² (the 1/d² falloff and the cosine) and the BSDF's dependence on wi (the
+//     negated position terms of the vertex x below); a camera-frame light (a flash) is chained
+//     through L = C + Rᵀ·offset. Point lights are delta lights: no BSDF-sampled (MIS) term. The
+//     shadow boundaries the light casts move with it, with ∂y/∂L = (1 − τ)(I − d̂n_rᵀ/(n_r·d̂))
+//     (internal/shadow_edges.h): seen directly by the camera in the shadow-edge term, through a
+//     bounce in secondary edges (B) (both run for light positions without vertex derivatives
+//     too, and follow the same budgets). Nothing of the light's visibility is left out;
 //   vertices, interior terms (geometry_derivatives.h): through every path vertex's shading
 //     normal (BSDF, cosines) — the face normal, or under smooth shading the interpolated vertex
 //     normals with their two-ring and the hit's sliding barycentrics (internal/shading_normal.h)
@@ -70,7 +79,15 @@
 
 namespace sft {
 
-enum class ParameterKind { kVertex, kAlbedo, kRoughness, kSpecular, kLight, kEnvironment };
+enum class ParameterKind {
+  kVertex,
+  kAlbedo,
+  kRoughness,
+  kSpecular,
+  kLight,
+  kEnvironment,
+  kLightPosition
+};
 
 struct ParameterLayout {
   int num_vertices = 0;
@@ -82,27 +99,41 @@ struct ParameterLayout {
   // the map's order y·width + x. 0 texels: no environment parameters.
   int num_environment_texels = 0;
   int environment_light = -1;
+  // Point-light positions as parameters: 3 per dataset light (coordinate k of light l at
+  // LightPositionOffset() + 3l + k). For a world-frame light they are its world position; for a
+  // camera-frame light (PointLight::camera_frame, a flash) its offset in the camera frame, shared
+  // by every view. Entries of lights that are not point lights get no derivatives.
+  bool light_positions = false;
 
   // Index ranges, in this order: vertex v coordinate k at 3v + k; albedo texel t channel c;
-  // roughness texel t; the specular weight; light l's scale; environment texel t channel c.
+  // roughness texel t; the specular weight; light l's scale; environment texel t channel c;
+  // light l's position coordinate k.
   int VertexOffset() const { return 0; }
   int AlbedoOffset() const { return 3 * num_vertices; }
   int RoughnessOffset() const { return AlbedoOffset() + 3 * num_albedo_texels; }
   int SpecularIndex() const { return RoughnessOffset() + num_roughness_texels; }
   int LightOffset() const { return SpecularIndex() + 1; }
   int EnvironmentOffset() const { return LightOffset() + num_lights; }
-  int size() const { return EnvironmentOffset() + 3 * num_environment_texels; }
+  int LightPositionOffset() const { return EnvironmentOffset() + 3 * num_environment_texels; }
+  int size() const { return LightPositionOffset() + (light_positions ? 3 * num_lights : 0); }
   // Whether dataset light `light`'s environment texels are parameters.
   bool FitsEnvironment(int light) const {
     return num_environment_texels > 0 && light >= 0 && light == environment_light;
   }
 
   ParameterKind KindOf(int index) const;
-  // "vertex[12].y", "albedo[40].g", "roughness[3]", "specular", "light[0]", "environment[7].b".
+  // Whether dataset light `light`'s position coordinates are parameters.
+  bool FitsLightPosition(int light) const {
+    return light_positions && light >= 0 && light < num_lights;
+  }
+
+  // "vertex[12].y", "albedo[40].g", "roughness[3]", "specular", "light[0]", "environment[7].b",
+  // "light_position[0].z".
   std::string Describe(int index) const;
 };
 
-// "vertices", "albedo", "roughness", "specular", "light", "environment" (the names of `--param`).
+// "vertices", "albedo", "roughness", "specular", "light", "environment", "light_position" (the
+// names of `--param`).
 bool ParameterKindFromName(const std::string& name, ParameterKind* kind);
 const char* ParameterKindName(ParameterKind kind);
 
@@ -113,7 +144,8 @@ struct ParameterSelection {
   bool roughness = true;
   bool specular = true;
   bool lights = true;
-  bool environment = true;  // fitted environment texels (when the layout has them).
+  bool environment = true;      // fitted environment texels (when the layout has them).
+  bool light_positions = true;  // point-light positions (when the layout has them).
 
   static ParameterSelection Only(ParameterKind kind);
   bool Selected(ParameterKind kind) const;
@@ -143,13 +175,14 @@ struct DerivativeRequest {
   bool jacobian_rows = false;              // fill DerivativeOutput::rows.
   const Image* adjoint_weights = nullptr;  // when set (width × height, ≥ 3 channels): fill
                                            // DerivativeOutput::gradient = Σ_p Σ_c w_pc ∂I_pc/∂θ.
-  // Visibility (edge) terms of vertex derivatives, sampled per view in proportion to the
-  // forward work: primary edge samples = ratio × spp × pixels (each traces two paths, one on
-  // either side of the edge, unless both sides see the same face); point-light shadow edge
-  // samples likewise (each traces up to four rays). Range [0, 16]; 0 turns the edge terms off
-  // (interior terms only, a biased derivative near silhouettes/shadows). The defaults keep the
-  // derivative pass within a few times the forward pass (`sft bench gradient`); raise them when
-  // the edge terms' noise dominates (e.g. few views, large silhouette derivatives).
+  // Visibility (edge) terms of vertex derivatives (the shadow terms also of point-light
+  // positions), sampled per view in proportion to the forward work: primary edge samples = ratio ×
+  // spp × pixels (each traces two paths, one on either side of the edge, unless both sides see the
+  // same face); point-light shadow edge samples likewise (each traces up to four rays). Range [0,
+  // 16]; 0 turns the edge terms off (interior terms only, a biased derivative near
+  // silhouettes/shadows). The defaults keep the derivative pass within a few times the forward pass
+  // (`sft bench gradient`); raise them when the edge terms' noise dominates (e.g. few views, large
+  // silhouette derivatives).
   double primary_edge_ratio = 0.25;
   double shadow_edge_ratio = 0.125;
   // Secondary edges (Li et al. 2018 §5: visibility seen from path vertices): edge samples per

@@ -222,12 +222,20 @@ void CollectDerivatives(TileJob* job, const ParameterLayout& layout, DerivativeO
 // The candidates of secondary edge samples, when the request needs them.
 std::optional<render_internal::SecondaryEdges> MaybeSecondaryEdges(
     const RenderScene& scene, const Material& material, const ViewSetup& view,
-    const RenderOptions& options, const DerivativeRequest* request,
+    const RenderOptions& options, const DerivativeRequest* request, const ParameterLayout* layout,
     const EnvironmentMap* environment, int max_segments, RenderStats* stats) {
-  if (request != nullptr && (request->jacobian_rows || request->adjoint_weights != nullptr) &&
-      request->params.vertices && options.pass == RenderPass::kColor &&
-      request->secondary_edge_samples > 0 &&
-      ((environment != nullptr && options.effects.shadows) || max_segments > 1)) {
+  if (request == nullptr || !(request->jacobian_rows || request->adjoint_weights != nullptr) ||
+      options.pass != RenderPass::kColor || !(request->secondary_edge_samples > 0)) {
+    return std::nullopt;
+  }
+  // Without vertex derivatives only the point lights' position parameters have secondary terms:
+  // their shadow boundaries seen through a bounce, (B).
+  const bool light_positions = request->params.light_positions && layout != nullptr &&
+                               layout->light_positions && !view.point_lights.empty() &&
+                               options.effects.shadows && max_segments > 1;
+  if ((request->params.vertices &&
+       ((environment != nullptr && options.effects.shadows) || max_segments > 1)) ||
+      (!request->params.vertices && light_positions)) {
     return render_internal::BuildSecondaryEdges(scene, material, view, options, *request,
                                                 environment != nullptr, max_segments, stats);
   }
@@ -243,7 +251,7 @@ void RenderImpl(const RenderScene& scene, const Material& material, const ViewSe
   const int max_segments = options.effects.bounces ? options.bounces : 1;
   RenderStats edge_stats;  // of the edge terms' set-up and samples outside the tiles.
   const std::optional<render_internal::SecondaryEdges> secondary = MaybeSecondaryEdges(
-      scene, material, view, options, request, environment, max_segments, &edge_stats);
+      scene, material, view, options, request, layout, environment, max_segments, &edge_stats);
   std::shared_ptr<const render_internal::VertexNormalJacobian> normal_jacobian;
   if (request != nullptr && (request->jacobian_rows || request->adjoint_weights != nullptr) &&
       request->params.vertices && options.shading == Shading::kSmooth) {
@@ -287,7 +295,10 @@ void RenderImpl(const RenderScene& scene, const Material& material, const ViewSe
     job.parts.Reset(layout->size());
     job.tile_secondary.resize(num_tiles);
   }
-  if (job.want_derivatives && request->params.vertices && options.pass == RenderPass::kColor) {
+  const bool light_positions = request != nullptr && request->params.light_positions &&
+                               layout != nullptr && layout->light_positions;
+  if (job.want_derivatives && (request->params.vertices || light_positions) &&
+      options.pass == RenderPass::kColor) {
     job.edge_lists.resize(static_cast<size_t>(width) * height);
     render_internal::AddEdgeTerms(ctx, &job.edge_lists, &edge_stats,
                                   job.want_parts ? &job.parts : nullptr);
@@ -331,6 +342,11 @@ Eigen::Vector3d CameraSampleDirection(const ViewSetup& view,
   sampler->Next2D(&jitter_x, &jitter_y);
   const Eigen::Vector2d film(x + jitter_x, y + jitter_y);
   return (world_from_cam_rotation * view.camera.CamFromImage(film)).normalized();
+}
+
+Eigen::Matrix3d LightPositionJacobian(const ViewSetup& view, const PointLight& light) {
+  if (!light.camera_frame) return Eigen::Matrix3d::Identity();
+  return view.cam_from_world.rotation.toRotationMatrix().transpose();
 }
 
 void RenderView(const RenderScene& scene, const Material& material, const ViewSetup& view,

@@ -88,6 +88,10 @@ struct PointLight {
   Eigen::Vector3d position;   // world frame.
   Eigen::Vector3d intensity;  // radiant intensity, W/sr.
   int light_index = -1;       // dataset light index (for its intensity-scale parameter); -1 none.
+  // Whether the light rides with the camera (a flash): its position parameters
+  // (ParameterLayout::light_positions) are then the offset o in the camera frame, with
+  // position = C + Rᵀ·o for the view's camera centre C and rotation R (cam_from_world).
+  bool camera_frame = false;
 };
 
 // Everything one view needs besides the scene and material.
@@ -101,6 +105,10 @@ struct ViewSetup {
   double environment_scale = 1.0;               // multiplies the environment's radiance, >= 0.
   uint64_t view_index = 0;                      // part of the sample seed.
 };
+
+// ∂(world position)/∂(position parameters) of point light `light` in `view`: the identity for a
+// world-frame light, Rᵀ (the camera's world-from-camera rotation) for a camera-frame one.
+Eigen::Matrix3d LightPositionJacobian(const ViewSetup& view, const PointLight& light);
 
 // Counters of one render: rays (for throughput measurements) and values lost to overflow.
 struct RenderStats {
@@ -176,7 +184,8 @@ void RenderViewWithDerivatives(const RenderScene& scene, const Material& materia
                                DerivativeOutput* output, RenderStats* stats = nullptr);
 // The same with the index space given: MakeParameterLayout's plus, for a fitted environment,
 // `num_environment_texels` and `environment_light` (the view's environment must then be that
-// light's map, of that many texels, wherever the view uses it).
+// light's map, of that many texels, wherever the view uses it), and `light_positions` (each
+// point light's position parameters, PointLight::camera_frame).
 void RenderViewWithDerivatives(const RenderScene& scene, const Material& material,
                                const ViewSetup& view, const RenderOptions& options,
                                const DerivativeRequest& request, const ParameterLayout& layout,

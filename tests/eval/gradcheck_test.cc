@@ -53,6 +53,27 @@ TEST_F(GradcheckTest, ImplementedKindsPass) {
   }
 }
 
+// Point-light positions: without shadows per pixel at the automatic step (8×8 blocks), the
+// renderer's next-event terms are smooth in the light's position.
+TEST_F(GradcheckTest, LightPositionsPass) {
+  GradcheckOptions options;
+  options.kind = ParameterKind::kLightPosition;
+  options.views = {2};
+  options.render.spp = 2;
+  options.render.bounces = 2;
+  options.render.effects.shadows = false;
+  GradcheckResult result;
+  const Status status = RunGradcheck(dataset_, mesh_, material_, options, &result);
+  ASSERT_TRUE(status.ok()) << status.message();
+  EXPECT_EQ(result.kind, "light_position");
+  EXPECT_EQ(result.block, 8);
+  EXPECT_TRUE(result.passed) << result.relative_error;
+  EXPECT_LT(result.relative_error, 2e-3);
+  ASSERT_EQ(result.views.size(), 1u);
+  EXPECT_GT(result.views[0].jacobian_entries, 0u);
+  EXPECT_LT(result.views[0].adjoint_mismatch, 1e-5);
+}
+
 // The check can fail: an impossible tolerance is not met.
 TEST_F(GradcheckTest, ImpossibleToleranceFails) {
   GradcheckOptions options;

@@ -114,6 +114,18 @@ bool EmitBoundary(int pixel, const Eigen::Vector3d& jump, double scale, const Bo
       out->push_back({pixel, 3 * rows.vertices[j] + k, d});
     }
   }
+  if (rows.light_param >= 0) {
+    for (int k = 0; k < 3; ++k) {
+      const double w = rows.light_row[k] * scale;
+      if (w == 0.0) continue;
+      const Eigen::Vector3d d = jump * w;
+      if (!std::isfinite(w) || !d.allFinite()) {
+        out->resize(first);
+        return false;
+      }
+      out->push_back({pixel, rows.light_param + k, d});
+    }
+  }
   return true;
 }
 
@@ -146,6 +158,8 @@ void AddEdgeTerms(const Context& ctx, std::vector<DerivativeList>* pixel_lists, 
       {DerivativeTerm::kShadowEdges, AddShadowEdgeTerms},
       {DerivativeTerm::kTexelEdges, AddTexelEdgeTerms}};
   for (const auto& [term, add_terms] : terms) {
+    // Without vertex derivatives only the shadow edges have terms (light positions).
+    if (!ctx.request->params.vertices && term != DerivativeTerm::kShadowEdges) continue;
     const size_t first = entries.size();
     add_terms(view, &entries);
     if (parts != nullptr) AddWeightedEntries(ctx, entries, first, &parts->part(term));

@@ -68,6 +68,10 @@ struct BoundaryRows {
   int count = 0;
   int vertices[kCapacity];
   Eigen::Vector3d rows[kCapacity];
+  // A point light's position parameters that move y (point-light shadow boundaries): the first
+  // of the three, −1 when none, and (∂y/∂parameters)ᵀ·row.
+  int light_param = -1;
+  Eigen::Vector3d light_row = Eigen::Vector3d::Zero();
   void Add(int vertex, const Eigen::Vector3d& row) {
     CHECK_LT(count, kCapacity);
     vertices[count] = vertex;
@@ -127,8 +131,9 @@ struct EdgeView {
 Eigen::Vector3d SideRadianceJump(const Context& ctx, const Eigen::Vector3d dirs[2],
                                  const RayHit hits[2], const Sampler& sampler, RenderStats* stats);
 
-// Appends the entries jump·(row_j·∂q/∂vertex_j)·scale for the moving vertices of one sample.
-// False, appending nothing, when one of them is not finite.
+// Appends the entries jump·(row_j·∂q/∂vertex_j)·scale for the moving vertices of one sample (and
+// the light position's, BoundaryRows::light_param). False, appending nothing, when one of them is
+// not finite.
 bool EmitBoundary(int pixel, const Eigen::Vector3d& jump, double scale, const BoundaryRows& rows,
                   std::vector<EdgeEntry>* out);
 
@@ -201,7 +206,8 @@ void SampleCandidates(const RenderOptions& options, const std::vector<Candidate>
 }
 
 // Boundary terms of one view seen directly by the camera (primary edges, point-light shadow
-// edges, texel boundaries), added to per-pixel lists scaled for the caller's 1/spp. With `parts`
+// edges, texel boundaries; without vertex derivatives the shadow edges' light-position terms
+// only), added to per-pixel lists scaled for the caller's 1/spp. With `parts`
 // (each part layout-sized; the request has adjoint weights), each term's entries weighted by the
 // adjoint weights of their pixel and 1/spp are also added to the term's part.
 void AddEdgeTerms(const Context& ctx, std::vector<DerivativeList>* pixel_lists, RenderStats* stats,

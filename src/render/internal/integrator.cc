@@ -54,6 +54,16 @@ LightTerm PointLightTerm(const PointLightSample& ls, const PointLight& light,
   return term;
 }
 
+// Marks `term` as differentiated with respect to the light's position when the request and the
+// layout have that light's position parameters.
+void SetLightPositionParams(const Context& ctx, const PointLight& light, LightTerm* term) {
+  if (!ctx.request->params.light_positions || !ctx.layout->FitsLightPosition(light.light_index)) {
+    return;
+  }
+  term->position_param = ctx.layout->LightPositionOffset() + 3 * light.light_index;
+  term->d_light_d_param = LightPositionJacobian(ctx.view, light);
+}
+
 // One vertex of a path being traced, and the path's running sums.
 struct PathVertex {
   int depth = 0;
@@ -90,8 +100,9 @@ void AddPointLights(const Context& ctx, const PathVertex& v, PathState* state) {
                                  /*skip_black=*/state->path == nullptr, state->stats, &ls)) {
       continue;
     }
-    Contribute(v, ls.wi, ls.f, PointLightTerm(ls, light, v.sp.n, state->path != nullptr),
-               light.light_index, state);
+    LightTerm term = PointLightTerm(ls, light, v.sp.n, state->path != nullptr);
+    if (state->path != nullptr) SetLightPositionParams(ctx, light, &term);
+    Contribute(v, ls.wi, ls.f, term, light.light_index, state);
   }
 }
 

@@ -46,24 +46,33 @@ void PathDerivatives::AddContribution(const Eigen::Vector3d& prefix, const Surfa
     const Eigen::Vector3d base = prefix.cwiseProduct(f) * light.c;
     AddEnvironmentTexels(light.env_texel, light.env_weight, light.env_count, base);
   }
-  if (!vertices_) return;
+  const bool light_position = light.follows_point && light.position_param >= 0;
+  if (!vertices_ && !light_position) return;
   // ∂(f ⊙ q·c) = (f ⊙ q)·∂c + c·q·∂g, g the glossy term (the diffuse term is constant).
   Eigen::Vector3d dg_dn, dg_dwi;
   EvalGlossyWithGradient(surface.params, n, wo, wi, &dg_dn, &dg_dwi);
   const Eigen::Vector3d base = prefix.cwiseProduct(light.q);
   const Eigen::Vector3d base_f = base.cwiseProduct(f);
+  if (light.follows_point) {
+    // ∂/∂x of the contribution at this vertex (rows: channels), x moving alone.
+    const Eigen::Matrix3d d_x =
+        base_f * light.dc_dx.transpose() + light.c * base * (dg_dwi.transpose() * light.dwi_dx);
+    if (light_position) {
+      const Eigen::Matrix3d g = -d_x * light.d_light_d_param;
+      for (int k = 0; k < 3; ++k) Emit(light.position_param + k, g.col(k));
+    }
+    if (vertices_ && point_.valid) {
+      for (int e = 0; e < point_.count; ++e) {
+        const Eigen::Matrix3d g = d_x * point_.m[e];
+        for (int k = 0; k < 3; ++k) Emit(3 * point_.vertex[e] + k, g.col(k));
+      }
+    }
+  }
+  if (!vertices_) return;
   const Eigen::Matrix3d d_n = base_f * light.dc_dn.transpose() + light.c * base * dg_dn.transpose();
   scratch_.clear();
   normal_.Map(d_n, point_, &scratch_);
   AddVertices(scratch_);
-  if (light.follows_point && point_.valid) {
-    const Eigen::Matrix3d d_x =
-        base_f * light.dc_dx.transpose() + light.c * base * (dg_dwi.transpose() * light.dwi_dx);
-    for (int e = 0; e < point_.count; ++e) {
-      const Eigen::Matrix3d g = d_x * point_.m[e];
-      for (int k = 0; k < 3; ++k) Emit(3 * point_.vertex[e] + k, g.col(k));
-    }
-  }
   for (int j = 0; j < count_; ++j) {
     AddVertices(scatters_[j].ds_dvertices, excluded_[j].cwiseProduct(f_q));
   }
@@ -102,13 +111,24 @@ void PathDerivatives::MapSlide(const Eigen::Matrix3d& g, VertexGradients* out) c
 
 void PathDerivatives::AddBoundary(const Eigen::Vector3d& weight, const int* vertices,
                                   const Eigen::Vector3d* rows, int count,
-                                  const Eigen::Vector3d& x_row) {
-  if (!vertices_) return;
+                                  const Eigen::Vector3d& x_row, int light_param,
+                                  const Eigen::Vector3d& light_row) {
+  if (!vertices_ && light_param < 0) return;
   if (!weight.allFinite()) {
-    Add(count > 0 ? 3 * vertices[0] : 0, weight);  // marks the path not finite.
+    Add(light_param >= 0 ? light_param
+        : count > 0      ? 3 * vertices[0]
+                         : 0,
+        weight);  // marks the path not finite.
     return;
   }
   const size_t first = pending_.size();
+  if (light_param >= 0) {
+    for (int k = 0; k < 3; ++k) Emit(light_param + k, weight * light_row[k]);
+  }
+  if (!vertices_) {
+    if (boundary_out_ != nullptr) boundary_ranges_.emplace_back(first, pending_.size());
+    return;
+  }
   for (int j = 0; j < count; ++j) {
     for (int k = 0; k < 3; ++k) Emit(3 * vertices[j] + k, weight * rows[j][k]);
   }

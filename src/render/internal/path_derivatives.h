@@ -125,6 +125,11 @@ struct LightTerm {
   bool follows_point = false;                        // point light: the next three are set.
   Eigen::Vector3d dc_dx = Eigen::Vector3d::Zero();   // ∂c/∂x = (3(n·wi)wi − n)/d³.
   Eigen::Matrix3d dwi_dx = Eigen::Matrix3d::Zero();  // ∂wi/∂x = −(I − wi wiᵀ)/d.
+  // A point light whose position is a parameter (ParameterLayout::FitsLightPosition): the first
+  // of its three parameters, and ∂L/∂(parameters) — I for a world-frame light, Rᵀ (world from
+  // camera) for a camera-frame one. c and wi depend on L − x only, so ∂/∂L = −∂/∂x.
+  int position_param = -1;
+  Eigen::Matrix3d d_light_d_param = Eigen::Matrix3d::Identity();
   // A fitted environment's term (ParameterLayout::FitsEnvironment): q's channel c is
   // Σ_k env_weight[k]·T_kc over the env_count texels T_k it blends, so ∂q_c/∂T_kc = env_weight[k]
   // (the bilinear weight times the map's and the light's scales, the MIS weight and 1/pdf).
@@ -213,9 +218,13 @@ class PathDerivatives {
   // A boundary (edge) term at the current vertex: Σ_j weight·(rows_j·∂y/∂p_{vertices_j}) for
   // the vertices that move the curve point, plus weight·(x_row·∂x/∂θ) for the motion of the
   // vertex itself (chained to the faces hit before; left out when that chain is undefined after
-  // a grazing hit). Non-finite values are added as such (the sample is then dropped).
+  // a grazing hit), plus, with light_param ≥ 0, weight·light_row_k for the point light's
+  // position parameter light_param + k (a shadow boundary moving with the light). The vertex
+  // terms are added only with vertex derivatives. Non-finite values are added as such (the
+  // sample is then dropped).
   void AddBoundary(const Eigen::Vector3d& weight, const int* vertices, const Eigen::Vector3d* rows,
-                   int count, const Eigen::Vector3d& x_row);
+                   int count, const Eigen::Vector3d& x_row, int light_param = -1,
+                   const Eigen::Vector3d& light_row = Eigen::Vector3d::Zero());
 
   // The path continues from the current vertex with scatter factor s = f·(n·wi)/pdf.
   void AddScatter(const Eigen::Vector3d& prefix, const SurfaceMaterial& surface,

@@ -377,9 +377,15 @@ void SampleShadowBoundary(const SecondaryVertex& v, double u_light, Sampler* sam
                         (static_cast<double>(pool.attempts) * v.num_samples);
   const Eigen::Vector3d m_row = point.m / point.r;
   BoundaryRows rows;
-  ShadowPointRows(e.shadow, scene, edge, e.s, m_row, &rows);
+  if (secondary.vertices) ShadowPointRows(e.shadow, scene, edge, e.s, m_row, &rows);
+  // The light's position parameters move y too (∂y/∂light, shadow_edges.h).
+  if (v.ctx.request->params.light_positions && v.ctx.layout->FitsLightPosition(light.light_index)) {
+    rows.light_param = v.ctx.layout->LightPositionOffset() + 3 * light.light_index;
+    rows.light_row =
+        (e.shadow.d_y_d_light * LightPositionJacobian(v.ctx.view, light)).transpose() * m_row;
+  }
   path->AddBoundary(v.throughput.cwiseProduct(jump) * weight, rows.vertices, rows.rows, rows.count,
-                    -m_row);
+                    -m_row, rows.light_param, rows.light_row);
 }
 
 // The shadow pool of the light at `light` (ShadowPool), drawn with `pool_sampler`; rays counted
@@ -422,12 +428,13 @@ SecondaryEdges BuildSecondaryEdges(const RenderScene& scene, const Material& mat
                                    const DerivativeRequest& request, bool environment,
                                    int max_segments, RenderStats* stats) {
   SecondaryEdges out;
-  if (max_segments > 1) {
+  out.vertices = request.params.vertices;
+  if (max_segments > 1 && out.vertices) {
     out.texels =
         SecondaryTexelsOf(scene, material, options.effects.specular && material.specular > 0.0);
   }
   out.environment = environment && options.effects.shadows;
-  out.mesh_edges = MeshEdgeTable::Of(scene);
+  if (out.vertices) out.mesh_edges = MeshEdgeTable::Of(scene);
   if (options.effects.shadows && max_segments > 1) {
     const double expected = static_cast<double>(view.camera.width) * view.camera.height *
                             options.spp * request.secondary_edge_samples;
@@ -474,9 +481,10 @@ void AddSecondaryEdgeSamples(const Context& ctx, const Sampler& path_sampler, in
     double u1, u2, u3, u4;
     sampler.Next2D(&u1, &u2);
     sampler.Next2D(&u3, &u4);
-    SampleMeshEdge(v, u1, u2, &sampler, path, stats);  // (A)
+    if (secondary.vertices) SampleMeshEdge(v, u1, u2, &sampler, path, stats);  // (A)
     Sampler texel_sampler = sampler.Fork(1);
-    if (v.indirect && secondary.texels != nullptr && !secondary.texels->segments.empty() &&
+    if (secondary.vertices && v.indirect && secondary.texels != nullptr &&
+        !secondary.texels->segments.empty() &&
         texel_sampler.Next1D() < kSecondaryTexelProbability) {
       SampleTexelBoundary(v, &texel_sampler, path, stats);  // (C)
     }

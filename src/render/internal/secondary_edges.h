@@ -78,6 +78,9 @@ struct SecondaryTexels {
 
 // The candidates of one view's secondary edge samples.
 struct SecondaryEdges {
+  // Whether vertex derivatives are requested: without them only the (B) samples run, for the
+  // point lights' position parameters (their shadow boundaries move with the light).
+  bool vertices = true;
   // Mesh edges where radiance can jump for some viewpoint (per mesh state).
   std::shared_ptr<const MeshEdgeTable> mesh_edges;
   bool environment = false;  // the environment is lit with visibility (shadows on).

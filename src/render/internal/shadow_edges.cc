@@ -88,6 +88,7 @@ bool CastShadowPoint(const RenderScene& scene, const Eigen::Vector3d& light, con
   const double tau = (dist + hit.t) / dist;
   out->along = dir * n_r.transpose() / cosine;
   out->d_y_d_point = tau * (Eigen::Matrix3d::Identity() - out->along);
+  out->d_y_d_light = (1.0 - tau) * (Eigen::Matrix3d::Identity() - out->along);
   return true;
 }
 
@@ -145,9 +146,16 @@ void AddShadowEdgeTerms(const EdgeView& view, std::vector<EdgeEntry>* entries) {
   if (!(ratio > 0.0 && options.effects.shadows && options.effects.direct)) return;
   const RenderScene& scene = ctx.scene;
   const auto& positions = scene.positions();
+  const bool vertices = ctx.request->params.vertices;
   for (size_t l = 0; l < ctx.view.point_lights.size(); ++l) {
     const PointLight& point_light = ctx.view.point_lights[l];
     const Eigen::Vector3d light = point_light.position;
+    // The light's position parameters, when they are differentiated: the boundary moves with
+    // ∂y/∂(parameters) = ∂y/∂light · ∂light/∂(parameters).
+    const bool moves_light = ctx.request->params.light_positions &&
+                             ctx.layout->FitsLightPosition(point_light.light_index);
+    if (!vertices && !moves_light) continue;
+    const Eigen::Matrix3d d_light_d_param = LightPositionJacobian(ctx.view, point_light);
     const auto sample_shadow = [&](const EdgeCandidate& candidate, double s, double inv_pdf,
                                    const Sampler& /*sampler*/, std::vector<EdgeEntry>* out) {
       RenderStats& local = view.thread_stats.local();
@@ -163,7 +171,11 @@ void AddShadowEdgeTerms(const EdgeView& view, std::vector<EdgeEntry>* entries) {
             return ShadowJump(view, point_light, shadow.receiver, q, m, &local);
           },
           [&](const Eigen::Vector3d& m_row, BoundaryRows* rows) {
-            ShadowPointRows(shadow, scene, edge, s, m_row, rows);
+            if (vertices) ShadowPointRows(shadow, scene, edge, s, m_row, rows);
+            if (moves_light) {
+              rows->light_param = ctx.layout->LightPositionOffset() + 3 * point_light.light_index;
+              rows->light_row = (shadow.d_y_d_light * d_light_d_param).transpose() * m_row;
+            }
           },
           &local, out);
     };

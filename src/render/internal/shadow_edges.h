@@ -24,12 +24,15 @@ struct ShadowPoint {
   Eigen::Vector3d barycentrics;  // of y on the receiver.
   Eigen::Matrix3d d_y_d_point;   // ∂y/∂(edge point).
   Eigen::Matrix3d along;         // ∂y/∂p_j = barycentrics_j·along (receiver corners p_j).
+  Eigen::Matrix3d d_y_d_light;   // ∂y/∂(light position).
 };
 
 // Casts the shadow of point a + s(b − a) of `edge` from the light at `light`; false when the
 // light does not reach the edge point, nothing lies behind it, or the receiver is grazed.
 // y = light + τ·d on the receiver's plane, d = point − light, τ = (|d| + t)/|d|:
-//   ∂y/∂point = τ(I − d̂ n_rᵀ/(n_r·d̂)),  ∂y/∂p_j = b_j·d̂ n_rᵀ/(n_r·d̂).
+//   ∂y/∂point = τ(I − d̂ n_rᵀ/(n_r·d̂)),  ∂y/∂p_j = b_j·d̂ n_rᵀ/(n_r·d̂),
+//   ∂y/∂light = (1 − τ)(I − d̂ n_rᵀ/(n_r·d̂)) (y = (1 − τ)·light + τ·point, slid along d̂ back
+//   onto the plane).
 bool CastShadowPoint(const RenderScene& scene, const Eigen::Vector3d& light, const MeshEdge& edge,
                      double s, RenderStats* stats, ShadowPoint* out);
 
