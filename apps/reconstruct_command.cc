@@ -144,10 +144,10 @@ Status PrintSchedule(const std::vector<StageOptions>& stages, const Dataset& dat
 
 // Unknown lighting (no view lists lights) is estimated as a fitted environment
 // (src/optim/fitted_environment.h), said in one line; `run` is the resumed folder ("" fresh).
-Status UnknownLighting(const std::string& run, const ReconstructCommandOptions& cli,
-                       Dataset* dataset) {
+Status UnknownLighting(const std::string& run, const EnvironmentEstimateOptions& options,
+                       const ReconstructCommandOptions& cli, Dataset* dataset) {
   std::string note;
-  SFT_RETURN_IF_ERROR(PrepareUnknownLighting(run, EnvironmentEstimateOptions(), dataset, &note));
+  SFT_RETURN_IF_ERROR(PrepareUnknownLighting(run, options, dataset, &note));
   if (!note.empty() && !cli.quiet) {
     std::printf("%s\n", note.c_str());
     std::fflush(stdout);  // before the progress lines on stderr.
@@ -177,7 +177,7 @@ Status PrepareSchedule(ReconstructCommandOptions* cli, Dataset* dataset,
       return PrintSchedule(stages, *dataset, state.holdout, state.held_out_views);
     }
     SFT_RETURN_IF_ERROR(CheckOutputDirectory(cli->out, {{cli->dataset}, {}}, "--resume"));
-    SFT_RETURN_IF_ERROR(UnknownLighting(cli->resume, *cli, dataset));
+    SFT_RETURN_IF_ERROR(UnknownLighting(cli->resume, EnvironmentEstimateOptions(), *cli, dataset));
     if (before_start) SFT_RETURN_IF_ERROR(before_start(cli->dataset, *dataset, stages));
     SFT_RETURN_IF_ERROR(Schedule::Resume(*dataset, cli->out, stages, state.run_info, state.progress,
                                          state.view_gains, schedule));
@@ -192,6 +192,11 @@ Status PrepareSchedule(ReconstructCommandOptions* cli, Dataset* dataset,
   SFT_RETURN_IF_ERROR(ChooseStart(*dataset, cli->init, &start));
   ScheduleConfig config;
   SFT_RETURN_IF_ERROR(FreshStages(*cli, start, &config, &stages));
+  if (LightingUnknown(*dataset) && config.environment_stage) {
+    StageOptions environment;
+    SFT_RETURN_IF_ERROR(EnvironmentStage(config, &environment));
+    stages.insert(stages.begin(), std::move(environment));
+  }
   std::vector<int> held_out;
   SFT_RETURN_IF_ERROR(ApplyHoldout(config.holdout, config.flat.value("views", std::vector<int>()),
                                    static_cast<int>(dataset->views.size()), &stages, &held_out));
@@ -204,7 +209,7 @@ Status PrepareSchedule(ReconstructCommandOptions* cli, Dataset* dataset,
                          ": holds an earlier reconstruction (continue it with --resume " +
                          cli->out + ", or choose another folder)");
   }
-  SFT_RETURN_IF_ERROR(UnknownLighting("", *cli, dataset));
+  SFT_RETURN_IF_ERROR(UnknownLighting("", config.environment, *cli, dataset));
   ScheduleStart state;
   SFT_RETURN_IF_ERROR(LoadStartMesh(*dataset, start, InitialMeshOptions(), &state.mesh, held_out));
   SFT_RETURN_IF_ERROR(LoadMaterial(cli->material.empty() ? kInitialMaterial : cli->material,

@@ -4,7 +4,9 @@
 //   - "schedule": a built-in stage list, "auto" (default: "hull" when the run starts from a
 //     carved hull, "refine" otherwise), "refine" or "hull";
 //   - "stages": an explicit stage list (an array of objects) instead of a built-in one;
-//   - "holdout": K, every K-th selected view is kept out of the fit (src/optim/holdout.h).
+//   - "holdout": K, every K-th selected view is kept out of the fit (src/optim/holdout.h);
+//   - "environment_size": [W, H] and "environment_stage": unknown lighting's fitted map and the
+//     automatic first stage that fits it alone (src/optim/fitted_environment.h).
 // A stage object holds any flat key plus "name", and the stage-only keys "texel_resolution",
 // "remesh", "remesh_edge_pixels", "resample", "resample_fold_fraction", "material_model" and
 // "texture_size" (the effect planner's keys, "effects": "auto" and "pin", are flat keys: config.h).
@@ -18,6 +20,7 @@
 #include <vector>
 
 #include "src/core/status.h"
+#include "src/optim/fitted_environment.h"
 #include "src/optim/schedule.h"
 
 namespace sft {
@@ -28,6 +31,12 @@ struct ScheduleConfig {
   nlohmann::json flat = nlohmann::json::object();  // keys that override every stage.
   int holdout = 0;             // "holdout": every K-th selected view held out; 0 = off, K >= 2.
   bool holdout_given = false;  // "holdout" was given (a resumed run must not change it).
+  // Unknown lighting: the fitted map's size ("environment_size": [W, H]).
+  EnvironmentEstimateOptions environment;
+  // "environment_stage": false = no automatic environment stage; an object = stage keys over
+  // the built-in stage's (EnvironmentStage).
+  bool environment_stage = true;
+  nlohmann::json environment_stage_keys = nlohmann::json::object();
 };
 
 // Adds `config`'s keys to *out (later calls override earlier ones key by key; "stages" and
@@ -41,6 +50,11 @@ Status ReadScheduleConfig(const std::string& path, ScheduleConfig* out);
 // `refine` when a flat key describes one stage's loop (phases, solver, outer_iterations, steps).
 Status ResolveStages(const ScheduleConfig& config, bool carved_start,
                      std::vector<StageOptions>* stages);
+
+// The automatic first stage of a run whose lighting is unknown (docs/reconstruct.md, "Unknown
+// lighting"): "environment", a texture stage that fits the environment map alone with the
+// material held as it starts (LM); config.environment_stage_keys and then the flat keys over it.
+Status EnvironmentStage(const ScheduleConfig& config, StageOptions* stage);
 
 // Applies stage keys (a stage object or flat keys) to one stage.
 Status ApplyStageConfig(const nlohmann::json& keys, const std::string& source, StageOptions* stage);

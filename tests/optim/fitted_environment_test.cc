@@ -166,6 +166,7 @@ TEST_F(FittedEnvironmentTest, FitRecoversTheBrightSideOfAnUnknownProbe) {
                   .ok());
   ReconstructOptions options;
   options.phases = PhaseSchedule::kTexture;
+  options.fit_environment = true;
   options.cache.render.spp = 8;
   options.cache.render.bounces = 1;
   options.cache.pyramid_levels = 2;
