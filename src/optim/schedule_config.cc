@@ -76,11 +76,12 @@ const char kHullSchedule[] = R"([
 ])";
 
 // environment: the automatic first stage under unknown lighting. The map alone, from a uniform
-// albedo: with the albedo free, the map and the albedo trade shading between them
-// (docs/design-notes.md, "Separating the fitted environment from the albedo").
+// albedo: with the albedo free, the map and the albedo trade shading between them; a light
+// smoothness prior lets the map hold the probe's bright lights (docs/design-notes.md,
+// "Separating the fitted environment from the albedo").
 const char kEnvironmentStage[] = R"({"name": "environment", "phases": "texture", "solver": "lm",
   "outer_iterations": 2, "steps": 8, "fit_albedo": false, "fit_roughness": false,
-  "fit_specular": false, "fit_environment": true})";
+  "fit_specular": false, "fit_environment": true, "environment_smoothness": 0.1})";
 
 // The flat keys that describe one stage's phases and solver loop: given any of them, `auto`
 // with a given mesh picks the one-stage `refine` list rather than a list whose stages set them.
