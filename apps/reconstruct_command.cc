@@ -103,6 +103,10 @@ Status ResumedStages(const ReconstructCommandOptions& cli, const RunState& state
       return Status::Error(cli.config + ": stages/schedule: a resumed run keeps its stages " +
                            "(only flat keys may change)");
     }
+    if (overrides.environment_given) {
+      return Status::Error(cli.config + ": environment_stage/environment_size: a resumed run " +
+                           "keeps its stages and its fitted environment");
+    }
   }
   SFT_RETURN_IF_ERROR(FlagKeys(cli, &overrides));
   if (overrides.holdout_given && overrides.holdout != state.holdout) {

@@ -79,9 +79,11 @@ const char kHullSchedule[] = R"([
 // albedo: with the albedo free, the map and the albedo trade shading between them; a light
 // smoothness prior lets the map hold the probe's bright lights (docs/design-notes.md,
 // "Separating the fitted environment from the albedo").
-const char kEnvironmentStage[] = R"({"name": "environment", "phases": "texture", "solver": "lm",
-  "outer_iterations": 2, "steps": 8, "fit_albedo": false, "fit_roughness": false,
-  "fit_specular": false, "fit_environment": true, "environment_smoothness": 0.1})";
+const char kEnvironmentStage[] = R"({"name": "environment", "solver": "lm",
+  "outer_iterations": 2, "steps": 8, "environment_smoothness": 0.1})";
+// What makes it the environment stage; flat keys (e.g. --phases) do not change these.
+const char kEnvironmentStageRole[] = R"({"phases": "texture", "fit_albedo": false,
+  "fit_roughness": false, "fit_specular": false, "fit_environment": true})";
 
 // The flat keys that describe one stage's phases and solver loop: given any of them, `auto`
 // with a given mesh picks the one-stage `refine` list rather than a list whose stages set them.
@@ -269,6 +271,7 @@ Status MergeScheduleConfig(const json& config, const std::string& source, Schedu
                              "height in [1, 256]");
       }
       out->environment = size;
+      out->environment_given = true;
     } else if (name == "environment_stage") {
       if (value.is_boolean()) {
         out->environment_stage = value.get<bool>();
@@ -281,6 +284,7 @@ Status MergeScheduleConfig(const json& config, const std::string& source, Schedu
         return Status::Error(source + ": environment_stage: expected true, false or an object " +
                              "of stage keys");
       }
+      out->environment_given = true;
     } else if (name == "name") {
       return Status::Error(source + ": name: a stage key (put it inside \"stages\")");
     } else {
@@ -302,8 +306,9 @@ Status EnvironmentStage(const ScheduleConfig& config, StageOptions* stage) {
   *stage = StageOptions();
   const std::string where = "environment stage";
   SFT_RETURN_IF_ERROR(ApplyStageConfig(json::parse(kEnvironmentStage), where, stage));
-  SFT_RETURN_IF_ERROR(ApplyStageConfig(config.environment_stage_keys, where, stage));
   SFT_RETURN_IF_ERROR(ApplyStageConfig(config.flat, "flat keys", stage));
+  SFT_RETURN_IF_ERROR(ApplyStageConfig(json::parse(kEnvironmentStageRole), where, stage));
+  SFT_RETURN_IF_ERROR(ApplyStageConfig(config.environment_stage_keys, where, stage));
   std::string why;
   if (!stage->Check(&why)) return Status::Error(where + ": " + why);
   return Status::Ok();

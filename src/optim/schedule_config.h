@@ -37,6 +37,7 @@ struct ScheduleConfig {
   // the built-in stage's (EnvironmentStage).
   bool environment_stage = true;
   nlohmann::json environment_stage_keys = nlohmann::json::object();
+  bool environment_given = false;  // either key was given (a resumed run keeps its map and stages).
 };
 
 // Adds `config`'s keys to *out (later calls override earlier ones key by key; "stages" and
@@ -53,7 +54,9 @@ Status ResolveStages(const ScheduleConfig& config, bool carved_start,
 
 // The automatic first stage of a run whose lighting is unknown (docs/reconstruct.md, "Unknown
 // lighting"): "environment", a texture stage that fits the environment map alone with the
-// material held as it starts (LM); config.environment_stage_keys and then the flat keys over it.
+// material held as it starts (LM). Its keys: the built-in ones < the flat keys < its role
+// (phases texture, fit_albedo/fit_roughness/fit_specular false, fit_environment true) <
+// config.environment_stage_keys.
 Status EnvironmentStage(const ScheduleConfig& config, StageOptions* stage);
 
 // Applies stage keys (a stage object or flat keys) to one stage.

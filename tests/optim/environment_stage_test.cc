@@ -166,12 +166,13 @@ TEST_F(EnvironmentStageTest, FittingTheMapFirstRecoversTheAlbedo) {
   EXPECT_LT(staged_error, joint_error);
 }
 
-// The run-level keys: the map's size and the stage's own keys, which the flat keys override;
-// wrong values are one error naming the key.
+// The run-level keys: the map's size and the stage's own keys; flat keys override the stage's
+// loop but not its role; wrong values are one error naming the key.
 TEST(EnvironmentStageConfigTest, KeysAndErrors) {
   ScheduleConfig config;
   ASSERT_TRUE(MergeScheduleConfig(nlohmann::json::parse(R"({"environment_size": [16, 8],
-      "environment_stage": {"outer_iterations": 3, "image_scale": 0.5}, "steps": 4})"),
+      "environment_stage": {"outer_iterations": 3, "image_scale": 0.5}, "steps": 4,
+      "phases": "alternate", "fit_albedo": true})"),
                                   "cfg.json", &config)
                   .ok());
   EXPECT_EQ(config.environment.width, 16);
@@ -181,6 +182,10 @@ TEST(EnvironmentStageConfigTest, KeysAndErrors) {
   EXPECT_EQ(stage.fit.outer_iterations, 3);
   EXPECT_EQ(stage.fit.solver.steps, 4);  // the flat key.
   EXPECT_FALSE(stage.fit.fit_roughness);
+  // Flat keys do not change what the stage is.
+  EXPECT_EQ(stage.fit.phases, PhaseSchedule::kTexture);
+  EXPECT_FALSE(stage.fit.fit_albedo);
+  EXPECT_DOUBLE_EQ(stage.fit.regularizers.environment_smoothness, 0.1);
 
   for (const char* bad : {R"({"environment_size": [1, 8]})", R"({"environment_size": 16})",
                           R"({"environment_size": [16, 300]})"}) {
