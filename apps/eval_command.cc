@@ -40,7 +40,8 @@ struct EvalCommandOptions {
 
 // The files the reconstruction mode reads (for the --json and --out location checks).
 RunInputs ReconstructionInputs(const EvalCommandOptions& opts) {
-  RunInputs inputs{{opts.dataset, opts.reconstruction}, {opts.mesh.mesh}};
+  RunInputs inputs{{opts.dataset, opts.reconstruction},
+                   {opts.mesh.mesh, opts.images.true_environment}};
   // An inline JSON material is no file.
   if (!opts.images.material.empty() && opts.images.material.front() != '{') {
     inputs.files.push_back(opts.images.material);
@@ -166,6 +167,9 @@ CommandRunner SetupEvalCommand(CLI::App* app) {
                   "repeatable")
       ->expected(1)
       ->take_all();
+  app->add_option("--true-environment", opts->images.true_environment,
+                  "Reconstruction mode, estimated lighting: the true environment (EXR, world "
+                  "frame); reports the fitted map's relative error after the albedo's gauge");
   app->add_option("--out", opts->images.out,
                   "Reconstruction mode: write the --relight renders under DIR/relight/");
   app->add_option("--json", opts->json, "Also write the JSON to this file");

@@ -112,6 +112,10 @@ Status ResumedStages(const ReconstructCommandOptions& cli, const RunState& state
       return Status::Error(cli.config + ": stages/schedule: a resumed run keeps its stages " +
                            "(only flat keys may change)");
     }
+    if (overrides.environment_given) {
+      return Status::Error(cli.config + ": environment_stage/environment_size: a resumed run " +
+                           "keeps its stages and its fitted environment");
+    }
   }
   SFT_RETURN_IF_ERROR(FlagKeys(cli, &overrides));
   if (overrides.holdout_given && overrides.holdout != state.holdout) {
@@ -161,14 +165,10 @@ Status PrintSchedule(const std::vector<StageOptions>& stages, const Dataset& dat
 }
 
 // Unknown lighting (no view lists lights) is estimated as a fitted environment
-// (src/optim/fitted_environment.h), said in one line; `run` is the resumed folder ("" fresh).
-// A fresh run's map is fixed in `frame` ("world" or "camera"); a resumed one keeps its own.
-Status UnknownLighting(const std::string& run, const ReconstructCommandOptions& cli,
-                       const std::string& frame, Dataset* dataset) {
-  EnvironmentEstimateOptions options;
-  if (!LightFrameFromName(frame, &options.frame)) {
-    return Status::Error("environment_frame: expected \"world\" or \"camera\"");
-  }
+// (src/optim/fitted_environment.h), said in one line; `run` is the resumed folder ("" fresh),
+// whose map keeps its own frame.
+Status UnknownLighting(const std::string& run, const EnvironmentEstimateOptions& options,
+                       const ReconstructCommandOptions& cli, Dataset* dataset) {
   std::string note;
   SFT_RETURN_IF_ERROR(PrepareUnknownLighting(run, options, dataset, &note));
   if (!note.empty() && !cli.quiet) {
@@ -200,7 +200,7 @@ Status PrepareSchedule(ReconstructCommandOptions* cli, Dataset* dataset,
       return PrintSchedule(stages, *dataset, state.holdout, state.held_out_views);
     }
     SFT_RETURN_IF_ERROR(CheckOutputDirectory(cli->out, {{cli->dataset}, {}}, "--resume"));
-    SFT_RETURN_IF_ERROR(UnknownLighting(cli->resume, *cli, "world", dataset));
+    SFT_RETURN_IF_ERROR(UnknownLighting(cli->resume, EnvironmentEstimateOptions(), *cli, dataset));
     if (before_start) SFT_RETURN_IF_ERROR(before_start(cli->dataset, *dataset, stages));
     SFT_RETURN_IF_ERROR(Schedule::Resume(*dataset, cli->out, stages, state.run_info, state.progress,
                                          state.view_gains, schedule));
@@ -215,6 +215,11 @@ Status PrepareSchedule(ReconstructCommandOptions* cli, Dataset* dataset,
   SFT_RETURN_IF_ERROR(ChooseStart(*dataset, cli->init, &start));
   ScheduleConfig config;
   SFT_RETURN_IF_ERROR(FreshStages(*cli, start, &config, &stages));
+  if (LightingUnknown(*dataset) && config.environment_stage) {
+    StageOptions environment;
+    SFT_RETURN_IF_ERROR(EnvironmentStage(config, &environment));
+    stages.insert(stages.begin(), std::move(environment));
+  }
   std::vector<int> held_out;
   SFT_RETURN_IF_ERROR(ApplyHoldout(config.holdout, config.flat.value("views", std::vector<int>()),
                                    static_cast<int>(dataset->views.size()), &stages, &held_out));
@@ -227,7 +232,11 @@ Status PrepareSchedule(ReconstructCommandOptions* cli, Dataset* dataset,
                          ": holds an earlier reconstruction (continue it with --resume " +
                          cli->out + ", or choose another folder)");
   }
-  SFT_RETURN_IF_ERROR(UnknownLighting("", *cli, config.environment_frame, dataset));
+  EnvironmentEstimateOptions estimate = config.environment;
+  if (!LightFrameFromName(config.environment_frame, &estimate.frame)) {
+    return Status::Error("environment_frame: expected \"world\" or \"camera\"");
+  }
+  SFT_RETURN_IF_ERROR(UnknownLighting("", estimate, *cli, dataset));
   ScheduleStart state;
   SFT_RETURN_IF_ERROR(LoadStartMesh(*dataset, start, InitialMeshOptions(), &state.mesh, held_out));
   SFT_RETURN_IF_ERROR(LoadMaterial(cli->material.empty() ? kInitialMaterial : cli->material,

@@ -287,6 +287,32 @@ Status ScoreAlbedo(bool lighting_estimated, PassScores* scores, Eigen::Vector3d*
   return Status::Ok();
 }
 
+// {"rel_rmse", "irradiance_rel_rmse", "width", "height"} of the run's fitted map against
+// options.true_environment after the albedo's gauge; null without one. An error for a run whose
+// lighting was given.
+Status ScoreEnvironment(const RunToRender& run, const ReconstructionEvalOptions& options,
+                        const Eigen::Vector3d& albedo_scale, json* score) {
+  *score = nullptr;
+  if (options.true_environment.empty()) return Status::Ok();
+  const int light = FittedEnvironmentLight(run.dataset);
+  if (!run.lighting_estimated || light < 0) {
+    return Status::Error("--true-environment: the dataset's lighting is given, nothing was fitted");
+  }
+  Image truth;
+  SFT_RETURN_IF_ERROR(ReadImage(options.true_environment, &truth));
+  const LightSpec& fitted = run.dataset.lights[light];
+  Image map = fitted.pixels;
+  for (float& value : map.data) value *= static_cast<float>(fitted.scale);
+  EnvironmentError error;
+  Status status = FittedEnvironmentError(map, ToRgb(truth), albedo_scale, &error);
+  if (!status.ok()) return Status::Error(options.true_environment + ": " + status.message());
+  *score = {{"rel_rmse", error.radiance},
+            {"irradiance_rel_rmse", error.irradiance},
+            {"width", map.width},
+            {"height", map.height}};
+  return Status::Ok();
+}
+
 }  // namespace
 
 Status EvaluateReconstruction(const std::string& dataset_dir, const std::string& reconstruction,
@@ -316,6 +342,8 @@ Status EvaluateReconstruction(const std::string& dataset_dir, const std::string&
                                  options.held_out ? &held_out : nullptr, &scores));
   Eigen::Vector3d albedo_scale;
   SFT_RETURN_IF_ERROR(ScoreAlbedo(run.lighting_estimated, &scores, &albedo_scale));
+  json environment;
+  SFT_RETURN_IF_ERROR(ScoreEnvironment(run, options, albedo_scale, &environment));
   json relight = nullptr;
   if (!conditions.empty()) {
     RelightInputs inputs;
@@ -344,6 +372,7 @@ Status EvaluateReconstruction(const std::string& dataset_dir, const std::string&
              {"albedo", scores.albedo.ToJson()},
              {"lighting", run.lighting_estimated ? "estimated" : "given"},
              {"albedo_scale", {albedo_scale[0], albedo_scale[1], albedo_scale[2]}},
+             {"environment", environment},
              {"roughness", scores.roughness.ToJson()},
              {"relight", relight},
              {"held_out", HeldOutJson(options.held_out, held_out, scores.held_out)}};

@@ -39,6 +39,10 @@ struct ReconstructionEvalOptions {
   // Score the run's held-out views (state.json's held_out_views; src/eval/held_out_eval.h)
   // instead of `views`: "full" after the median fitted gain, and a "held_out" section.
   bool held_out = false;
+  // The true environment of a dataset whose lighting the run estimated (an equirectangular EXR
+  // in the world frame): adds "environment" with the fitted map's relative error after the
+  // albedo's gauge (FittedEnvironmentError, src/optim/fitted_environment.h). Empty = none.
+  std::string true_environment;
 
   bool Check(std::string* why) const;
 };

@@ -262,6 +262,8 @@ const std::map<std::string, Key>& Keys() {
                      [](const O& o) { return std::string(PhaseScheduleName(o.phases)); })},
       {"outer_iterations", Int([](O* o) -> int& { return o->outer_iterations; }, 1, 10000)},
       {"normal_sliding", Bool([](O* o) -> bool& { return o->cache.edges.normal_sliding; })},
+      {"fit_albedo", Bool([](O* o) -> bool& { return o->fit_albedo; })},
+      {"fit_roughness", Bool([](O* o) -> bool& { return o->fit_roughness; })},
       {"fit_specular", Bool([](O* o) -> bool& { return o->fit_specular; })},
       {"fit_lights", Bool([](O* o) -> bool& { return o->fit_lights; })},
       {"fit_light_positions", Bool([](O* o) -> bool& { return o->fit_light_positions; })},

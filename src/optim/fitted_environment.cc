@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <nlohmann/json.hpp>
+#include <vector>
 
 #include "src/core/file_util.h"
 #include "src/image/image_io.h"
@@ -165,6 +167,82 @@ Status PrepareUnknownLighting(const std::string& run, const EnvironmentEstimateO
             " environment with the material (albedo is then known up to one scale per channel)";
   }
   return AddFittedEnvironment(texels, frame, dataset);
+}
+
+namespace {
+
+// Texel t's direction on a w × h lat-long grid (any fixed convention serves: both maps share it).
+Eigen::Vector3d TexelDirection(int t, int w, int h) {
+  const double theta = M_PI * ((t / w) + 0.5) / h, phi = 2.0 * M_PI * ((t % w) + 0.5) / w;
+  return {std::sin(theta) * std::cos(phi), std::cos(theta), std::sin(theta) * std::sin(phi)};
+}
+
+// √(Σ_t w_t‖a_t − b_t‖² / Σ_t w_t‖b_t‖²) over RGB triples.
+double RelativeRmse(const std::vector<Eigen::Vector3d>& a, const std::vector<Eigen::Vector3d>& b,
+                    const std::vector<double>& weight) {
+  double error = 0.0, norm = 0.0;
+  for (size_t t = 0; t < a.size(); ++t) {
+    error += weight[t] * (a[t] - b[t]).squaredNorm();
+    norm += weight[t] * b[t].squaredNorm();
+  }
+  return norm > 0.0 ? std::sqrt(error / norm) : std::numeric_limits<double>::infinity();
+}
+
+// The irradiance at every texel's direction of a map given per texel with solid angles `weight`.
+std::vector<Eigen::Vector3d> Irradiance(const std::vector<Eigen::Vector3d>& radiance,
+                                        const std::vector<double>& weight, int w, int h) {
+  std::vector<Eigen::Vector3d> dirs(radiance.size());
+  for (size_t t = 0; t < dirs.size(); ++t) dirs[t] = TexelDirection(static_cast<int>(t), w, h);
+  std::vector<Eigen::Vector3d> irradiance(radiance.size(), Eigen::Vector3d::Zero());
+  for (size_t n = 0; n < dirs.size(); ++n) {
+    for (size_t t = 0; t < dirs.size(); ++t) {
+      const double cosine = dirs[n].dot(dirs[t]);
+      if (cosine > 0.0) irradiance[n] += radiance[t] * (weight[t] * cosine);
+    }
+  }
+  return irradiance;
+}
+
+}  // namespace
+
+Status FittedEnvironmentError(const Image& fitted, const Image& truth,
+                              const Eigen::Vector3d& albedo_scale, EnvironmentError* error) {
+  if (fitted.empty() || fitted.channels < 3 || truth.empty() || truth.channels < 3) {
+    return Status::Error("environment error: needs two non-empty RGB maps");
+  }
+  for (int c = 0; c < 3; ++c) {
+    if (!(albedo_scale[c] > 0.0 && std::isfinite(albedo_scale[c]))) {
+      return Status::Error("environment error: the albedo scale must be finite and > 0");
+    }
+  }
+  const int w = fitted.width, h = fitted.height;
+  // Box filter of the truth onto the fitted grid, every truth pixel weighed by its solid angle
+  // (2π/W_t · π/H_t · sin θ); a texel's weight sums to its solid angle.
+  const double pixel = 2.0 * M_PI * M_PI / (static_cast<double>(truth.width) * truth.height);
+  std::vector<Eigen::Vector3d> ours(w * h), theirs(w * h, Eigen::Vector3d::Zero());
+  std::vector<double> weight(w * h, 0.0);
+  for (int y = 0; y < truth.height; ++y) {
+    const double solid_angle = pixel * std::sin(M_PI * (y + 0.5) / truth.height);
+    const int ty = std::min(h - 1, static_cast<int>(static_cast<int64_t>(y) * h / truth.height));
+    for (int x = 0; x < truth.width; ++x) {
+      const int tx = std::min(w - 1, static_cast<int>(static_cast<int64_t>(x) * w / truth.width));
+      const int t = ty * w + tx;
+      weight[t] += solid_angle;
+      for (int c = 0; c < 3; ++c) theirs[t][c] += solid_angle * truth.at(x, y, c);
+    }
+  }
+  for (int t = 0; t < w * h; ++t) {
+    // A texel finer than the truth's pixels gets none (weight 0: left out).
+    if (weight[t] > 0.0) theirs[t] /= weight[t];
+    for (int c = 0; c < 3; ++c) ours[t][c] = fitted.at(t % w, t / w, c) / albedo_scale[c];
+  }
+  error->radiance = RelativeRmse(ours, theirs, weight);
+  error->irradiance =
+      RelativeRmse(Irradiance(ours, weight, w, h), Irradiance(theirs, weight, w, h), weight);
+  if (!std::isfinite(error->radiance) || !std::isfinite(error->irradiance)) {
+    return Status::Error("environment error: the true environment is black or not finite");
+  }
+  return Status::Ok();
 }
 
 }  // namespace sft

@@ -16,6 +16,7 @@
 #ifndef SFT_OPTIM_FITTED_ENVIRONMENT_H_
 #define SFT_OPTIM_FITTED_ENVIRONMENT_H_
 
+#include <Eigen/Core>
 #include <string>
 
 #include "src/core/image.h"
@@ -75,6 +76,21 @@ int FittedEnvironmentLight(const Dataset& dataset);
 // otherwise changes nothing (*note empty). Errors name the file.
 Status PrepareUnknownLighting(const std::string& run, const EnvironmentEstimateOptions& options,
                               Dataset* dataset, std::string* note);
+
+// How far a fitted map is from the true environment, both relative RMS errors (dimensionless, 0 =
+// exact) over the fitted grid, every texel weighed by its solid angle.
+struct EnvironmentError {
+  double radiance = 0.0;    // of the texels' radiance.
+  double irradiance = 0.0;  // of the irradiance E(n) = ∫ L(ω)·max(0, n·ω) dω at the texels' n.
+};
+
+// The error of `fitted` against `truth` (an equirectangular probe in the fitted map's frame, any
+// resolution, RGB or RGBA): `truth` is box-filtered onto the fitted grid, and the fitted radiance
+// is divided per channel by `albedo_scale` (the albedo's gauge: when s·albedo matches the true
+// albedo, radiance / s matches the true radiance); √(Σ w‖f/s − t‖² / Σ w‖t‖²). Errors: an empty
+// or non-RGB image, a non-positive or non-finite scale, a black truth.
+Status FittedEnvironmentError(const Image& fitted, const Image& truth,
+                              const Eigen::Vector3d& albedo_scale, EnvironmentError* error);
 
 }  // namespace sft
 

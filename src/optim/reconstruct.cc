@@ -21,8 +21,8 @@ double NowSeconds() {
 ActiveParameters TexturePhase(const ReconstructOptions& options) {
   ActiveParameters active;
   active.vertices = false;
-  active.albedo = true;
-  active.roughness = true;
+  active.albedo = options.fit_albedo;
+  active.roughness = options.fit_roughness;
   active.specular = options.fit_specular;
   active.lights = options.fit_lights;
   active.light_positions = options.fit_light_positions;

@@ -35,6 +35,8 @@ struct ReconstructOptions {
   RegularizerOptions regularizers;                   // Laplacian and texel smoothness weights.
   PhaseSchedule phases = PhaseSchedule::kAlternate;  // texture, geometry or both alternating.
   int outer_iterations = 4;   // outer iterations (fresh seeds each), [1, 10000].
+  bool fit_albedo = true;     // the texture phase fits the albedo texels (false: held as given).
+  bool fit_roughness = true;  // the texture phase fits the roughness texels (false: held).
   bool fit_specular = false;  // the texture phase also fits the specular weight.
   bool fit_lights = false;    // the texture phase also fits the light intensity scales.
   // The texture phase also fits the point lights' positions (3 per light: a world-frame light's
@@ -45,8 +47,11 @@ struct ReconstructOptions {
   // the fixed gauge; src/optim/parameters.h, kExposureGaugeView).
   bool fit_exposure = false;
   // The texture phase also fits the fitted environment's texels (unknown lighting,
-  // src/optim/fitted_environment.h); without a fitted environment it changes nothing.
-  bool fit_environment = true;
+  // src/optim/fitted_environment.h); without a fitted environment it changes nothing. Off by
+  // default: `sft reconstruct` fits the map in an automatic first stage with the material held
+  // (schedule_config.h, EnvironmentStage) and holds it after, since fitted with the albedo the
+  // map and the albedo trade shading between them.
+  bool fit_environment = false;
   uint64_t seed = 1;       // base seed of the renders.
   std::vector<int> views;  // dataset views to fit; empty = all.
   // Shading of the fit's renders: "auto" (the dataset's, DatasetShading in src/io/scene_setup.h:

@@ -75,6 +75,16 @@ const char kHullSchedule[] = R"([
    "adam_views_per_step": 16, "restart_roughness": 0.5, "restart_specular": 0.2}
 ])";
 
+// environment: the automatic first stage under unknown lighting. The map alone, from a uniform
+// albedo: with the albedo free, the map and the albedo trade shading between them; a light
+// smoothness prior lets the map hold the probe's bright lights (docs/design-notes.md,
+// "Separating the fitted environment from the albedo").
+const char kEnvironmentStage[] = R"({"name": "environment", "solver": "lm",
+  "outer_iterations": 2, "steps": 8, "environment_smoothness": 0.1})";
+// What makes it the environment stage; flat keys (e.g. --phases) do not change these.
+const char kEnvironmentStageRole[] = R"({"phases": "texture", "fit_albedo": false,
+  "fit_roughness": false, "fit_specular": false, "fit_environment": true})";
+
 // The flat keys that describe one stage's phases and solver loop: given any of them, `auto`
 // with a given mesh picks the one-stage `refine` list rather than a list whose stages set them.
 bool FlatKeysDescribeOneStage(const json& flat) {
@@ -251,6 +261,36 @@ Status MergeScheduleConfig(const json& config, const std::string& source, Schedu
       }
       out->environment_frame = value.get<std::string>();
       out->environment_frame_given = true;
+    } else if (name == "environment_size") {
+      EnvironmentEstimateOptions size = out->environment;
+      if (value.is_array() && value.size() == 2 && value[0].is_number_integer() &&
+          value[1].is_number_integer()) {
+        size.width = static_cast<int>(std::clamp<int64_t>(value[0].get<int64_t>(), -1, 1 << 20));
+        size.height = static_cast<int>(std::clamp<int64_t>(value[1].get<int64_t>(), -1, 1 << 20));
+      } else {
+        size.width = 0;  // fails the check below.
+      }
+      std::string why;
+      if (!size.Check(&why)) {
+        return Status::Error(source +
+                             ": environment_size: expected [width, height], width in [2, 512] and "
+                             "height in [1, 256]");
+      }
+      out->environment = size;
+      out->environment_given = true;
+    } else if (name == "environment_stage") {
+      if (value.is_boolean()) {
+        out->environment_stage = value.get<bool>();
+      } else if (value.is_object()) {
+        StageOptions probe;
+        SFT_RETURN_IF_ERROR(ApplyStageConfig(value, source + ": environment_stage", &probe));
+        out->environment_stage = true;
+        out->environment_stage_keys.update(value);
+      } else {
+        return Status::Error(source + ": environment_stage: expected true, false or an object " +
+                             "of stage keys");
+      }
+      out->environment_given = true;
     } else if (name == "name") {
       return Status::Error(source + ": name: a stage key (put it inside \"stages\")");
     } else {
@@ -266,6 +306,18 @@ Status ReadScheduleConfig(const std::string& path, ScheduleConfig* out) {
   json config;
   SFT_RETURN_IF_ERROR(ParseJsonFile(path, &config));
   return MergeScheduleConfig(config, path, out);
+}
+
+Status EnvironmentStage(const ScheduleConfig& config, StageOptions* stage) {
+  *stage = StageOptions();
+  const std::string where = "environment stage";
+  SFT_RETURN_IF_ERROR(ApplyStageConfig(json::parse(kEnvironmentStage), where, stage));
+  SFT_RETURN_IF_ERROR(ApplyStageConfig(config.flat, "flat keys", stage));
+  SFT_RETURN_IF_ERROR(ApplyStageConfig(json::parse(kEnvironmentStageRole), where, stage));
+  SFT_RETURN_IF_ERROR(ApplyStageConfig(config.environment_stage_keys, where, stage));
+  std::string why;
+  if (!stage->Check(&why)) return Status::Error(where + ": " + why);
+  return Status::Ok();
 }
 
 Status ResolveStages(const ScheduleConfig& config, bool carved_start,

@@ -6,6 +6,8 @@
 //   - "stages": an explicit stage list (an array of objects) instead of a built-in one;
 //   - "holdout": K, every K-th selected view is kept out of the fit (src/optim/holdout.h);
 //   - "environment_frame": "world" or "camera", where unknown lighting's fitted map is fixed.
+//   - "environment_size": [W, H] and "environment_stage": unknown lighting's fitted map and the
+//     automatic first stage that fits it alone (src/optim/fitted_environment.h).
 // A stage object holds any flat key plus "name", and the stage-only keys "texel_resolution",
 // "remesh", "remesh_edge_pixels", "resample", "resample_fold_fraction", "material_model" and
 // "texture_size" (the effect planner's keys, "effects": "auto" and "pin", are flat keys: config.h).
@@ -19,6 +21,7 @@
 #include <vector>
 
 #include "src/core/status.h"
+#include "src/optim/fitted_environment.h"
 #include "src/optim/schedule.h"
 
 namespace sft {
@@ -33,6 +36,13 @@ struct ScheduleConfig {
   // "camera" (src/optim/fitted_environment.h).
   std::string environment_frame = "world";
   bool environment_frame_given = false;  // given (a resumed run must not change it).
+  // Unknown lighting: the fitted map's size ("environment_size": [W, H]).
+  EnvironmentEstimateOptions environment;
+  // "environment_stage": false = no automatic environment stage; an object = stage keys over
+  // the built-in stage's (EnvironmentStage).
+  bool environment_stage = true;
+  nlohmann::json environment_stage_keys = nlohmann::json::object();
+  bool environment_given = false;  // either key was given (a resumed run keeps its map and stages).
 };
 
 // Adds `config`'s keys to *out (later calls override earlier ones key by key; "stages" and
@@ -46,6 +56,13 @@ Status ReadScheduleConfig(const std::string& path, ScheduleConfig* out);
 // `refine` when a flat key describes one stage's loop (phases, solver, outer_iterations, steps).
 Status ResolveStages(const ScheduleConfig& config, bool carved_start,
                      std::vector<StageOptions>* stages);
+
+// The automatic first stage of a run whose lighting is unknown (docs/reconstruct.md, "Unknown
+// lighting"): "environment", a texture stage that fits the environment map alone with the
+// material held as it starts (LM). Its keys: the built-in ones < the flat keys < its role
+// (phases texture, fit_albedo/fit_roughness/fit_specular false, fit_environment true) <
+// config.environment_stage_keys.
+Status EnvironmentStage(const ScheduleConfig& config, StageOptions* stage);
 
 // Applies stage keys (a stage object or flat keys) to one stage.
 Status ApplyStageConfig(const nlohmann::json& keys, const std::string& source, StageOptions* stage);

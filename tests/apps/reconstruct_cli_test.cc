@@ -8,6 +8,8 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "src/core/image.h"
+#include "src/image/image_io.h"
 #include "tests/testing/synth_dataset.h"
 #include "tests/testing/temp_dir.h"
 
@@ -183,6 +185,53 @@ TEST(ReconstructCliTest, PrintScheduleFollowsTheStart) {
   EXPECT_THAT(out, HasSubstr("1/4"));
   EXPECT_GE(CountLines(out), 4) << out;
   EXPECT_FALSE(fs::exists(tmp.Join("o")));
+}
+
+// Unknown lighting (a probe-lit dataset with its lights removed): the schedule starts with the
+// automatic environment stage (not with "environment_stage": false), a resumed run refuses the
+// environment keys, and sft eval --true-environment scores the fitted map against the probe.
+TEST(ReconstructCliTest, UnknownLightingStartsWithTheEnvironmentStage) {
+  testing::TempDir tmp;
+  Image probe(8, 4, 3);
+  for (size_t k = 0; k < probe.data.size(); ++k) probe.data[k] = (k / 3) % 8 < 4 ? 2.0f : 0.3f;
+  ASSERT_TRUE(WriteExr(tmp.Join("probe.exr"), probe).ok());
+  ASSERT_EQ(testing::SynthIcosphere(tmp.Join("ds"),
+                                    "--cameras 3 --zooms 1 --res 12 --spp 4 "
+                                    "--bounces 1 --envmap " +
+                                        tmp.Join("probe.exr")),
+            "");
+  nlohmann::json scene = nlohmann::json::parse(testing::ReadTestFile(tmp.Join("ds/scene.json")));
+  scene["lights"] = nlohmann::json::array();
+  for (nlohmann::json& view : scene["views"]) view["lights"] = nlohmann::json::array();
+  testing::WriteTestFile(tmp.Join("ds/scene.json"), scene.dump(1));
+  const std::string base = "reconstruct --dataset " + tmp.Join("ds") + " --init " +
+                           tmp.Join("ds/gt/mesh.ply") + " --outer 1 --steps 1 --spp 2";
+  std::string out;
+  ASSERT_EQ(RunSft(base + " --print-schedule", &out), 0) << out;
+  EXPECT_EQ(CountLines(out), 3) << out;  // the header, environment, refine.
+  EXPECT_LT(out.find("environment"), out.find("refine")) << out;
+  testing::WriteTestFile(tmp.Join("cfg.json"), R"({"environment_stage": false})");
+  ASSERT_EQ(RunSft(base + " --print-schedule --config " + tmp.Join("cfg.json"), &out), 0) << out;
+  EXPECT_EQ(out.find("environment"), std::string::npos) << out;
+
+  ASSERT_EQ(RunSft(base + " --quiet --no-report --out " + tmp.Join("o"), &out), 0) << out;
+  EXPECT_TRUE(fs::exists(tmp.Join("o/environment.exr")));
+  EXPECT_EQ(
+      RunSft("reconstruct --quiet --resume " + tmp.Join("o") + " --config " + tmp.Join("cfg.json"),
+             &out),
+      1);
+  EXPECT_THAT(out, HasSubstr("environment_stage/environment_size"));
+  ASSERT_EQ(RunSft("eval --dataset " + tmp.Join("ds") + " --reconstruction " + tmp.Join("o") +
+                       " --spp 2 --true-environment " + tmp.Join("probe.exr") + " --json " +
+                       tmp.Join("eval.json"),
+                   &out),
+            0)
+      << out;
+  const nlohmann::json eval = nlohmann::json::parse(testing::ReadTestFile(tmp.Join("eval.json")));
+  EXPECT_EQ(eval["lighting"], "estimated");
+  ASSERT_TRUE(eval["environment"].is_object()) << eval.dump(1);
+  EXPECT_GT(eval["environment"]["irradiance_rel_rmse"].get<double>(), 0.0);
+  EXPECT_EQ(eval["environment"]["width"], 32);
 }
 
 TEST(ReconstructCliTest, BadInputIsOneLine) {

@@ -1,5 +1,6 @@
 // Unknown lighting as a fitted environment (src/optim/fitted_environment.h): the start map and its
-// gauge, the dataset it makes, and a fit that recovers the lighting of a probe it was not given.
+// gauge, the dataset it makes, a fit that recovers the lighting of a probe it was not given, and
+// the fitted map's error against a true probe.
 // (The renderer's environment-texel derivatives are checked against finite differences in
 // tests/render/derivatives_test.cc.)
 #include "src/optim/fitted_environment.h"
@@ -185,6 +186,7 @@ TEST_F(FittedEnvironmentTest, FitRecoversTheBrightSideOfAnUnknownProbe) {
                   .ok());
   ReconstructOptions options;
   options.phases = PhaseSchedule::kTexture;
+  options.fit_environment = true;
   options.cache.render.spp = 8;
   options.cache.render.bounces = 1;
   options.cache.pyramid_levels = 2;
@@ -313,6 +315,37 @@ TEST_F(CameraFixedEnvironmentTest, ExplainsAFlashThatAWorldFixedMapCannot) {
   EXPECT_GE(best_x, 4) << best_x << "," << best_y;
   EXPECT_LE(best_x, 6) << best_x << "," << best_y;
   EXPECT_GE(best_y, 2) << best_x << "," << best_y;
+}
+
+// The map's error against the truth: 0 for the truth's own box filter, also when the map is
+// brighter by the albedo's gauge; a constant map of the truth's mean radiance has both errors, the
+// irradiance's smaller; a black truth or a zero gauge is an error.
+TEST(FittedEnvironmentErrorTest, GaugeAndBoxFilter) {
+  const Image truth = TwoSidedProbe();  // 16 × 8: each 8 × 4 texel is 2 × 2 pixels of one value.
+  Image fitted(8, 4, 3);
+  const Eigen::Vector3d gauge(2.0, 1.0, 0.5);
+  for (int y = 0; y < 4; ++y) {
+    for (int x = 0; x < 8; ++x) {
+      for (int c = 0; c < 3; ++c) fitted.at(x, y, c) = truth.at(2 * x, 2 * y, c) * gauge[c];
+    }
+  }
+  EnvironmentError error;
+  ASSERT_TRUE(FittedEnvironmentError(fitted, truth, gauge, &error).ok());
+  EXPECT_NEAR(error.radiance, 0.0, 1e-6);
+  EXPECT_NEAR(error.irradiance, 0.0, 1e-6);
+  ASSERT_TRUE(FittedEnvironmentError(fitted, truth, Eigen::Vector3d::Ones(), &error).ok());
+  EXPECT_GT(error.radiance, 0.5);
+
+  Image constant(8, 4, 3);
+  constant.data.assign(constant.data.size(), 1.1f);  // the truth's mean green radiance.
+  ASSERT_TRUE(FittedEnvironmentError(constant, truth, Eigen::Vector3d::Ones(), &error).ok());
+  EXPECT_GT(error.radiance, 0.2);
+  EXPECT_GT(error.irradiance, 0.2);
+  EXPECT_LT(error.irradiance, error.radiance);  // the cosine lobe blurs the step.
+
+  EXPECT_FALSE(
+      FittedEnvironmentError(constant, Image(16, 8, 3), Eigen::Vector3d::Ones(), &error).ok());
+  EXPECT_FALSE(FittedEnvironmentError(constant, truth, Eigen::Vector3d(1, 0, 1), &error).ok());
 }
 
 }  // namespace
