@@ -273,6 +273,7 @@ class CameraFixedEnvironmentTest : public ::testing::Test {
     options.cache.render.bounces = 1;
     options.cache.pyramid_levels = 2;
     options.planner.enabled = false;
+    options.fit_environment = true;                  // jointly with the albedo.
     options.regularizers.albedo_smoothness = 100.0;  // the shading must come from the lighting.
     options.regularizers.environment_smoothness = 0.01;
     std::unique_ptr<Reconstruction> r;
