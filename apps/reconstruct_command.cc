@@ -217,7 +217,7 @@ Status PrepareSchedule(ReconstructCommandOptions* cli, Dataset* dataset,
   SFT_RETURN_IF_ERROR(FreshStages(*cli, start, &config, &stages));
   if (LightingUnknown(*dataset) && config.environment_stage) {
     StageOptions environment;
-    SFT_RETURN_IF_ERROR(EnvironmentStage(config, &environment));
+    SFT_RETURN_IF_ERROR(EnvironmentStage(config, stages.front(), &environment));
     stages.insert(stages.begin(), std::move(environment));
   }
   std::vector<int> held_out;

@@ -308,10 +308,15 @@ Status ReadScheduleConfig(const std::string& path, ScheduleConfig* out) {
   return MergeScheduleConfig(config, path, out);
 }
 
-Status EnvironmentStage(const ScheduleConfig& config, StageOptions* stage) {
+Status EnvironmentStage(const ScheduleConfig& config, const StageOptions& first,
+                        StageOptions* stage) {
   *stage = StageOptions();
   const std::string where = "environment stage";
   SFT_RETURN_IF_ERROR(ApplyStageConfig(json::parse(kEnvironmentStage), where, stage));
+  // The scale and pyramid the list starts at: a map of 32×16 texels needs no finer images, and a
+  // full-scale stage before a coarse-to-fine list would cost more than the list's first stages.
+  stage->fit.cache.image_scale_log2 = first.fit.cache.image_scale_log2;
+  stage->fit.cache.pyramid_levels = first.fit.cache.pyramid_levels;
   SFT_RETURN_IF_ERROR(ApplyStageConfig(config.flat, "flat keys", stage));
   SFT_RETURN_IF_ERROR(ApplyStageConfig(json::parse(kEnvironmentStageRole), where, stage));
   SFT_RETURN_IF_ERROR(ApplyStageConfig(config.environment_stage_keys, where, stage));

@@ -59,10 +59,12 @@ Status ResolveStages(const ScheduleConfig& config, bool carved_start,
 
 // The automatic first stage of a run whose lighting is unknown (docs/reconstruct.md, "Unknown
 // lighting"): "environment", a texture stage that fits the environment map alone with the
-// material held as it starts (LM). Its keys: the built-in ones < the flat keys < its role
+// material held as it starts (LM), at the image scale and pyramid levels of `first`, the list's
+// first stage. Its keys: the built-in ones and first's scale < the flat keys < its role
 // (phases texture, fit_albedo/fit_roughness/fit_specular false, fit_environment true) <
 // config.environment_stage_keys.
-Status EnvironmentStage(const ScheduleConfig& config, StageOptions* stage);
+Status EnvironmentStage(const ScheduleConfig& config, const StageOptions& first,
+                        StageOptions* stage);
 
 // Applies stage keys (a stage object or flat keys) to one stage.
 Status ApplyStageConfig(const nlohmann::json& keys, const std::string& source, StageOptions* stage);

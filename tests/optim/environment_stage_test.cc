@@ -125,7 +125,7 @@ testing::TempDir* EnvironmentStageTest::dir_ = nullptr;
 // 2.5× as much.
 TEST_F(EnvironmentStageTest, FittingTheMapFirstRecoversTheAlbedo) {
   StageOptions environment_stage;
-  ASSERT_TRUE(EnvironmentStage(ScheduleConfig(), &environment_stage).ok());
+  ASSERT_TRUE(EnvironmentStage(ScheduleConfig(), StageOptions(), &environment_stage).ok());
   EXPECT_EQ(environment_stage.name, "environment");
   EXPECT_FALSE(environment_stage.fit.fit_albedo);
   EXPECT_TRUE(environment_stage.fit.fit_environment);
@@ -177,8 +177,17 @@ TEST(EnvironmentStageConfigTest, KeysAndErrors) {
                   .ok());
   EXPECT_EQ(config.environment.width, 16);
   EXPECT_EQ(config.environment.height, 8);
+  // It starts at the list's first scale and pyramid; its own keys win (image_scale 0.5 above).
+  StageOptions first;
+  first.fit.cache.image_scale_log2 = 3;
+  first.fit.cache.pyramid_levels = 2;
   StageOptions stage;
-  ASSERT_TRUE(EnvironmentStage(config, &stage).ok());
+  ASSERT_TRUE(EnvironmentStage(ScheduleConfig(), first, &stage).ok());
+  EXPECT_EQ(stage.fit.cache.image_scale_log2, 3);
+  EXPECT_EQ(stage.fit.cache.pyramid_levels, 2);
+  ASSERT_TRUE(EnvironmentStage(config, first, &stage).ok());
+  EXPECT_EQ(stage.fit.cache.image_scale_log2, 1);
+  EXPECT_EQ(stage.fit.cache.pyramid_levels, 2);
   EXPECT_EQ(stage.fit.outer_iterations, 3);
   EXPECT_EQ(stage.fit.solver.steps, 4);  // the flat key.
   EXPECT_FALSE(stage.fit.fit_roughness);
