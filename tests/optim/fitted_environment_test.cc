@@ -23,6 +23,32 @@ namespace {
 
 using ::testing::HasSubstr;
 
+// Unknown lighting: `dataset` with every light and every view's light list removed.
+void RemoveLights(Dataset* dataset) {
+  dataset->lights.clear();
+  for (ViewSpec& view : dataset->views) {
+    view.lights.clear();
+    view.light_ids.clear();
+  }
+}
+
+// A texture fit of the map jointly with the albedo on these tests' 6 views at 32²: 8 spp, one
+// bounce, a nearly constant albedo (on a convex object a varying albedo could otherwise explain
+// the shading: the ambiguity docs/reconstruct.md describes), and a light map prior (its default
+// suits captures of many more pixels).
+ReconstructOptions JointMapFitOptions() {
+  ReconstructOptions options;
+  options.phases = PhaseSchedule::kTexture;
+  options.fit_environment = true;
+  options.cache.render.spp = 8;
+  options.cache.render.bounces = 1;
+  options.cache.pyramid_levels = 2;
+  options.planner.enabled = false;
+  options.regularizers.albedo_smoothness = 100.0;
+  options.regularizers.environment_smoothness = 0.01;
+  return options;
+}
+
 // A probe whose left half (u < 0.5) is 10× as bright as its right half, slightly warm.
 Image TwoSidedProbe() {
   Image probe(16, 8, 3);
@@ -59,11 +85,7 @@ class FittedEnvironmentTest : public ::testing::Test {
   void SetUp() override {
     ASSERT_TRUE(ReadDataset(dir_->Join("ds"), &dataset_).ok());
     ASSERT_FALSE(LightingUnknown(dataset_));
-    dataset_.lights.clear();
-    for (ViewSpec& view : dataset_.views) {
-      view.lights.clear();
-      view.light_ids.clear();
-    }
+    RemoveLights(&dataset_);
     ASSERT_TRUE(ReadMesh(dir_->Join("ds/gt/mesh.ply"), &mesh_).ok());
   }
 
@@ -184,19 +206,8 @@ TEST_F(FittedEnvironmentTest, FitRecoversTheBrightSideOfAnUnknownProbe) {
   ASSERT_TRUE(LoadMaterial(R"({"albedo": [0.5, 0.5, 0.5], "roughness": 0.6, "resolution": 1})",
                            mesh_, &start)
                   .ok());
-  ReconstructOptions options;
-  options.phases = PhaseSchedule::kTexture;
-  options.fit_environment = true;
-  options.cache.render.spp = 8;
-  options.cache.render.bounces = 1;
-  options.cache.pyramid_levels = 2;
-  options.planner.enabled = false;
-  // Albedo nearly constant: the shading must come from the lighting (on a convex object a
-  // varying albedo could otherwise explain it: the ambiguity docs/reconstruct.md describes).
-  options.regularizers.albedo_smoothness = 100.0;
-  // The probe's step between its halves is what the map must find: a light prior (its default
-  // suits captures of many more pixels than these 6 views at 32²).
-  options.regularizers.environment_smoothness = 0.01;
+  // The probe's step between its halves is what the map must find, from a nearly constant albedo.
+  const ReconstructOptions options = JointMapFitOptions();
   std::unique_ptr<Reconstruction> r;
   ASSERT_TRUE(Reconstruction::Create(dataset_, mesh_, start, {}, options, &r).ok());
   std::vector<IterationRecord> records;
@@ -249,11 +260,7 @@ class CameraFixedEnvironmentTest : public ::testing::Test {
   double Fit(LightFrame frame, Image* env) {
     Dataset dataset;
     EXPECT_TRUE(ReadDataset(dir_->Join("ds"), &dataset).ok());
-    dataset.lights.clear();
-    for (ViewSpec& view : dataset.views) {
-      view.lights.clear();
-      view.light_ids.clear();
-    }
+    RemoveLights(&dataset);
     TriMesh mesh;
     EXPECT_TRUE(ReadMesh(dir_->Join("ds/gt/mesh.ply"), &mesh).ok());
     EnvironmentEstimateOptions estimate;
@@ -267,15 +274,7 @@ class CameraFixedEnvironmentTest : public ::testing::Test {
     EXPECT_TRUE(LoadMaterial(R"({"albedo": [0.5, 0.5, 0.5], "roughness": 0.6, "resolution": 1})",
                              mesh, &start)
                     .ok());
-    ReconstructOptions options;
-    options.phases = PhaseSchedule::kTexture;
-    options.cache.render.spp = 8;
-    options.cache.render.bounces = 1;
-    options.cache.pyramid_levels = 2;
-    options.planner.enabled = false;
-    options.fit_environment = true;                  // jointly with the albedo.
-    options.regularizers.albedo_smoothness = 100.0;  // the shading must come from the lighting.
-    options.regularizers.environment_smoothness = 0.01;
+    const ReconstructOptions options = JointMapFitOptions();
     std::unique_ptr<Reconstruction> r;
     EXPECT_TRUE(Reconstruction::Create(dataset, mesh, start, {}, options, &r).ok());
     if (r == nullptr) return std::numeric_limits<double>::infinity();
