@@ -126,8 +126,9 @@ Status ResumedStages(const ReconstructCommandOptions& cli, const RunState& state
   if (overrides.environment_frame_given && LightingUnknown(dataset)) {
     LightFrame frame = LightFrame::kWorld;
     SFT_RETURN_IF_ERROR(ReadFittedEnvironmentFrame(cli.resume, &frame));
-    if (overrides.environment_frame != LightFrameName(frame)) {
-      return Status::Error("environment_frame " + overrides.environment_frame + ": the run in " +
+    if (overrides.environment.frame != frame) {
+      return Status::Error(std::string("environment_frame ") +
+                           LightFrameName(overrides.environment.frame) + ": the run in " +
                            cli.resume + " fits a " + LightFrameName(frame) +
                            "-fixed environment and keeps it");
     }
@@ -232,11 +233,7 @@ Status PrepareSchedule(ReconstructCommandOptions* cli, Dataset* dataset,
                          ": holds an earlier reconstruction (continue it with --resume " +
                          cli->out + ", or choose another folder)");
   }
-  EnvironmentEstimateOptions estimate = config.environment;
-  if (!LightFrameFromName(config.environment_frame, &estimate.frame)) {
-    return Status::Error("environment_frame: expected \"world\" or \"camera\"");
-  }
-  SFT_RETURN_IF_ERROR(UnknownLighting("", estimate, *cli, dataset));
+  SFT_RETURN_IF_ERROR(UnknownLighting("", config.environment, *cli, dataset));
   ScheduleStart state;
   SFT_RETURN_IF_ERROR(LoadStartMesh(*dataset, start, InitialMeshOptions(), &state.mesh, held_out));
   SFT_RETURN_IF_ERROR(LoadMaterial(cli->material.empty() ? kInitialMaterial : cli->material,

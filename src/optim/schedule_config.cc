@@ -256,10 +256,10 @@ Status MergeScheduleConfig(const json& config, const std::string& source, Schedu
       out->holdout = value.get<int>();
       out->holdout_given = true;
     } else if (name == "environment_frame") {
-      if (!value.is_string() || (value != "world" && value != "camera")) {
+      if (!value.is_string() ||
+          !LightFrameFromName(value.get<std::string>(), &out->environment.frame)) {
         return Status::Error(source + ": environment_frame: expected \"world\" or \"camera\"");
       }
-      out->environment_frame = value.get<std::string>();
       out->environment_frame_given = true;
     } else if (name == "environment_size") {
       EnvironmentEstimateOptions size = out->environment;

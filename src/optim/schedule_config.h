@@ -32,12 +32,10 @@ struct ScheduleConfig {
   nlohmann::json flat = nlohmann::json::object();  // keys that override every stage.
   int holdout = 0;             // "holdout": every K-th selected view held out; 0 = off, K >= 2.
   bool holdout_given = false;  // "holdout" was given (a resumed run must not change it).
-  // "environment_frame": where a fitted environment (unknown lighting) is fixed, "world" or
-  // "camera" (src/optim/fitted_environment.h).
-  std::string environment_frame = "world";
-  bool environment_frame_given = false;  // given (a resumed run must not change it).
-  // Unknown lighting: the fitted map's size ("environment_size": [W, H]).
+  // Unknown lighting: the fitted map's size ("environment_size": [W, H]) and the frame it is
+  // fixed in ("environment_frame": "world" or "camera"; src/optim/fitted_environment.h).
   EnvironmentEstimateOptions environment;
+  bool environment_frame_given = false;  // "environment_frame" given (a resume must not change it).
   // "environment_stage": false = no automatic environment stage; an object = stage keys over
   // the built-in stage's (EnvironmentStage).
   bool environment_stage = true;

@@ -221,6 +221,18 @@ TEST(ReconstructCliTest, UnknownLightingStartsWithTheEnvironmentStage) {
              &out),
       1);
   EXPECT_THAT(out, HasSubstr("environment_stage/environment_size"));
+  // The run fitted a world-fixed map; a resume keeps that frame (the same frame is accepted).
+  EXPECT_EQ(RunSft("reconstruct --quiet --resume " + tmp.Join("o") + " --environment-frame camera",
+                   &out),
+            1);
+  EXPECT_THAT(out, HasSubstr("environment_frame camera: the run in " + tmp.Join("o") +
+                             " fits a world-fixed environment"));
+  EXPECT_EQ(CountLines(out), 1) << out;
+  ASSERT_EQ(RunSft("reconstruct --quiet --no-report --resume " + tmp.Join("o") +
+                       " --environment-frame world",
+                   &out),
+            0)
+      << out;
   ASSERT_EQ(RunSft("eval --dataset " + tmp.Join("ds") + " --reconstruction " + tmp.Join("o") +
                        " --spp 2 --true-environment " + tmp.Join("probe.exr") + " --json " +
                        tmp.Join("eval.json"),

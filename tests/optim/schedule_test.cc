@@ -29,10 +29,10 @@ using ::testing::HasSubstr;
 // error naming the file and the key.
 TEST(ScheduleConfigTest, EnvironmentFrameIsWorldOrCamera) {
   ScheduleConfig config;
-  EXPECT_EQ(config.environment_frame, "world");
+  EXPECT_EQ(config.environment.frame, LightFrame::kWorld);
   EXPECT_FALSE(config.environment_frame_given);
   ASSERT_TRUE(MergeScheduleConfig({{"environment_frame", "camera"}}, "cfg", &config).ok());
-  EXPECT_EQ(config.environment_frame, "camera");
+  EXPECT_EQ(config.environment.frame, LightFrame::kCamera);
   EXPECT_TRUE(config.environment_frame_given);
   EXPECT_TRUE(config.flat.empty());  // not a stage key.
   for (const json& bad : {json("object"), json(1)}) {
