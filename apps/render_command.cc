@@ -66,11 +66,7 @@ Status RunRender(const RenderCommandOptions& opts) {
   // need no light, so they also render datasets with unknown lighting (empty `lights`).
   if (render.pass == RenderPass::kColor) SFT_RETURN_IF_ERROR(CheckViewsHaveLights(dataset));
   if (!opts.lights.empty()) {
-    std::vector<double> scales;
-    std::vector<Eigen::Vector3d> positions;
-    SFT_RETURN_IF_ERROR(ReadLightScales(opts.lights, dataset, &scales, &positions));
-    ApplyLightScales(scales, &dataset);
-    ApplyLightPositions(positions, &dataset);
+    SFT_RETURN_IF_ERROR(ApplyLightsFile(opts.lights, &dataset));
   }
   TriMesh mesh;
   SFT_RETURN_IF_ERROR(ReadMesh(opts.mesh, &mesh));

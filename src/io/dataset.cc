@@ -56,6 +56,7 @@ constexpr Keys kTopLevelKeys = {
 constexpr Keys kSimilarityKeys = {"scale", "rotation", "translation"};
 constexpr Keys kCameraKeys = {"id", "model", "width", "height", "params"};
 constexpr Keys kPointLightKeys = {"id", "type", "frame", "position", "intensity"};
+constexpr Keys kDirectionalLightKeys = {"id", "type", "frame", "direction", "irradiance"};
 constexpr Keys kEnvironmentLightKeys = {"id", "type", "frame", "image", "world_from_env", "scale"};
 constexpr Keys kViewKeys = {"image", "mask", "camera", "lights", "cam_from_world"};
 constexpr Keys kPoseKeys = {"rotation", "translation"};
@@ -302,25 +303,49 @@ class SceneParser {
     return Status::Ok();
   }
 
+  // Three non-negative numbers, or one grey number g for [g, g, g] (a light's RGB power).
+  Status NonNegativeRgb(const json& entry, const std::string& path, const char* key,
+                        Eigen::Vector3d* out) const {
+    const json* value = nullptr;
+    SFT_RETURN_IF_ERROR(Require(entry, path, key, &value));
+    const std::string field = Field(path, key);
+    if (value->is_number()) {  // a grey light.
+      double grey = 0;
+      SFT_RETURN_IF_ERROR(Number(*value, field, &grey));
+      *out = Eigen::Vector3d::Constant(grey);
+    } else {
+      SFT_RETURN_IF_ERROR(Vector3(*value, field, out));
+    }
+    if ((out->array() < 0).any()) return Error(field, "must be non-negative");
+    return Status::Ok();
+  }
+
   Status ParsePointLight(const json& entry, const std::string& path, LightSpec* light) const {
     light->type = LightType::kPoint;
     SFT_RETURN_IF_ERROR(ParseLightFrame(entry, path, light));
     const json* value = nullptr;
     SFT_RETURN_IF_ERROR(Require(entry, path, "position", &value));
     SFT_RETURN_IF_ERROR(Vector3(*value, Field(path, "position"), &light->position));
-    SFT_RETURN_IF_ERROR(Require(entry, path, "intensity", &value));
-    const std::string intensity_path = Field(path, "intensity");
-    if (value->is_number()) {  // a grey light.
-      double grey = 0;
-      SFT_RETURN_IF_ERROR(Number(*value, intensity_path, &grey));
-      light->intensity = Eigen::Vector3d::Constant(grey);
-    } else {
-      SFT_RETURN_IF_ERROR(Vector3(*value, intensity_path, &light->intensity));
+    return NonNegativeRgb(entry, path, "intensity", &light->intensity);
+  }
+
+  // "direction": the direction the light travels, normalized here; a zero vector is an error.
+  Status ParseDirectionalLight(const json& entry, const std::string& path, LightSpec* light) const {
+    light->type = LightType::kDirectional;
+    SFT_RETURN_IF_ERROR(ParseLightFrame(entry, path, light));
+    const json* value = nullptr;
+    SFT_RETURN_IF_ERROR(Require(entry, path, "direction", &value));
+    const std::string direction_path = Field(path, "direction");
+    SFT_RETURN_IF_ERROR(Vector3(*value, direction_path, &light->direction));
+    const double norm = light->direction.norm();
+    if (!(norm > 1e-12) || !std::isfinite(norm)) {
+      return Error(direction_path, "must have a non-zero finite length");
     }
-    if ((light->intensity.array() < 0).any()) {
-      return Error(intensity_path, "must be non-negative");
+    // Leave unit directions untouched so that write/read cycles are exact.
+    if (std::abs(norm - 1.0) > 4 * std::numeric_limits<double>::epsilon()) {
+      light->direction /= norm;
     }
-    return Status::Ok();
+    return NonNegativeRgb(entry, path, "irradiance", &light->irradiance);
   }
 
   Status ParseEnvironmentLight(const json& entry, const std::string& path, LightSpec* light) const {
@@ -375,12 +400,16 @@ class SceneParser {
       if (type == "point") {
         SFT_RETURN_IF_ERROR(ParsePointLight(entry, path, &light));
         light.extra = UnknownKeys(entry, kPointLightKeys);
+      } else if (type == "directional") {
+        SFT_RETURN_IF_ERROR(ParseDirectionalLight(entry, path, &light));
+        light.extra = UnknownKeys(entry, kDirectionalLightKeys);
       } else if (type == "environment") {
         SFT_RETURN_IF_ERROR(ParseEnvironmentLight(entry, path, &light));
         light.extra = UnknownKeys(entry, kEnvironmentLightKeys);
       } else {
         return Error(Field(path, "type"),
-                     "unknown light type \"" + type + "\" (expected \"point\" or \"environment\")");
+                     "unknown light type \"" + type +
+                         "\" (expected \"point\", \"directional\" or \"environment\")");
       }
       dataset->lights.push_back(std::move(light));
     }

@@ -94,50 +94,19 @@ class LightPositionFitTest : public ::testing::Test {
                       " --material '{\"albedo\": [0.6, 0.5, 0.4], \"roughness\": 0.4, "
                       "\"specular\": 0.2}'"),
               "");
-    MakeWorldLightDataset(dir_->Join("flash"), dir_->Join("world"));
+    // A copy lit by a world-frame light at kTrueWorld instead of the flash.
+    ASSERT_EQ(testing::RelightDataset(dir_->Join("flash"), dir_->Join("world"),
+                                      [](Dataset* dataset) {
+                                        LightSpec& light = dataset->lights.at(0);
+                                        light.frame = LightFrame::kWorld;
+                                        light.position = kTrueWorld;
+                                        light.intensity *= 2.0;  // farther than the flash.
+                                      }),
+              "");
   }
   static void TearDownTestSuite() {
     delete dir_;
     dir_ = nullptr;
-  }
-
-  // A copy of the flash dataset lit by a world-frame light at kTrueWorld instead, its images
-  // rendered by sft's renderer (64 spp, one segment, flat shading, as `sft synth` renders).
-  static void MakeWorldLightDataset(const std::string& from, const std::string& to) {
-    Dataset dataset;
-    ASSERT_TRUE(ReadDataset(from, &dataset).ok());
-    ASSERT_EQ(dataset.lights.size(), 1u);
-    dataset.lights[0].frame = LightFrame::kWorld;
-    dataset.lights[0].position = kTrueWorld;
-    dataset.lights[0].intensity *= 2.0;  // farther than the flash.
-    TriMesh mesh;
-    ASSERT_TRUE(ReadMesh(JoinPath(from, "gt/mesh.ply"), &mesh).ok());
-    Material truth;
-    ASSERT_TRUE(LoadMaterial(JoinPath(from, "gt/material.json"), mesh, &truth).ok());
-    ASSERT_TRUE(MakeDirectories(JoinPath(to, "images")).ok());
-    ASSERT_TRUE(MakeDirectories(JoinPath(to, "masks")).ok());
-    std::error_code error;
-    std::filesystem::copy(JoinPath(from, "gt"), JoinPath(to, "gt"),
-                          std::filesystem::copy_options::recursive, error);
-    ASSERT_FALSE(error) << error.message();
-    DatasetViews views;
-    ASSERT_TRUE(MakeDatasetViews(dataset, &views).ok());
-    std::vector<Eigen::Vector3d> positions;
-    std::vector<Eigen::Vector3i> faces;
-    MeshToArrays(mesh, &positions, &faces);
-    const RenderScene scene(positions, faces);
-    RenderOptions render;
-    render.spp = 64;
-    render.bounces = 1;
-    render.shading = Shading::kFlat;
-    for (size_t v = 0; v < dataset.views.size(); ++v) {
-      Image image, mask;
-      RenderView(scene, truth, views.views[v], render, &image);
-      ASSERT_TRUE(WriteImage(JoinPath(to, dataset.views[v].image), image).ok());
-      ASSERT_TRUE(LoadViewMask(dataset, static_cast<int>(v), &mask).ok());
-      ASSERT_TRUE(WritePng(JoinPath(to, dataset.views[v].mask), mask, /*srgb=*/false).ok());
-    }
-    ASSERT_TRUE(WriteSceneJson(dataset, to).ok());
   }
 
   // Fits `dataset_dir`'s light from kDisplacement off the truth (texture phases: LM over albedo,
