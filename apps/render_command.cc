@@ -150,8 +150,8 @@ CommandRunner SetupRenderCommand(CLI::App* app) {
                   "Material: JSON file or inline JSON (see docs/cli.md); default albedo 0.7");
   app->add_option("--out", opts->out, "Output directory; images go to OUT/images/")->required();
   app->add_option("--lights", opts->lights,
-                  "Fitted lights to apply: scales and point-light positions (lights.json "
-                  "written by sft reconstruct)");
+                  "Fitted lights to apply: scales, point-light positions and directional-light "
+                  "directions (lights.json written by sft reconstruct)");
   app->add_option("--spp", opts->render.spp, "Samples per pixel")->capture_default_str();
   app->add_option("--bounces", opts->render.bounces,
                   "Path segments: 1 = direct light only, 2 = one indirect bounce")

@@ -1,5 +1,5 @@
 // Fitted directional-light directions (`fit_light_directions`; issue 22): the parameter layout
-// beside light positions, the config key, lights.json with directions (written, read back, refused
+// beside light positions, lights.json with directions (written, read back, refused
 // when malformed), and fits on a small synthetic dataset where the light starts 10° off.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -16,9 +16,9 @@
 #include "src/geometry/mesh.h"
 #include "src/io/dataset.h"
 #include "src/io/light_scales.h"
-#include "src/optim/config.h"
 #include "src/optim/parameters.h"
 #include "src/optim/reconstruct.h"
+#include "tests/testing/light_fits.h"
 #include "tests/testing/synth_dataset.h"
 #include "tests/testing/temp_dir.h"
 
@@ -70,29 +70,13 @@ TEST(LightDirectionParametersTest, LayoutBlocksAndValues) {
   EXPECT_STREQ(ParameterKindName(kind), "light_direction");
 }
 
-TEST(LightDirectionConfigTest, KeyIsParsedAndWritten) {
-  ReconstructOptions options;
-  EXPECT_FALSE(options.fit_light_directions);
-  ASSERT_TRUE(ApplyReconstructConfig({{"fit_light_directions", true}}, "c.json", &options).ok());
-  EXPECT_TRUE(options.fit_light_directions);
-  EXPECT_EQ(ReconstructConfigJson(options)["fit_light_directions"], true);
-  const Status status = ApplyReconstructConfig({{"fit_light_directions", 1}}, "c.json", &options);
-  EXPECT_THAT(status.message(),
-              ::testing::HasSubstr("c.json: fit_light_directions: expected true or false"));
-}
-
 // An icosphere dataset (6 views at 32², flat shading, constant albedo 0.6/0.5/0.4, roughness 0.4,
 // specular 0.2) lit by one world-frame directional light travelling along kTrueTravel.
 class LightDirectionFitTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     dir_ = new testing::TempDir();
-    ASSERT_EQ(testing::SynthIcosphere(
-                  dir_->Join("flash"),
-                  "--cameras 6 --zooms 1 --res 32 --spp 16 --bounces 1 --shading flat "
-                  "--material '{\"albedo\": [0.6, 0.5, 0.4], \"roughness\": 0.4, "
-                  "\"specular\": 0.2}'"),
-              "");
+    ASSERT_EQ(testing::SynthLightFitIcosphere(dir_->Join("flash")), "");
     ASSERT_EQ(testing::RelightDataset(dir_->Join("flash"), dir_->Join("sun"),
                                       [](Dataset* dataset) {
                                         LightSpec& light = dataset->lights.at(0);
@@ -117,36 +101,19 @@ testing::TempDir* LightDirectionFitTest::dir_ = nullptr;
 // the true material; with `material` the albedo and roughness too, else held), returns the final
 // angle to the truth in degrees, and checks that lights.json round-trips the fitted direction.
 double FitDirection(const std::string& dataset_dir, bool material_too) {
-  Dataset dataset;
-  EXPECT_TRUE(ReadDataset(dataset_dir, &dataset).ok());
+  testing::LightFit fit;
+  EXPECT_EQ(testing::ReadLightFit(dataset_dir, &fit), "");
+  Dataset& dataset = fit.dataset;
   EXPECT_EQ(dataset.lights.at(0).type, LightType::kDirectional);
-  TriMesh mesh;
-  EXPECT_TRUE(ReadMesh(JoinPath(dataset_dir, "gt/mesh.ply"), &mesh).ok());
-  Material material;
-  EXPECT_TRUE(LoadMaterial(JoinPath(dataset_dir, "gt/material.json"), mesh, &material).ok());
-  ReconstructOptions options;
-  options.cache.render.spp = 8;
-  options.cache.render.bounces = 1;
-  options.cache.render.shading = Shading::kFlat;
-  options.shading = "flat";
-  options.cache.pyramid_levels = 3;
-  options.phases = PhaseSchedule::kTexture;
-  options.outer_iterations = 3;
-  options.solver.steps = 5;
-  options.fit_light_directions = true;
-  options.fit_albedo = options.fit_roughness = material_too;
-  options.regularizers.albedo_smoothness = 0.1;
+  fit.options.fit_light_directions = true;
+  fit.options.fit_albedo = fit.options.fit_roughness = material_too;
   const Eigen::Vector3d axis = kTrueTravel.unitOrthogonal();
   const Eigen::Vector3d start = Eigen::AngleAxisd(10.0 * M_PI / 180.0, axis) * kTrueTravel;
   EXPECT_NEAR(AngleDegrees(start, kTrueTravel), 10.0, 1e-9);
   std::unique_ptr<Reconstruction> r;
-  const Status created =
-      Reconstruction::Create(dataset, mesh, material, {}, options, &r, {}, Image(), {}, {start});
-  EXPECT_TRUE(created.ok()) << created.message();
-  if (!created.ok()) return 180.0;
-  for (int outer = 0; outer < options.outer_iterations; ++outer) {
-    EXPECT_TRUE(r->RunOuter(outer, nullptr).ok());
-  }
+  const std::string error = testing::RunLightFit(fit, {}, {start}, &r);
+  EXPECT_EQ(error, "");
+  if (!error.empty()) return 180.0;
   const std::vector<Eigen::Vector3d> fitted = r->LightDirections();
   EXPECT_EQ(fitted.size(), 1u);
   if (fitted.size() != 1) return 180.0;
@@ -186,21 +153,16 @@ TEST_F(LightDirectionFitTest, LightsFileRefusesBadDirections) {
   Dataset dataset;
   ASSERT_TRUE(ReadDataset(dir_->Join("sun"), &dataset).ok());
   const std::string path = dir_->Join("bad_lights.json");
-  const auto read_error = [&](const std::string& entry) {
-    EXPECT_TRUE(
-        WriteTextFile(path, R"({"format": "sft-light-scales/1", "lights": [)" + entry + "]}").ok());
-    std::vector<double> scales;
-    std::vector<Eigen::Vector3d> positions, directions;
-    return ReadLightScales(path, dataset, &scales, &positions, &directions).message();
+  const auto read_error = [&](const std::string& members) {
+    return testing::LightsFileError(path, dataset, members);
   };
-  const std::string id = "\"id\": \"" + dataset.lights[0].id + "\", \"scale\": 1";
-  EXPECT_THAT(read_error("{" + id + ", \"direction\": [1, 2]}"),
+  EXPECT_THAT(read_error(R"("direction": [1, 2])"),
               ::testing::HasSubstr("bad_lights.json: lights[0].direction: expected 3 numbers"));
-  EXPECT_THAT(read_error("{" + id + ", \"direction\": [0, 0, 0]}"),
+  EXPECT_THAT(read_error(R"("direction": [0, 0, 0])"),
               ::testing::HasSubstr("lights[0].direction: must not be zero"));
-  EXPECT_THAT(read_error("{" + id + ", \"frame\": \"camera\", \"direction\": [0, 0, 1]}"),
+  EXPECT_THAT(read_error(R"("frame": "camera", "direction": [0, 0, 1])"),
               ::testing::HasSubstr("lights[0].frame: expected \"world\""));
-  EXPECT_THAT(read_error("{" + id + ", \"position\": [0, 0, 1]}"),
+  EXPECT_THAT(read_error(R"("position": [0, 0, 1])"),
               ::testing::HasSubstr("lights[0].position: light \"" + dataset.lights[0].id +
                                    "\" is not a point light"));
 }

@@ -81,15 +81,8 @@ TEST_P(LightDirectionDerivativesTest, MatchesCentralDifferences) {
   const DirectionCase& c = GetParam();
   static const testing::CubeOverGround* fixture = new testing::CubeOverGround(kRes);
   const testing::CubeOverGround& s = *fixture;
-  Material material = ConstantMaterial(static_cast<int>(s.geometry.faces.size()),
-                                       Eigen::Vector3d(0.7, 0.6, 0.5), 0.4, 0.3);
-  RenderOptions options;
-  options.spp = c.spp;
-  options.bounces = c.bounces;
-  options.effects.shadows = c.shadows;
-  options.effects.environment = false;
-  options.seed = 5;
-  options.sampling_material = &material;
+  const Material material = s.GlossyMaterial();
+  const RenderOptions options = s.Options(c.spp, c.bounces, c.shadows, &material);
 
   const Eigen::Vector3d x0 = BaseParameters(s.view, c.camera_frame);
   // δ: mostly across the direction, a fifth along it.

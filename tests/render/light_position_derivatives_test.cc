@@ -84,15 +84,8 @@ TEST_P(LightPositionDerivativesTest, MatchesCentralDifferences) {
   const LightCase& c = GetParam();
   static const CubeScene* fixture = new CubeScene();
   const CubeScene& s = *fixture;
-  Material material = ConstantMaterial(static_cast<int>(s.geometry.faces.size()),
-                                       Eigen::Vector3d(0.7, 0.6, 0.5), 0.4, 0.3);
-  RenderOptions options;
-  options.spp = c.spp;
-  options.bounces = c.bounces;
-  options.effects.shadows = c.shadows;
-  options.effects.environment = false;
-  options.seed = 5;
-  options.sampling_material = &material;
+  const Material material = s.GlossyMaterial();
+  const RenderOptions options = s.Options(c.spp, c.bounces, c.shadows, &material);
 
   const Eigen::Vector3d delta = Eigen::Vector3d(0.6, -0.3, 0.74).normalized();
   const testing::LightDerivativeCheck check(

@@ -23,5 +23,22 @@ CubeOverGround::CubeOverGround(int res)
   scene = std::make_unique<RenderScene>(geometry.positions, geometry.faces);
 }
 
+Material CubeOverGround::GlossyMaterial() const {
+  return ConstantMaterial(static_cast<int>(geometry.faces.size()), Eigen::Vector3d(0.7, 0.6, 0.5),
+                          0.4, 0.3);
+}
+
+RenderOptions CubeOverGround::Options(int spp, int bounces, bool shadows,
+                                      const Material* sampling) {
+  RenderOptions options;
+  options.spp = spp;
+  options.bounces = bounces;
+  options.effects.shadows = shadows;
+  options.effects.environment = false;
+  options.seed = 5;
+  options.sampling_material = sampling;
+  return options;
+}
+
 }  // namespace testing
 }  // namespace sft

@@ -6,6 +6,7 @@
 
 #include <memory>
 
+#include "src/geometry/material.h"
 #include "src/render/render.h"
 #include "src/render/scene.h"
 #include "tests/testing/meshes.h"
@@ -18,6 +19,12 @@ namespace testing {
 // lights.
 struct CubeOverGround {
   explicit CubeOverGround(int res);
+
+  // The light tests' glossy material: albedo 0.7/0.6/0.5, roughness 0.4, specular 0.3.
+  Material GlossyMaterial() const;
+  // Their render options: `spp`, `bounces`, shadows on or off, no environment, seed 5, paths
+  // sampled with `sampling` (detached sampling: nearby lights follow the same paths).
+  static RenderOptions Options(int spp, int bounces, bool shadows, const Material* sampling);
 
   Triangles geometry;
   ViewSetup view;

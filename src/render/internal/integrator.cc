@@ -421,17 +421,26 @@ bool SampleDirectionalLightVisible(const Context& ctx, const DirectionalLight& l
 
 namespace {
 
-// The first hit of the ray from `origin` along `dir` (from t_near on), shaded: false when it is
-// not on face `receiver`. A degenerate face has n = 0, so light samples fail there.
+// The first hit of the ray from `origin` along `dir` (from t_near on), shaded, with its material
+// and ray offset.
+struct Receiver {
+  int face = -1;
+  ShadingPoint sp;
+  BsdfParams params;
+  double offset = 0.0;
+};
+
+// False when the first hit is not on face `receiver`. A degenerate face has n = 0, so light
+// samples fail there.
 bool ShadeReceiver(const Context& ctx, const Eigen::Vector3d& origin, const Eigen::Vector3d& dir,
-                   double t_near, int receiver, RenderStats* stats, ShadingPoint* sp,
-                   BsdfParams* params, int* face) {
+                   double t_near, int receiver, RenderStats* stats, Receiver* out) {
   const RayHit hit = ctx.scene.Intersect(origin, dir, t_near, kInfinity);
   ++stats->bounce_rays;
   if (!hit.hit || hit.face != receiver) return false;
-  Shade(ctx, dir, hit, sp);
-  *params = LookUpMaterial(ctx, ctx.material, hit.face, hit.u, hit.v).params;
-  *face = hit.face;
+  Shade(ctx, dir, hit, &out->sp);
+  out->params = LookUpMaterial(ctx, ctx.material, hit.face, hit.u, hit.v).params;
+  out->face = hit.face;
+  out->offset = RayOffset(ctx, hit.face, out->sp.p);
   return true;
 }
 
@@ -440,34 +449,27 @@ bool ShadeReceiver(const Context& ctx, const Eigen::Vector3d& origin, const Eige
 bool DirectAtReceiver(const Context& ctx, const PointLight& light, const Eigen::Vector3d& origin,
                       const Eigen::Vector3d& dir, double t_near, int receiver, RenderStats* stats,
                       Eigen::Vector3d* radiance) {
-  ShadingPoint sp;
-  BsdfParams params;
-  int face = -1;
-  if (!ShadeReceiver(ctx, origin, dir, t_near, receiver, stats, &sp, &params, &face)) return false;
+  Receiver r;
+  if (!ShadeReceiver(ctx, origin, dir, t_near, receiver, stats, &r)) return false;
   radiance->setZero();
   PointLightSample ls;
-  if (!SamplePointLightVisible(ctx, light, face, sp.p, sp.n, sp.wo, params,
-                               RayOffset(ctx, face, sp.p), /*shadows=*/true,
-                               /*skip_black=*/false, stats, &ls)) {
-    return true;
+  if (SamplePointLightVisible(ctx, light, r.face, r.sp.p, r.sp.n, r.sp.wo, r.params, r.offset,
+                              /*shadows=*/true, /*skip_black=*/false, stats, &ls)) {
+    const LightTerm term = PointLightTerm(ls, light, r.sp.n, /*derivatives=*/false);
+    *radiance = ls.f.cwiseProduct(term.q) * term.c;
   }
-  const LightTerm term = PointLightTerm(ls, light, sp.n, /*derivatives=*/false);
-  *radiance = ls.f.cwiseProduct(term.q) * term.c;
   return true;
 }
 
 bool DirectAtReceiver(const Context& ctx, const DirectionalLight& light,
                       const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, double t_near,
                       int receiver, RenderStats* stats, Eigen::Vector3d* radiance) {
-  ShadingPoint sp;
-  BsdfParams params;
-  int face = -1;
-  if (!ShadeReceiver(ctx, origin, dir, t_near, receiver, stats, &sp, &params, &face)) return false;
+  Receiver r;
+  if (!ShadeReceiver(ctx, origin, dir, t_near, receiver, stats, &r)) return false;
   radiance->setZero();
   PointLightSample ls;
-  if (SampleDirectionalLightVisible(ctx, light, sp.p, sp.n, sp.wo, params,
-                                    RayOffset(ctx, face, sp.p), /*shadows=*/true,
-                                    /*skip_black=*/false, stats, &ls)) {
+  if (SampleDirectionalLightVisible(ctx, light, r.sp.p, r.sp.n, r.sp.wo, r.params, r.offset,
+                                    /*shadows=*/true, /*skip_black=*/false, stats, &ls)) {
     *radiance = ls.f.cwiseProduct(light.irradiance) * ls.cos_i;
   }
   return true;
