@@ -66,11 +66,7 @@ Status RunRender(const RenderCommandOptions& opts) {
   // need no light, so they also render datasets with unknown lighting (empty `lights`).
   if (render.pass == RenderPass::kColor) SFT_RETURN_IF_ERROR(CheckViewsHaveLights(dataset));
   if (!opts.lights.empty()) {
-    std::vector<double> scales;
-    std::vector<Eigen::Vector3d> positions;
-    SFT_RETURN_IF_ERROR(ReadLightScales(opts.lights, dataset, &scales, &positions));
-    ApplyLightScales(scales, &dataset);
-    ApplyLightPositions(positions, &dataset);
+    SFT_RETURN_IF_ERROR(ApplyLightsFile(opts.lights, &dataset));
   }
   TriMesh mesh;
   SFT_RETURN_IF_ERROR(ReadMesh(opts.mesh, &mesh));
@@ -154,8 +150,8 @@ CommandRunner SetupRenderCommand(CLI::App* app) {
                   "Material: JSON file or inline JSON (see docs/cli.md); default albedo 0.7");
   app->add_option("--out", opts->out, "Output directory; images go to OUT/images/")->required();
   app->add_option("--lights", opts->lights,
-                  "Fitted lights to apply: scales and point-light positions (lights.json "
-                  "written by sft reconstruct)");
+                  "Fitted lights to apply: scales, point-light positions and directional-light "
+                  "directions (lights.json written by sft reconstruct)");
   app->add_option("--spp", opts->render.spp, "Samples per pixel")->capture_default_str();
   app->add_option("--bounces", opts->render.bounces,
                   "Path segments: 1 = direct light only, 2 = one indirect bounce")

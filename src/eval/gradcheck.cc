@@ -36,6 +36,11 @@ ViewSetup PerturbView(const ViewSetup& base, const ParameterLayout& layout,
       light.intensity *= 1.0 + t * delta[layout.LightOffset() + light.light_index];
     }
   }
+  for (DirectionalLight& light : view.directional_lights) {
+    if (light.light_index >= 0) {
+      light.irradiance *= 1.0 + t * delta[layout.LightOffset() + light.light_index];
+    }
+  }
   if (view.environment_light_index >= 0) {
     view.environment_scale *= 1.0 + t * delta[layout.LightOffset() + view.environment_light_index];
   }
@@ -43,6 +48,17 @@ ViewSetup PerturbView(const ViewSetup& base, const ParameterLayout& layout,
     if (!layout.FitsLightPosition(light.light_index)) continue;
     const Eigen::Vector3d d(&delta[layout.LightPositionOffset() + 3 * light.light_index]);
     light.position += t * (LightPositionJacobian(view, light) * d);
+  }
+  // A direction's parameters are the unit direction v0 in the light's frame: v0 + t·δ,
+  // normalized (the layout's light_directions; at t = 0 |v| = 1, parameter_norm).
+  const Eigen::Matrix3d cam_from_world = view.cam_from_world.rotation.toRotationMatrix();
+  for (DirectionalLight& light : view.directional_lights) {
+    if (!layout.FitsLightDirection(light.light_index)) continue;
+    const Eigen::Vector3d d(&delta[layout.LightDirectionOffset() + 3 * light.light_index]);
+    const Eigen::Vector3d v0 =
+        light.camera_frame ? cam_from_world * light.direction : light.direction;
+    const Eigen::Vector3d v = (v0 + t * d).normalized();
+    light.direction = light.camera_frame ? cam_from_world.transpose() * v : v;
   }
   return view;
 }
@@ -264,7 +280,8 @@ Status PrepareGradcheck(const Dataset& dataset, const GradcheckOptions& options,
       SelectViews(options.views, static_cast<int>(setup->views.views.size()), &setup->selected));
   setup->block = options.block > 0 ? options.block
                                    : (options.kind == ParameterKind::kVertex ||
-                                              options.kind == ParameterKind::kLightPosition
+                                              options.kind == ParameterKind::kLightPosition ||
+                                              options.kind == ParameterKind::kLightDirection
                                           ? 8
                                           : 1);
   return Status::Ok();
@@ -282,6 +299,7 @@ Status RunGradcheck(const Dataset& dataset, const TriMesh& mesh, const Material&
   ParameterLayout layout =
       MakeParameterLayout(scene, material, static_cast<int>(dataset.lights.size()));
   layout.light_positions = options.kind == ParameterKind::kLightPosition;
+  layout.light_directions = options.kind == ParameterKind::kLightDirection;
   const bool vertices = options.kind == ParameterKind::kVertex;
 
   std::vector<double> delta =
@@ -302,8 +320,9 @@ Status RunGradcheck(const Dataset& dataset, const TriMesh& mesh, const Material&
     step = options.kind == ParameterKind::kRoughness ? 1e-4 * std::max(mean_roughness, 0.01)
            : vertices ? kAutomaticVertexStep * GlossyStepFactor(material, options.render.effects) *
                             scene.extent()
-           : options.kind == ParameterKind::kLightPosition ? kAutomaticVertexStep * scene.extent()
-                                                           : 1e-3;
+           : options.kind == ParameterKind::kLightPosition  ? kAutomaticVertexStep * scene.extent()
+           : options.kind == ParameterKind::kLightDirection ? kAutomaticVertexStep
+                                                            : 1e-3;
   }
 
   RenderOptions render = options.render;

@@ -67,9 +67,11 @@ struct GradcheckOptions {
                       // roughness r, 5e-3 × the bounding-box diagonal for vertices, times
                       // clamp(2α, 1/16, 1) with a glossy lobe of width α = r²_min; 5e-3 × the
                       // diagonal for light positions, which move each point light by h·δ_l in
-                      // its own frame, ParameterLayout::light_positions).
-  // Side B of the pixel blocks summed before comparing; 0 = automatic: 8 for vertices and light
-  // positions (edge
+                      // its own frame, ParameterLayout::light_positions; 5e-3 for light
+                      // directions, about 5e-3 rad of each directional light's unit direction
+                      // in its frame).
+  // Side B of the pixel blocks summed before comparing; 0 = automatic: 8 for vertices, light
+  // positions and light directions (edge
   // sampling puts silhouette and shadow-boundary derivatives at random pixels along the edge, and
   // the finite difference of a moving edge is quantised by the camera samples that cross it:
   // both are unbiased but noisy per pixel, and agree on block sums), 1 (per pixel) otherwise.

@@ -210,11 +210,7 @@ Status LoadRunToRender(const std::string& dataset_dir, const std::string& recons
   }
   const std::string lights = JoinPath(reconstruction, "lights.json");
   if (FileExists(lights)) {
-    std::vector<double> scales;
-    std::vector<Eigen::Vector3d> positions;
-    SFT_RETURN_IF_ERROR(ReadLightScales(lights, run->dataset, &scales, &positions));
-    ApplyLightScales(scales, &run->dataset);
-    ApplyLightPositions(positions, &run->dataset);
+    SFT_RETURN_IF_ERROR(ApplyLightsFile(lights, &run->dataset));
   }
   return Status::Ok();
 }

@@ -26,6 +26,10 @@ std::string IndexPath(const std::string& prefix, size_t i) {
   return prefix + "[" + std::to_string(i) + "]";
 }
 
+std::string SizeText(int width, int height) {
+  return std::to_string(width) + "x" + std::to_string(height);
+}
+
 std::string StripJsonExceptionId(const std::string& what) {
   if (!what.empty() && what[0] == '[') {
     const size_t end = what.find("] ");
@@ -42,6 +46,7 @@ using json = nlohmann::json;
 using dataset_internal::IndexPath;
 using dataset_internal::kFormatTag;
 using dataset_internal::kSceneFile;
+using dataset_internal::SizeText;
 using dataset_internal::StripJsonExceptionId;
 
 // Largest deviation of world_from_env^T world_from_env from the identity that still counts as a
@@ -56,6 +61,7 @@ constexpr Keys kTopLevelKeys = {
 constexpr Keys kSimilarityKeys = {"scale", "rotation", "translation"};
 constexpr Keys kCameraKeys = {"id", "model", "width", "height", "params"};
 constexpr Keys kPointLightKeys = {"id", "type", "frame", "position", "intensity"};
+constexpr Keys kDirectionalLightKeys = {"id", "type", "frame", "direction", "irradiance"};
 constexpr Keys kEnvironmentLightKeys = {"id", "type", "frame", "image", "world_from_env", "scale"};
 constexpr Keys kViewKeys = {"image", "mask", "camera", "lights", "cam_from_world"};
 constexpr Keys kPoseKeys = {"rotation", "translation"};
@@ -73,10 +79,6 @@ json UnknownKeys(const json& obj, Keys known) {
 
 std::string Field(const std::string& prefix, const std::string& key) {
   return prefix.empty() ? key : prefix + "." + key;
-}
-
-std::string SizeText(int width, int height) {
-  return std::to_string(width) + "x" + std::to_string(height);
 }
 
 // "string \"abc\"", "number 3", "array" ... for error messages.
@@ -302,25 +304,49 @@ class SceneParser {
     return Status::Ok();
   }
 
+  // Three non-negative numbers, or one grey number g for [g, g, g] (a light's RGB power).
+  Status NonNegativeRgb(const json& entry, const std::string& path, const char* key,
+                        Eigen::Vector3d* out) const {
+    const json* value = nullptr;
+    SFT_RETURN_IF_ERROR(Require(entry, path, key, &value));
+    const std::string field = Field(path, key);
+    if (value->is_number()) {  // a grey light.
+      double grey = 0;
+      SFT_RETURN_IF_ERROR(Number(*value, field, &grey));
+      *out = Eigen::Vector3d::Constant(grey);
+    } else {
+      SFT_RETURN_IF_ERROR(Vector3(*value, field, out));
+    }
+    if ((out->array() < 0).any()) return Error(field, "must be non-negative");
+    return Status::Ok();
+  }
+
   Status ParsePointLight(const json& entry, const std::string& path, LightSpec* light) const {
     light->type = LightType::kPoint;
     SFT_RETURN_IF_ERROR(ParseLightFrame(entry, path, light));
     const json* value = nullptr;
     SFT_RETURN_IF_ERROR(Require(entry, path, "position", &value));
     SFT_RETURN_IF_ERROR(Vector3(*value, Field(path, "position"), &light->position));
-    SFT_RETURN_IF_ERROR(Require(entry, path, "intensity", &value));
-    const std::string intensity_path = Field(path, "intensity");
-    if (value->is_number()) {  // a grey light.
-      double grey = 0;
-      SFT_RETURN_IF_ERROR(Number(*value, intensity_path, &grey));
-      light->intensity = Eigen::Vector3d::Constant(grey);
-    } else {
-      SFT_RETURN_IF_ERROR(Vector3(*value, intensity_path, &light->intensity));
+    return NonNegativeRgb(entry, path, "intensity", &light->intensity);
+  }
+
+  // "direction": the direction the light travels, normalized here; a zero vector is an error.
+  Status ParseDirectionalLight(const json& entry, const std::string& path, LightSpec* light) const {
+    light->type = LightType::kDirectional;
+    SFT_RETURN_IF_ERROR(ParseLightFrame(entry, path, light));
+    const json* value = nullptr;
+    SFT_RETURN_IF_ERROR(Require(entry, path, "direction", &value));
+    const std::string direction_path = Field(path, "direction");
+    SFT_RETURN_IF_ERROR(Vector3(*value, direction_path, &light->direction));
+    const double norm = light->direction.norm();
+    if (!(norm > 1e-12) || !std::isfinite(norm)) {
+      return Error(direction_path, "must have a non-zero finite length");
     }
-    if ((light->intensity.array() < 0).any()) {
-      return Error(intensity_path, "must be non-negative");
+    // Leave unit directions untouched so that write/read cycles are exact.
+    if (std::abs(norm - 1.0) > 4 * std::numeric_limits<double>::epsilon()) {
+      light->direction /= norm;
     }
-    return Status::Ok();
+    return NonNegativeRgb(entry, path, "irradiance", &light->irradiance);
   }
 
   Status ParseEnvironmentLight(const json& entry, const std::string& path, LightSpec* light) const {
@@ -375,12 +401,16 @@ class SceneParser {
       if (type == "point") {
         SFT_RETURN_IF_ERROR(ParsePointLight(entry, path, &light));
         light.extra = UnknownKeys(entry, kPointLightKeys);
+      } else if (type == "directional") {
+        SFT_RETURN_IF_ERROR(ParseDirectionalLight(entry, path, &light));
+        light.extra = UnknownKeys(entry, kDirectionalLightKeys);
       } else if (type == "environment") {
         SFT_RETURN_IF_ERROR(ParseEnvironmentLight(entry, path, &light));
         light.extra = UnknownKeys(entry, kEnvironmentLightKeys);
       } else {
         return Error(Field(path, "type"),
-                     "unknown light type \"" + type + "\" (expected \"point\" or \"environment\")");
+                     "unknown light type \"" + type +
+                         "\" (expected \"point\", \"directional\" or \"environment\")");
       }
       dataset->lights.push_back(std::move(light));
     }
@@ -558,42 +588,7 @@ class SceneParser {
   bool any_path_ = false;
 };
 
-Status CheckSize(const std::string& path, const char* what, const Image& image,
-                 const Camera& camera) {
-  if (image.width != camera.width || image.height != camera.height) {
-    return Status::Error(path + ": " + what + " is " + SizeText(image.width, image.height) +
-                         " but camera \"" + camera.id + "\" is " +
-                         SizeText(camera.width, camera.height));
-  }
-  return Status::Ok();
-}
-
 std::string ScenePath(const Dataset& dataset) { return JoinPath(dataset.root, kSceneFile); }
-
-const Camera& ViewCamera(const Dataset& dataset, int index) {
-  CHECK_GE(index, 0);
-  CHECK_LT(index, static_cast<int>(dataset.views.size()));
-  const int camera = dataset.views[index].camera;
-  CHECK_GE(camera, 0) << "view " << index << " has no resolved camera";
-  CHECK_LT(camera, static_cast<int>(dataset.cameras.size()));
-  return dataset.cameras[camera];
-}
-
-Status CheckViewFiles(const Dataset& dataset, int index) {
-  const ViewSpec& view = dataset.views[index];
-  const Camera& camera = ViewCamera(dataset, index);
-  Image image;
-  const std::string image_path = JoinPath(dataset.root, view.image);
-  SFT_RETURN_IF_ERROR(ReadImage(image_path, &image));
-  SFT_RETURN_IF_ERROR(CheckSize(image_path, "image", image, camera));
-  if (!view.mask.empty()) {
-    const std::string mask_path = JoinPath(dataset.root, view.mask);
-    Image mask;
-    SFT_RETURN_IF_ERROR(ReadMask(mask_path, &mask));
-    SFT_RETURN_IF_ERROR(CheckSize(mask_path, "mask", mask, camera));
-  }
-  return Status::Ok();
-}
 
 }  // namespace
 
@@ -667,67 +662,6 @@ Status CheckViewsHaveLights(const Dataset& dataset) {
                            "is not supported yet)");
     }
   }
-  return Status::Ok();
-}
-
-Status CheckDatasetFiles(const Dataset& dataset) {
-  const int num_views = static_cast<int>(dataset.views.size());
-  std::vector<Status> statuses(num_views);
-  // Photographs can be large: decode them in parallel, report the first failure in view order.
-  tbb::parallel_for(0, num_views, [&](int i) { statuses[i] = CheckViewFiles(dataset, i); });
-  for (const Status& status : statuses) SFT_RETURN_IF_ERROR(status);
-  for (int l = 0; l < static_cast<int>(dataset.lights.size()); ++l) {
-    if (dataset.lights[l].type != LightType::kEnvironment) continue;
-    Image probe;
-    SFT_RETURN_IF_ERROR(LoadProbe(dataset, l, &probe));
-  }
-  return Status::Ok();
-}
-
-Status LoadViewImage(const Dataset& dataset, int index, Image* rgb) {
-  const Camera& camera = ViewCamera(dataset, index);
-  const std::string path = JoinPath(dataset.root, dataset.views[index].image);
-  Image image;
-  SFT_RETURN_IF_ERROR(ReadImage(path, &image));
-  SFT_RETURN_IF_ERROR(CheckSize(path, "image", image, camera));
-  *rgb = ToRgb(image);
-  return Status::Ok();
-}
-
-Status LoadViewMask(const Dataset& dataset, int index, Image* mask) {
-  const Camera& camera = ViewCamera(dataset, index);
-  const ViewSpec& view = dataset.views[index];
-  if (view.mask.empty()) {
-    return Status::Error(ScenePath(dataset) + ": " + IndexPath("views", index) +
-                         ".mask: view has no mask");
-  }
-  const std::string path = JoinPath(dataset.root, view.mask);
-  Image result;
-  SFT_RETURN_IF_ERROR(ReadMask(path, &result));
-  SFT_RETURN_IF_ERROR(CheckSize(path, "mask", result, camera));
-  *mask = std::move(result);
-  return Status::Ok();
-}
-
-Status LoadProbe(const Dataset& dataset, int light_index, Image* rgb) {
-  CHECK_GE(light_index, 0);
-  CHECK_LT(light_index, static_cast<int>(dataset.lights.size()));
-  const LightSpec& light = dataset.lights[light_index];
-  CHECK(light.type == LightType::kEnvironment) << "light " << light.id << " is not a probe";
-  if (!light.pixels.empty()) {
-    *rgb = ToRgb(light.pixels);
-    return Status::Ok();
-  }
-  const std::string path = JoinPath(dataset.root, light.image);
-  Image image;
-  SFT_RETURN_IF_ERROR(ReadImage(path, &image));
-  Image result = ToRgb(image);
-  // Negative texels (ringing from HDR resampling) and non-finite ones would break importance
-  // sampling; they carry no usable radiance.
-  for (float& v : result.data) {
-    if (!(v > 0.0f) || !std::isfinite(v)) v = 0.0f;
-  }
-  *rgb = std::move(result);
   return Status::Ok();
 }
 

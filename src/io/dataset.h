@@ -12,11 +12,12 @@
 //
 // A read/write cycle reproduces scene.json exactly as JSON (key order and number formatting
 // aside) except for these normalizations of documented keys: a non-unit quaternion is normalized;
-// defaults are written out explicitly (point light "frame": "world", environment light
-// "world_from_env": identity and "scale": 1, view "lights": [], "background": "black"; an
+// defaults are written out explicitly (point and directional light "frame": "world", environment
+// light "world_from_env": identity and "scale": 1, view "lights": [], "background": "black"; an
 // environment light's "frame": "world" is dropped, as files before that key had none); a grey
-// point-light intensity (one number) becomes [g, g, g]; a null "mask" or "ground_truth" is
-// dropped; an integral float such as a width of 16.0 is written as 16.
+// point-light intensity or directional irradiance (one number) becomes [g, g, g]; a directional
+// light's direction is scaled to unit length; a null "mask" or "ground_truth" is dropped; an
+// integral float such as a width of 16.0 is written as 16.
 #ifndef SFT_IO_DATASET_H_
 #define SFT_IO_DATASET_H_
 
@@ -32,7 +33,7 @@
 
 namespace sft {
 
-enum class LightType { kPoint, kEnvironment };
+enum class LightType { kPoint, kEnvironment, kDirectional };
 enum class LightFrame { kWorld, kCamera };  // where a light is fixed (LightSpec::frame).
 enum class Background { kBlack, kEnvironment };
 
@@ -53,6 +54,12 @@ struct LightSpec {
   // Point lights.
   Eigen::Vector3d position = Eigen::Vector3d::Zero();   // in `frame`, scene units.
   Eigen::Vector3d intensity = Eigen::Vector3d::Zero();  // radiant intensity, W/sr, RGB.
+  // Directional lights (a light at infinity, e.g. the sun). `direction` is the unit direction
+  // the light travels (from the light towards the scene, as in Blender, Mitsuba and glTF), in
+  // `frame`; normalized on read. `irradiance` is the irradiance on a surface facing the light,
+  // W/m², RGB.
+  Eigen::Vector3d direction = Eigen::Vector3d(0, 0, -1);
+  Eigen::Vector3d irradiance = Eigen::Vector3d::Zero();
   // Environment lights.
   std::string image;  // relative to the dataset root: an equirectangular linear EXR.
   Eigen::Matrix3d world_from_env = Eigen::Matrix3d::Identity();

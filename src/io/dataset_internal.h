@@ -18,6 +18,9 @@ std::string IndexPath(const std::string& prefix, size_t i);
 // "[json.exception.parse_error.101] parse error at ..." -> "parse error at ...".
 std::string StripJsonExceptionId(const std::string& what);
 
+// "640x480", for error messages.
+std::string SizeText(int width, int height);
+
 }  // namespace dataset_internal
 }  // namespace sft
 

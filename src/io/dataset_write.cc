@@ -50,6 +50,11 @@ ojson LightsJson(const Dataset& dataset) {
       entry["frame"] = light.frame == LightFrame::kCamera ? "camera" : "world";
       entry["position"] = {light.position.x(), light.position.y(), light.position.z()};
       entry["intensity"] = {light.intensity.x(), light.intensity.y(), light.intensity.z()};
+    } else if (light.type == LightType::kDirectional) {
+      entry["type"] = "directional";
+      entry["frame"] = light.frame == LightFrame::kCamera ? "camera" : "world";
+      entry["direction"] = {light.direction.x(), light.direction.y(), light.direction.z()};
+      entry["irradiance"] = {light.irradiance.x(), light.irradiance.y(), light.irradiance.z()};
     } else {
       entry["type"] = "environment";
       if (light.frame == LightFrame::kCamera) entry["frame"] = "camera";

@@ -13,21 +13,28 @@ const char* FrameName(LightFrame frame) {
   return frame == LightFrame::kCamera ? "camera" : "world";
 }
 
-// Reads entry `entry`'s optional "frame" and "position" for point light `light` into *position.
-Status ReadPosition(const nlohmann::json& entry, const std::string& where, const LightSpec& light,
-                    bool* found, Eigen::Vector3d* position) {
+// Reads entry `entry`'s optional "frame" and `key` ("position" of a point light, "direction" of
+// a directional light, whose type `type` is) for light `light` into *value.
+Status ReadLightVector(const nlohmann::json& entry, const std::string& where,
+                       const LightSpec& light, const char* key, LightType type, bool* found,
+                       Eigen::Vector3d* value) {
   *found = false;
-  if (!entry.contains("position")) return Status::Ok();
-  if (light.type != LightType::kPoint) {
-    return Status::Error(where + ".position: light \"" + light.id + "\" is not a point light");
+  if (!entry.contains(key)) return Status::Ok();
+  const std::string field = where + "." + key;
+  if (light.type != type) {
+    return Status::Error(field + ": light \"" + light.id + "\" is not a " +
+                         (type == LightType::kPoint ? "point" : "directional") + " light");
   }
-  const nlohmann::json& p = entry["position"];
-  if (!p.is_array() || p.size() != 3) return Status::Error(where + ".position: expected 3 numbers");
+  const nlohmann::json& p = entry[key];
+  if (!p.is_array() || p.size() != 3) return Status::Error(field + ": expected 3 numbers");
   for (int k = 0; k < 3; ++k) {
     if (!p[k].is_number() || !std::isfinite(p[k].get<double>())) {
-      return Status::Error(where + ".position: expected 3 finite numbers");
+      return Status::Error(field + ": expected 3 finite numbers");
     }
-    (*position)[k] = p[k].get<double>();
+    (*value)[k] = p[k].get<double>();
+  }
+  if (type == LightType::kDirectional && !(value->norm() > 0.0)) {
+    return Status::Error(field + ": must not be zero");
   }
   if (entry.value("frame", "world") != std::string(FrameName(light.frame))) {
     return Status::Error(where + ".frame: expected \"" + FrameName(light.frame) +
@@ -41,7 +48,8 @@ Status ReadPosition(const nlohmann::json& entry, const std::string& where, const
 
 Status WriteLightScales(const std::string& path, const Dataset& dataset,
                         const std::vector<double>& scales,
-                        const std::vector<Eigen::Vector3d>& positions) {
+                        const std::vector<Eigen::Vector3d>& positions,
+                        const std::vector<Eigen::Vector3d>& directions) {
   nlohmann::ordered_json json;
   json["format"] = "sft-light-scales/1";
   json["lights"] = nlohmann::ordered_json::array();
@@ -53,13 +61,19 @@ Status WriteLightScales(const std::string& path, const Dataset& dataset,
       entry["frame"] = FrameName(light.frame);
       entry["position"] = {p.x(), p.y(), p.z()};
     }
+    if (!directions.empty() && light.type == LightType::kDirectional) {
+      const Eigen::Vector3d d = directions.at(l).normalized();
+      entry["frame"] = FrameName(light.frame);
+      entry["direction"] = {d.x(), d.y(), d.z()};
+    }
     json["lights"].push_back(entry);
   }
   return WriteTextFile(path, json.dump(1) + "\n");
 }
 
 Status ReadLightScales(const std::string& path, const Dataset& dataset, std::vector<double>* scales,
-                       std::vector<Eigen::Vector3d>* positions) {
+                       std::vector<Eigen::Vector3d>* positions,
+                       std::vector<Eigen::Vector3d>* directions) {
   std::string text;
   SFT_RETURN_IF_ERROR(ReadTextFile(path, &text));
   const nlohmann::json json = nlohmann::json::parse(text, nullptr, /*allow_exceptions=*/false);
@@ -72,9 +86,12 @@ Status ReadLightScales(const std::string& path, const Dataset& dataset, std::vec
     return Status::Error(path + ": lights: expected an array");
   }
   scales->assign(dataset.lights.size(), std::nan(""));
-  std::vector<Eigen::Vector3d> read(dataset.lights.size());
-  for (size_t l = 0; l < dataset.lights.size(); ++l) read[l] = dataset.lights[l].position;
-  bool any_position = false;
+  std::vector<Eigen::Vector3d> read(dataset.lights.size()), read_directions(dataset.lights.size());
+  for (size_t l = 0; l < dataset.lights.size(); ++l) {
+    read[l] = dataset.lights[l].position;
+    read_directions[l] = dataset.lights[l].direction;
+  }
+  bool any_position = false, any_direction = false;
   for (size_t i = 0; i < lights->size(); ++i) {
     const nlohmann::json& entry = (*lights)[i];
     const std::string where = path + ": lights[" + std::to_string(i) + "]";
@@ -91,9 +108,14 @@ Status ReadLightScales(const std::string& path, const Dataset& dataset, std::vec
       if (dataset.lights[l].id == entry["id"].get<std::string>()) {
         (*scales)[l] = scale;
         found = true;
-        bool has_position = false;
-        SFT_RETURN_IF_ERROR(ReadPosition(entry, where, dataset.lights[l], &has_position, &read[l]));
-        any_position = any_position || has_position;
+        const LightSpec& light = dataset.lights[l];
+        bool has = false;
+        SFT_RETURN_IF_ERROR(
+            ReadLightVector(entry, where, light, "position", LightType::kPoint, &has, &read[l]));
+        any_position = any_position || has;
+        SFT_RETURN_IF_ERROR(ReadLightVector(entry, where, light, "direction",
+                                            LightType::kDirectional, &has, &read_directions[l]));
+        any_direction = any_direction || has;
       }
     }
     if (!found) return Status::Error(where + ".id: the dataset has no light with this id");
@@ -107,6 +129,10 @@ Status ReadLightScales(const std::string& path, const Dataset& dataset, std::vec
     positions->clear();
     if (any_position) *positions = std::move(read);
   }
+  if (directions != nullptr) {
+    directions->clear();
+    if (any_direction) *directions = std::move(read_directions);
+  }
   return Status::Ok();
 }
 
@@ -117,11 +143,30 @@ void ApplyLightPositions(const std::vector<Eigen::Vector3d>& positions, Dataset*
   }
 }
 
+void ApplyLightDirections(const std::vector<Eigen::Vector3d>& directions, Dataset* dataset) {
+  for (size_t l = 0; l < dataset->lights.size() && l < directions.size(); ++l) {
+    LightSpec& light = dataset->lights[l];
+    if (light.type == LightType::kDirectional) light.direction = directions[l].normalized();
+  }
+}
+
+Status ApplyLightsFile(const std::string& path, Dataset* dataset) {
+  std::vector<double> scales;
+  std::vector<Eigen::Vector3d> positions, directions;
+  SFT_RETURN_IF_ERROR(ReadLightScales(path, *dataset, &scales, &positions, &directions));
+  ApplyLightScales(scales, dataset);
+  ApplyLightPositions(positions, dataset);
+  ApplyLightDirections(directions, dataset);
+  return Status::Ok();
+}
+
 void ApplyLightScales(const std::vector<double>& scales, Dataset* dataset) {
   for (size_t l = 0; l < dataset->lights.size() && l < scales.size(); ++l) {
     LightSpec& light = dataset->lights[l];
     if (light.type == LightType::kPoint) {
       light.intensity *= scales[l];
+    } else if (light.type == LightType::kDirectional) {
+      light.irradiance *= scales[l];
     } else {
       light.scale *= scales[l];
     }

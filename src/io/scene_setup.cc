@@ -65,6 +65,17 @@ Status MakeDatasetViews(const Dataset& dataset, DatasetViews* out) {
         view.point_lights.push_back(point);
         continue;
       }
+      if (light.type == LightType::kDirectional) {
+        DirectionalLight directional;
+        directional.direction = light.frame == LightFrame::kCamera
+                                    ? world_from_cam.rotation * light.direction
+                                    : light.direction;
+        directional.irradiance = light.irradiance;
+        directional.light_index = l;
+        directional.camera_frame = light.frame == LightFrame::kCamera;
+        view.directional_lights.push_back(directional);
+        continue;
+      }
       if (view.environment != nullptr) {
         return Status::Error("views[" + std::to_string(v) +
                              "].lights: more than one environment light in one view is not "

@@ -163,7 +163,8 @@ struct PlannerContext {
   bool geometry_phase = false;  // the fit moves vertices: derivative terms are measured.
   bool fit_specular = false;    // the texture phase fits the specular weight.
   bool has_environment = false;
-  bool has_point_lights = false;
+  bool has_point_lights =
+      false;  // point or directional lights (delta lights that cast shadow edges).
   bool specular_nonzero = true;  // some specular weight of the material is > 0.
   // K: the number of independent seeds the stage's noise averages over, >= 1: its outer
   // iterations (one seed each), or for Adam with `resample` its steps in full-view renders.

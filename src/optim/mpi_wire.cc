@@ -7,7 +7,7 @@ namespace {
 // ranks would render without it (and results would depend on the rank count). The sizes below
 // are those of the fields written (x86-64, libstdc++).
 #if defined(__x86_64__) && defined(__GLIBCXX__)
-static_assert(sizeof(DerivativeRequest) == 56, "a DerivativeRequest field: write it below");
+static_assert(sizeof(DerivativeRequest) == 64, "a DerivativeRequest field: write it below");
 static_assert(sizeof(RenderOptions) == 88, "a RenderOptions field: write it below");
 static_assert(sizeof(Effects) == 5, "an Effects field: write it below");
 #endif
@@ -105,6 +105,7 @@ std::vector<std::vector<char> > StateParts(const RenderState& s) {
   material.Put(s.material.fresnel);
   settings.PutVector(s.light_scales);
   settings.PutVector(s.light_positions);
+  settings.PutVector(s.light_directions);
   PutRenderOptions(s.render, &settings);
   PutRequest(s.request, &settings);
   settings.Put(s.layout);
@@ -140,6 +141,7 @@ void ApplyStatePart(int part, const std::vector<char>& bytes, RenderState* s) {
     case kSettingsPart:
       s->light_scales = r.GetVector<double>();
       s->light_positions = r.GetVector<Eigen::Vector3d>();
+      s->light_directions = r.GetVector<Eigen::Vector3d>();
       s->render = GetRenderOptions(&r);
       s->request = GetRequest(&r);
       s->layout = r.Get<ParameterLayout>();

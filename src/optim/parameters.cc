@@ -38,6 +38,7 @@ ParameterSelection ActiveParameters::ToSelection() const {
   selection.lights = lights;
   selection.environment = environment;
   selection.light_positions = light_positions;
+  selection.light_directions = light_directions;
   return selection;
 }
 
@@ -90,30 +91,34 @@ SceneParameters::SceneParameters(const std::vector<Eigen::Vector3d>& positions,
   }
 }
 
-void SceneParameters::AddLightPositions(const std::vector<Eigen::Vector3d>& positions) {
-  CHECK_EQ(static_cast<int>(positions.size()), layout_.num_lights);
-  std::vector<double> packed(3 * positions.size());
-  for (size_t l = 0; l < positions.size(); ++l) {
-    for (int k = 0; k < 3; ++k) packed[3 * l + k] = positions[l][k];
+void SceneParameters::AddLightVectors(const std::vector<Eigen::Vector3d>& vectors,
+                                      bool directions) {
+  CHECK_EQ(static_cast<int>(vectors.size()), layout_.num_lights);
+  std::vector<double> packed(3 * vectors.size());
+  for (size_t l = 0; l < vectors.size(); ++l) {
+    for (int k = 0; k < 3; ++k) packed[3 * l + k] = vectors[l][k];
   }
-  const auto first = values_.begin() + layout_.LightPositionOffset();
-  if (layout_.light_positions) {
+  bool& present = directions ? layout_.light_directions : layout_.light_positions;
+  const auto first = values_.begin() +
+                     (directions ? layout_.LightDirectionOffset() : layout_.LightPositionOffset());
+  if (present) {
     std::copy(packed.begin(), packed.end(), first);
     return;
   }
-  // Inserted before the exposure gains (ExposureOffset() moves with the layout's size).
+  // Inserted before the later blocks (ExposureOffset() moves with the layout's size).
   values_.insert(first, packed.begin(), packed.end());
-  layout_.light_positions = true;
+  present = true;
 }
 
-std::vector<Eigen::Vector3d> SceneParameters::LightPositions() const {
-  std::vector<Eigen::Vector3d> positions;
-  if (!layout_.light_positions) return positions;
+std::vector<Eigen::Vector3d> SceneParameters::LightVectors(bool directions) const {
+  std::vector<Eigen::Vector3d> vectors;
+  if (!(directions ? layout_.light_directions : layout_.light_positions)) return vectors;
+  const int offset = directions ? layout_.LightDirectionOffset() : layout_.LightPositionOffset();
   for (int l = 0; l < layout_.num_lights; ++l) {
-    const double* p = &values_[layout_.LightPositionOffset() + 3 * l];
-    positions.emplace_back(p[0], p[1], p[2]);
+    const double* p = &values_[offset + 3 * l];
+    vectors.emplace_back(p[0], p[1], p[2]);
   }
-  return positions;
+  return vectors;
 }
 
 Image SceneParameters::EnvironmentTexels() const {
@@ -157,6 +162,9 @@ std::vector<BlockSpan> SceneParameters::Blocks() const {
   for (int l = 0; layout_.light_positions && l < layout_.num_lights; ++l) {
     blocks.push_back({layout_.LightPositionOffset() + 3 * l, 3, ParameterKind::kLightPosition});
   }
+  for (int l = 0; layout_.light_directions && l < layout_.num_lights; ++l) {
+    blocks.push_back({layout_.LightDirectionOffset() + 3 * l, 3, ParameterKind::kLightDirection});
+  }
   for (int v = 0; v < num_gain_views_; ++v) {
     blocks.push_back({GainIndex(v, 0), 3, ParameterKind::kLight, /*exposure=*/true});
   }
@@ -190,6 +198,10 @@ BlockSpan SceneParameters::BlockOf(int index) const {
       const int local = index - layout_.LightPositionOffset();
       return {index - local % 3, 3, ParameterKind::kLightPosition};
     }
+    case ParameterKind::kLightDirection: {
+      const int local = index - layout_.LightDirectionOffset();
+      return {index - local % 3, 3, ParameterKind::kLightDirection};
+    }
   }
   return {index, 1, ParameterKind::kLight};
 }
@@ -221,6 +233,7 @@ double SceneParameters::Lower(int index, const ParameterBounds& bounds) const {
   switch (layout_.KindOf(index)) {
     case ParameterKind::kVertex:
     case ParameterKind::kLightPosition:
+    case ParameterKind::kLightDirection:
       return -std::numeric_limits<double>::infinity();
     case ParameterKind::kAlbedo:
     case ParameterKind::kSpecular:
@@ -240,6 +253,7 @@ double SceneParameters::Upper(int index, const ParameterBounds& bounds) const {
   switch (layout_.KindOf(index)) {
     case ParameterKind::kVertex:
     case ParameterKind::kLightPosition:
+    case ParameterKind::kLightDirection:
       return std::numeric_limits<double>::infinity();
     case ParameterKind::kLight:
       return bounds.light_scale_max;

@@ -3,12 +3,15 @@
 // texels (RGB), roughness texels, the specular weight, one intensity scale per dataset light, the
 // texels of a fitted environment (RGB radiance; src/optim/fitted_environment.h), and with
 // AddLightPositions three position coordinates per dataset light (a point light's position in its
-// own frame: world, or the camera frame for a flash; ParameterLayout::light_positions) —
+// own frame: world, or the camera frame for a flash; ParameterLayout::light_positions), with
+// AddLightDirections three direction numbers per dataset light (ParameterLayout::
+// light_directions) —
 // followed by the fit-only exposure gains: 3 per fitted view (R, G, B), which multiply that view's
 // rendered image before the residual (the renderer never sees them; docs/reconstruct.md,
 // "Exposure and white balance"). Ceres parameter blocks point into this vector: one block per
 // vertex (3), per albedo texel (3), per roughness texel (1), the specular weight (1), each light
-// scale (1), each environment texel (3), each light position (3) and each view's gains (3), so
+// scale (1), each environment texel (3), each light position (3), each light direction (3) and
+// each view's gains (3), so
 // the mapping between Ceres
 // blocks and indices is the block's offset in the vector.
 #ifndef SFT_OPTIM_PARAMETERS_H_
@@ -56,13 +59,14 @@ struct ActiveParameters {
   bool exposure = false;         // the per-view exposure gains (all views but the gauge view).
   bool environment = false;      // the fitted environment's texels (when the parameters have them).
   bool light_positions = false;  // point-light positions (when the parameters have them).
+  bool light_directions = false;  // directional-light directions (when the parameters have them).
 
   // The renderer's kinds (exposure gains are applied by the render cache, not the renderer).
   ParameterSelection ToSelection() const;
   bool Includes(ParameterKind kind) const;
   bool Any() const {
     return vertices || albedo || roughness || specular || lights || exposure || environment ||
-           light_positions;
+           light_positions || light_directions;
   }
 };
 
@@ -119,10 +123,20 @@ class SceneParameters {
   // Makes the lights' positions parameters (ParameterLayout::light_positions), starting at
   // `positions` (one per dataset light, each in its light's frame; entries of lights that are
   // not point lights are kept but get no derivatives). The exposure gains keep their values.
-  void AddLightPositions(const std::vector<Eigen::Vector3d>& positions);
+  void AddLightPositions(const std::vector<Eigen::Vector3d>& positions) {
+    AddLightVectors(positions, /*directions=*/false);
+  }
   bool has_light_positions() const { return layout_.light_positions; }
   // The lights' position parameters, one per dataset light (empty without them).
-  std::vector<Eigen::Vector3d> LightPositions() const;
+  std::vector<Eigen::Vector3d> LightPositions() const { return LightVectors(false); }
+  // The same for directional lights' directions (ParameterLayout::light_directions): three
+  // numbers v per dataset light in its frame, the light travelling along v/|v| (entries of lights
+  // that are not directional are kept but get no derivatives).
+  void AddLightDirections(const std::vector<Eigen::Vector3d>& directions) {
+    AddLightVectors(directions, /*directions=*/true);
+  }
+  bool has_light_directions() const { return layout_.light_directions; }
+  std::vector<Eigen::Vector3d> LightDirections() const { return LightVectors(true); }
 
   // Current state, for rendering and output. `material` must have the layout's texel counts;
   // its fresnel mode and resolutions are kept.
@@ -136,13 +150,18 @@ class SceneParameters {
   int environment_width() const { return environment_width_; }
   int environment_height() const { return environment_height_; }
 
-  // Lower/upper bound of parameter `index` (±infinity for vertices and light positions).
+  // Lower/upper bound of parameter `index` (±infinity for vertices, light positions and
+  // directions).
   double Lower(int index, const ParameterBounds& bounds) const;
   double Upper(int index, const ParameterBounds& bounds) const;
   // Clamps every value into the bounds (projection onto the feasible set).
   void Project(const ParameterBounds& bounds, std::vector<double>* values) const;
 
  private:
+  // AddLightPositions (`directions` false) or AddLightDirections, and their getters.
+  void AddLightVectors(const std::vector<Eigen::Vector3d>& vectors, bool directions);
+  std::vector<Eigen::Vector3d> LightVectors(bool directions) const;
+
   ParameterLayout layout_;
   int num_gain_views_ = 0;
   int environment_width_ = 0;

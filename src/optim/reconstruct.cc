@@ -26,6 +26,7 @@ ActiveParameters TexturePhase(const ReconstructOptions& options) {
   active.specular = options.fit_specular;
   active.lights = options.fit_lights;
   active.light_positions = options.fit_light_positions;
+  active.light_directions = options.fit_light_directions;
   active.exposure = options.fit_exposure;
   active.environment = options.fit_environment;
   return active;
@@ -36,6 +37,37 @@ ActiveParameters GeometryPhase() {
   active.vertices = true;
   active.albedo = active.roughness = active.specular = active.lights = false;
   return active;
+}
+
+// Light positions (directions) are parameters whenever an earlier fit moved them (`positions`,
+// `directions` not empty: one per dataset light) or this fit fits them (starting at the
+// dataset's).
+Status AddLightGeometry(const Dataset& dataset, const ReconstructOptions& options,
+                        const std::vector<Eigen::Vector3d>& positions,
+                        const std::vector<Eigen::Vector3d>& directions, SceneParameters* params) {
+  const size_t num_lights = dataset.lights.size();
+  for (const bool direction : {false, true}) {
+    const std::vector<Eigen::Vector3d>& given = direction ? directions : positions;
+    const bool fit = direction ? options.fit_light_directions : options.fit_light_positions;
+    if (!fit && given.empty()) continue;
+    if (!given.empty() && given.size() != num_lights) {
+      return Status::Error(std::string(direction ? "light directions: " : "light positions: ") +
+                           std::to_string(given.size()) + " given, the dataset has " +
+                           std::to_string(num_lights) + " lights");
+    }
+    std::vector<Eigen::Vector3d> start = given;
+    if (start.empty()) {
+      for (const LightSpec& light : dataset.lights) {
+        start.push_back(direction ? light.direction : light.position);
+      }
+    }
+    if (direction) {
+      params->AddLightDirections(start);
+    } else {
+      params->AddLightPositions(start);
+    }
+  }
+  return Status::Ok();
 }
 
 }  // namespace
@@ -119,7 +151,8 @@ Status Reconstruction::Create(const Dataset& dataset, const TriMesh& mesh, const
                               std::unique_ptr<Reconstruction>* out,
                               const std::vector<Eigen::Vector3d>& view_gains,
                               const Image& environment,
-                              const std::vector<Eigen::Vector3d>& light_positions) {
+                              const std::vector<Eigen::Vector3d>& light_positions,
+                              const std::vector<Eigen::Vector3d>& light_directions) {
   std::string why;
   if (!options.Check(&why)) return Status::Error(why);
   std::unique_ptr<Reconstruction> r(new Reconstruction());
@@ -166,18 +199,8 @@ Status Reconstruction::Create(const Dataset& dataset, const TriMesh& mesh, const
       r->params_.values()[r->params_.layout().LightOffset() + l] = light_scales[l];
     }
   }
-  // Light positions are parameters whenever an earlier fit moved them or this fit fits them.
-  if (options.fit_light_positions || !light_positions.empty()) {
-    if (!light_positions.empty() && static_cast<int>(light_positions.size()) != num_lights) {
-      return Status::Error("light positions: " + std::to_string(light_positions.size()) +
-                           " given, the dataset has " + std::to_string(num_lights) + " lights");
-    }
-    std::vector<Eigen::Vector3d> start = light_positions;
-    if (start.empty()) {
-      for (const LightSpec& light : dataset.lights) start.push_back(light.position);
-    }
-    r->params_.AddLightPositions(start);
-  }
+  SFT_RETURN_IF_ERROR(
+      AddLightGeometry(dataset, options, light_positions, light_directions, &r->params_));
   SFT_RETURN_IF_ERROR(RenderCache::Create(dataset, &r->views_, views, r->faces_, material,
                                           &r->params_, r->options_.cache, &r->cache_));
   r->start_time_ = NowSeconds();

@@ -43,6 +43,9 @@ struct ReconstructOptions {
   // world position, a camera-frame light's offset in the camera frame; docs/reconstruct.md,
   // "Fitted point lights").
   bool fit_light_positions = false;
+  // The texture phase also fits the directional lights' directions (3 numbers v per light in its
+  // frame, the light travelling along v/|v|; docs/reconstruct.md, "Fitted directional lights").
+  bool fit_light_directions = false;
   // The texture phase also fits per-view exposure gains (3 per fitted view, the first fitted view
   // the fixed gauge; src/optim/parameters.h, kExposureGaugeView).
   bool fit_exposure = false;
@@ -94,7 +97,8 @@ class Reconstruction {
                        std::unique_ptr<Reconstruction>* out,
                        const std::vector<Eigen::Vector3d>& view_gains = {},
                        const Image& environment = Image(),
-                       const std::vector<Eigen::Vector3d>& light_positions = {});
+                       const std::vector<Eigen::Vector3d>& light_positions = {},
+                       const std::vector<Eigen::Vector3d>& light_directions = {});
 
   // Runs the effect planner for outer iteration `outer` (its renders use the chosen plan from
   // now on). The ceiling is the configured effects and budgets; `image_signal_scale` and
@@ -113,6 +117,9 @@ class Reconstruction {
   // The point lights' position parameters per dataset light, each in its light's frame (empty
   // when they are not parameters).
   std::vector<Eigen::Vector3d> LightPositions() const { return params_.LightPositions(); }
+  // The directional lights' direction parameters per dataset light (empty when they are not
+  // parameters).
+  std::vector<Eigen::Vector3d> LightDirections() const { return params_.LightDirections(); }
   // The fitted environment's texels (empty without one).
   Image EnvironmentTexels() const { return params_.EnvironmentTexels(); }
   // The exposure gains per dataset view: the fitted views' current ones, the others' as given to

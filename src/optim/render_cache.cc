@@ -235,8 +235,9 @@ void RenderCache::UpdateScene() {
 }
 
 ViewSetup RenderCache::ScaledView(int v) const {
-  ViewSetup view = ScaledViewSetup(*views_, view_indices_[v], options_.image_scale_log2,
-                                   params_->LightScales(), params_->LightPositions());
+  ViewSetup view =
+      ScaledViewSetup(*views_, view_indices_[v], options_.image_scale_log2, params_->LightScales(),
+                      params_->LightPositions(), params_->LightDirections());
   UseFittedEnvironment(params_->layout(), fitted_environment_, view_indices_[v], &view);
   return view;
 }
@@ -259,6 +260,7 @@ RenderState RenderCache::CurrentState(const RenderOptions& render,
   state.material = material_;
   state.light_scales = params_->LightScales();
   state.light_positions = params_->LightPositions();
+  state.light_directions = params_->LightDirections();
   state.render = render;
   state.request = request;
   state.layout = params_->layout();

@@ -55,13 +55,16 @@ Status ReadRunState(const std::string& out, RunState* state);
 
 // mesh.ply, mesh.obj, material.json (+ .mc files), lights.json.
 // `light_positions`: the fitted point-light positions (empty: none fitted; lights.json then has
-// no positions and ReadRunSnapshot returns them empty).
+// no positions and ReadRunSnapshot returns them empty); `light_directions` the same for the
+// fitted directional-light directions.
 Status WriteRunSnapshot(const std::string& out, const Dataset& dataset, const TriMesh& mesh,
                         const Material& material, const std::vector<double>& light_scales,
-                        const std::vector<Eigen::Vector3d>& light_positions = {});
+                        const std::vector<Eigen::Vector3d>& light_positions = {},
+                        const std::vector<Eigen::Vector3d>& light_directions = {});
 Status ReadRunSnapshot(const std::string& out, const Dataset& dataset, TriMesh* mesh,
                        Material* material, std::vector<double>* light_scales,
-                       std::vector<Eigen::Vector3d>* light_positions = nullptr);
+                       std::vector<Eigen::Vector3d>* light_positions = nullptr,
+                       std::vector<Eigen::Vector3d>* light_directions = nullptr);
 
 // exposure.json: {"format": "sft-exposure/1", "gauge_view": G, "views": [{"view": i, "image":
 // its image path in the dataset, "gains": [R, G, B]}, ...]} for every dataset view; gains

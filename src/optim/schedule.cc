@@ -154,7 +154,8 @@ Status Schedule::Resume(const Dataset& dataset, const std::string& out,
     p.stage_prepared = true;
   }
   SFT_RETURN_IF_ERROR(ReadRunSnapshot(out, dataset, &s->current_.mesh, &s->current_.material,
-                                      &s->current_.light_scales, &s->current_.light_positions));
+                                      &s->current_.light_scales, &s->current_.light_positions,
+                                      &s->current_.light_directions));
   if (!view_gains.empty() && view_gains.size() != dataset.views.size()) {
     return Status::Error(JoinPath(out, "state.json") +
                          ": exposure_gains: " + std::to_string(view_gains.size()) +
@@ -200,9 +201,10 @@ double Schedule::Elapsed() const { return seconds_at_start_ + NowSeconds() - ses
 
 Status Schedule::CreateReconstruction() {
   const StageOptions& stage = stages_[progress_.stage];
-  SFT_RETURN_IF_ERROR(Reconstruction::Create(
-      *dataset_, current_.mesh, current_.material, current_.light_scales, stage.fit,
-      &reconstruction_, current_.view_gains, current_.environment, current_.light_positions));
+  SFT_RETURN_IF_ERROR(Reconstruction::Create(*dataset_, current_.mesh, current_.material,
+                                             current_.light_scales, stage.fit, &reconstruction_,
+                                             current_.view_gains, current_.environment,
+                                             current_.light_positions, current_.light_directions));
   reconstruction_->elapsed_offset = Elapsed();
   reconstruction_stage_ = progress_.stage;
   phases_seen_ = 0;
@@ -239,6 +241,8 @@ void Schedule::SyncCurrent() {
   current_.light_scales = reconstruction_->LightScales();
   std::vector<Eigen::Vector3d> light_positions = reconstruction_->LightPositions();
   if (!light_positions.empty()) current_.light_positions = std::move(light_positions);
+  std::vector<Eigen::Vector3d> light_directions = reconstruction_->LightDirections();
+  if (!light_directions.empty()) current_.light_directions = std::move(light_directions);
   current_.view_gains = reconstruction_->ViewGains();
   Image environment = reconstruction_->EnvironmentTexels();
   if (!environment.empty()) current_.environment = std::move(environment);
@@ -524,7 +528,8 @@ Status Schedule::RunStageOuter(const ScheduleCallbacks& callbacks, bool* stop) {
 Status Schedule::Checkpoint() {
   progress_.seconds = Elapsed();
   SFT_RETURN_IF_ERROR(WriteRunSnapshot(out_, *dataset_, current_.mesh, current_.material,
-                                       current_.light_scales, current_.light_positions));
+                                       current_.light_scales, current_.light_positions,
+                                       current_.light_directions));
   if (!current_.environment.empty()) {
     const LightSpec& light = dataset_->lights.at(FittedEnvironmentLight(*dataset_));
     SFT_RETURN_IF_ERROR(WriteFittedEnvironment(out_, current_.environment, light.frame));

@@ -78,6 +78,9 @@ struct ScheduleStart {
   // Fitted point-light positions per dataset light, in each light's frame (lights.json); empty =
   // the dataset's (none fitted yet).
   std::vector<Eigen::Vector3d> light_positions;
+  // Fitted directional-light directions per dataset light, in each light's frame (lights.json);
+  // empty = the dataset's (none fitted yet).
+  std::vector<Eigen::Vector3d> light_directions;
   // Exposure gains per dataset view (src/optim/parameters.h); empty = all 1.
   std::vector<Eigen::Vector3d> view_gains;
   // The fitted environment's texels (unknown lighting, src/optim/fitted_environment.h); empty =

@@ -47,8 +47,9 @@ Status StateRenderer::UpdateEnvironment(const RenderState& state) {
 }
 
 void StateRenderer::Render(const RenderState& state, const ViewJob& job, ViewResult* result) const {
-  ViewSetup view = ScaledViewSetup(views_, state.view_indices[job.view], state.image_scale_log2,
-                                   state.light_scales, state.light_positions);
+  ViewSetup view =
+      ScaledViewSetup(views_, state.view_indices[job.view], state.image_scale_log2,
+                      state.light_scales, state.light_positions, state.light_directions);
   UseFittedEnvironment(state.layout, fitted_environment_, state.view_indices[job.view], &view);
   RenderViewJob(*scene_, state.material, view, state.render, state.request, state.layout, job,
                 result);

@@ -13,7 +13,8 @@ ViewRunner* g_view_runner = nullptr;
 
 ViewSetup ScaledViewSetup(const DatasetViews& views, int dataset_view, int image_scale_log2,
                           const std::vector<double>& light_scales,
-                          const std::vector<Eigen::Vector3d>& light_positions) {
+                          const std::vector<Eigen::Vector3d>& light_positions,
+                          const std::vector<Eigen::Vector3d>& light_directions) {
   ViewSetup view = views.views[dataset_view];
   view.camera = DownscaledCamera(view.camera, image_scale_log2);
   const Rigid3d world_from_cam = view.cam_from_world.Inverse();
@@ -23,6 +24,16 @@ ViewSetup ScaledViewSetup(const DatasetViews& views, int dataset_view, int image
     if (light_positions.empty()) continue;
     const Eigen::Vector3d& p = light_positions.at(light.light_index);
     light.position = light.camera_frame ? world_from_cam * p : p;
+  }
+  for (DirectionalLight& light : view.directional_lights) {
+    if (light.light_index < 0) continue;
+    light.irradiance *= light_scales[light.light_index];
+    if (light_directions.empty()) continue;
+    const Eigen::Vector3d& v = light_directions.at(light.light_index);
+    light.parameter_norm = v.norm();
+    CHECK(light.parameter_norm > 0.0) << "light " << light.light_index << ": zero direction";
+    const Eigen::Vector3d d = v / light.parameter_norm;
+    light.direction = light.camera_frame ? world_from_cam.rotation * d : d;
   }
   if (view.environment_light_index >= 0) {
     view.environment_scale *= light_scales[view.environment_light_index];

@@ -64,6 +64,9 @@ struct RenderState {
   // Fitted point-light positions per dataset light, each in its light's frame (world, or the
   // camera frame of a flash); empty = the dataset's (SceneParameters::LightPositions).
   std::vector<Eigen::Vector3d> light_positions;
+  // Fitted directional-light directions per dataset light (v, the light travelling along v/|v|
+  // in its frame); empty = the dataset's (SceneParameters::LightDirections).
+  std::vector<Eigen::Vector3d> light_directions;
   RenderOptions render;       // spp, bounces, effects, threads, shading.
   DerivativeRequest request;  // derivative kinds and edge budgets (no weights).
   // The index space of rows and gradients (SceneParameters::layout): vertices, texels, lights
@@ -81,10 +84,12 @@ struct RenderState {
 // View `dataset_view` of `views` as the fit renders it: its camera downscaled by
 // 2^-image_scale_log2, its lights' intensities times their scales and, when `light_positions` is
 // not empty (one per dataset light, in the light's frame), its point lights at those positions
-// (a camera-frame light at C + Rᵀ·offset).
+// (a camera-frame light at C + Rᵀ·offset), and when `light_directions` is not empty its
+// directional lights travelling along v/|v| (Rᵀ·v/|v| for a camera-frame light).
 ViewSetup ScaledViewSetup(const DatasetViews& views, int dataset_view, int image_scale_log2,
                           const std::vector<double>& light_scales,
-                          const std::vector<Eigen::Vector3d>& light_positions = {});
+                          const std::vector<Eigen::Vector3d>& light_positions = {},
+                          const std::vector<Eigen::Vector3d>& light_directions = {});
 
 // The renderer's maps of a fitted environment's texels: one map when the light is world-fixed,
 // one per dataset view when it is camera-fixed (LightSpec::frame; ViewWorldFromEnv).

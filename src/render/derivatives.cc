@@ -12,7 +12,8 @@ ParameterKind ParameterLayout::KindOf(int index) const {
   if (index == SpecularIndex()) return ParameterKind::kSpecular;
   if (index < EnvironmentOffset()) return ParameterKind::kLight;
   if (index < LightPositionOffset()) return ParameterKind::kEnvironment;
-  return ParameterKind::kLightPosition;
+  if (index < LightDirectionOffset()) return ParameterKind::kLightPosition;
+  return ParameterKind::kLightDirection;
 }
 
 std::string ParameterLayout::Describe(int index) const {
@@ -39,6 +40,10 @@ std::string ParameterLayout::Describe(int index) const {
       const int local = index - LightPositionOffset();
       return "light_position[" + std::to_string(local / 3) + "]." + kAxis[local % 3];
     }
+    case ParameterKind::kLightDirection: {
+      const int local = index - LightDirectionOffset();
+      return "light_direction[" + std::to_string(local / 3) + "]." + kAxis[local % 3];
+    }
   }
   return "?";
 }
@@ -58,6 +63,8 @@ bool ParameterKindFromName(const std::string& name, ParameterKind* kind) {
     *kind = ParameterKind::kEnvironment;
   else if (name == "light_position")
     *kind = ParameterKind::kLightPosition;
+  else if (name == "light_direction")
+    *kind = ParameterKind::kLightDirection;
   else
     return false;
   return true;
@@ -79,6 +86,8 @@ const char* ParameterKindName(ParameterKind kind) {
       return "environment";
     case ParameterKind::kLightPosition:
       return "light_position";
+    case ParameterKind::kLightDirection:
+      return "light_direction";
   }
   return "?";
 }
@@ -92,6 +101,7 @@ ParameterSelection ParameterSelection::Only(ParameterKind kind) {
   s.lights = kind == ParameterKind::kLight;
   s.environment = kind == ParameterKind::kEnvironment;
   s.light_positions = kind == ParameterKind::kLightPosition;
+  s.light_directions = kind == ParameterKind::kLightDirection;
   return s;
 }
 
@@ -111,6 +121,8 @@ bool ParameterSelection::Selected(ParameterKind kind) const {
       return environment;
     case ParameterKind::kLightPosition:
       return light_positions;
+    case ParameterKind::kLightDirection:
+      return light_directions;
   }
   return false;
 }

@@ -31,6 +31,12 @@
 //     (internal/shadow_edges.h): seen directly by the camera in the shadow-edge term, through a
 //     bounce in secondary edges (B) (both run for light positions without vertex derivatives
 //     too, and follow the same budgets). Nothing of the light's visibility is left out;
+//   light directions (directional lights, ParameterLayout::light_directions): every next-event
+//     contribution of that light at every path vertex, through wi = −d — the cosine c = n·wi and
+//     the BSDF's dependence on wi — chained through d = M·v/|v| (M = I, or Rᵀ for a camera-frame
+//     light); a delta light too, so no BSDF-sampled term. The shadow boundaries the light casts
+//     move with ∂y/∂d = t(I − d n_rᵀ/(n_r·d)) (t from the edge point to the shadow point;
+//     internal/shadow_edges.h), seen directly and through a bounce, as for light positions;
 //   vertices, interior terms (geometry_derivatives.h): through every path vertex's shading
 //     normal (BSDF, cosines) — the face normal, or under smooth shading the interpolated vertex
 //     normals with their two-ring and the hit's sliding barycentrics (internal/shading_normal.h)
@@ -53,11 +59,11 @@
 // (A) mesh edges seen from a path vertex — silhouettes against the environment (when it is lit
 // with shadows) or against farther surfaces, and creases under flat shading, when a further
 // bounce is traced;
-// (B) point-light shadow boundaries on the surface a bounce reaches; (C) texel boundaries on the
-// surface a bounce reaches. Their sampling is unbiased: (A) and (C) draw (edge, point) pairs —
-// (A) from a mixture of the edges around the vertex's face and all edges ∝ length, (C) ∝ length
-// × material jump — uniform in the angle they subtend, and keep one by resampling with the
-// BSDF·cosine towards it; (B) resamples a per-view pool of cast shadow points with the
+// (B) point- and directional-light shadow boundaries on the surface a bounce reaches; (C) texel
+// boundaries on the surface a bounce reaches. Their sampling is unbiased: (A) and (C) draw (edge,
+// point) pairs — (A) from a mixture of the edges around the vertex's face and all edges ∝ length,
+// (C) ∝ length × material jump — uniform in the angle they subtend, and keep one by resampling with
+// the BSDF·cosine towards it; (B) resamples a per-view pool of cast shadow points with the
 // BSDF·cosine times the curve's angular speed.
 // Primary edges cover silhouettes, boundary and non-manifold edges and, under flat shading,
 // creases between non-coplanar faces (smooth shading is continuous across them: Shading in
@@ -86,7 +92,8 @@ enum class ParameterKind {
   kSpecular,
   kLight,
   kEnvironment,
-  kLightPosition
+  kLightPosition,
+  kLightDirection
 };
 
 struct ParameterLayout {
@@ -104,10 +111,19 @@ struct ParameterLayout {
   // camera-frame light (PointLight::camera_frame, a flash) its offset in the camera frame, shared
   // by every view. Entries of lights that are not point lights get no derivatives.
   bool light_positions = false;
+  // Directional-light directions as parameters: 3 per dataset light (component k of light l at
+  // LightDirectionOffset() + 3l + k), a vector v in the light's frame (world, or the camera frame
+  // for DirectionalLight::camera_frame) whose direction v/|v| is the direction the light travels.
+  // Three numbers normalized inside the render rather than two tangent-plane coordinates: they
+  // need no per-evaluation re-anchoring, so Ceres' plain parameter blocks, Adam's flat steps and
+  // lights.json all hold the same three numbers, and the normalization's Jacobian (I − d dᵀ)/|v|
+  // (DirectionalLight::parameter_norm) makes the one free direction, the length, a null direction
+  // of every row. Entries of lights that are not directional get no derivatives.
+  bool light_directions = false;
 
   // Index ranges, in this order: vertex v coordinate k at 3v + k; albedo texel t channel c;
   // roughness texel t; the specular weight; light l's scale; environment texel t channel c;
-  // light l's position coordinate k.
+  // light l's position coordinate k; light l's direction component k.
   int VertexOffset() const { return 0; }
   int AlbedoOffset() const { return 3 * num_vertices; }
   int RoughnessOffset() const { return AlbedoOffset() + 3 * num_albedo_texels; }
@@ -115,7 +131,10 @@ struct ParameterLayout {
   int LightOffset() const { return SpecularIndex() + 1; }
   int EnvironmentOffset() const { return LightOffset() + num_lights; }
   int LightPositionOffset() const { return EnvironmentOffset() + 3 * num_environment_texels; }
-  int size() const { return LightPositionOffset() + (light_positions ? 3 * num_lights : 0); }
+  int LightDirectionOffset() const {
+    return LightPositionOffset() + (light_positions ? 3 * num_lights : 0);
+  }
+  int size() const { return LightDirectionOffset() + (light_directions ? 3 * num_lights : 0); }
   // Whether dataset light `light`'s environment texels are parameters.
   bool FitsEnvironment(int light) const {
     return num_environment_texels > 0 && light >= 0 && light == environment_light;
@@ -126,14 +145,18 @@ struct ParameterLayout {
   bool FitsLightPosition(int light) const {
     return light_positions && light >= 0 && light < num_lights;
   }
+  // Whether dataset light `light`'s direction components are parameters.
+  bool FitsLightDirection(int light) const {
+    return light_directions && light >= 0 && light < num_lights;
+  }
 
   // "vertex[12].y", "albedo[40].g", "roughness[3]", "specular", "light[0]", "environment[7].b",
-  // "light_position[0].z".
+  // "light_position[0].z", "light_direction[0].x".
   std::string Describe(int index) const;
 };
 
-// "vertices", "albedo", "roughness", "specular", "light", "environment", "light_position" (the
-// names of `--param`).
+// "vertices", "albedo", "roughness", "specular", "light", "environment", "light_position",
+// "light_direction" (the names of `--param`).
 bool ParameterKindFromName(const std::string& name, ParameterKind* kind);
 const char* ParameterKindName(ParameterKind kind);
 
@@ -144,8 +167,9 @@ struct ParameterSelection {
   bool roughness = true;
   bool specular = true;
   bool lights = true;
-  bool environment = true;      // fitted environment texels (when the layout has them).
-  bool light_positions = true;  // point-light positions (when the layout has them).
+  bool environment = true;       // fitted environment texels (when the layout has them).
+  bool light_positions = true;   // point-light positions (when the layout has them).
+  bool light_directions = true;  // directional-light directions (when the layout has them).
 
   static ParameterSelection Only(ParameterKind kind);
   bool Selected(ParameterKind kind) const;

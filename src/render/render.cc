@@ -228,11 +228,13 @@ std::optional<render_internal::SecondaryEdges> MaybeSecondaryEdges(
       options.pass != RenderPass::kColor || !(request->secondary_edge_samples > 0)) {
     return std::nullopt;
   }
-  // Without vertex derivatives only the point lights' position parameters have secondary terms:
-  // their shadow boundaries seen through a bounce, (B).
-  const bool light_positions = request->params.light_positions && layout != nullptr &&
-                               layout->light_positions && !view.point_lights.empty() &&
-                               options.effects.shadows && max_segments > 1;
+  // Without vertex derivatives only the point lights' positions and the directional lights'
+  // directions have secondary terms: their shadow boundaries seen through a bounce, (B).
+  const bool light_positions =
+      layout != nullptr && options.effects.shadows && max_segments > 1 &&
+      ((request->params.light_positions && layout->light_positions && !view.point_lights.empty()) ||
+       (request->params.light_directions && layout->light_directions &&
+        !view.directional_lights.empty()));
   if ((request->params.vertices &&
        ((environment != nullptr && options.effects.shadows) || max_segments > 1)) ||
       (!request->params.vertices && light_positions)) {
@@ -295,9 +297,11 @@ void RenderImpl(const RenderScene& scene, const Material& material, const ViewSe
     job.parts.Reset(layout->size());
     job.tile_secondary.resize(num_tiles);
   }
-  const bool light_positions = request != nullptr && request->params.light_positions &&
-                               layout != nullptr && layout->light_positions;
-  if (job.want_derivatives && (request->params.vertices || light_positions) &&
+  // Light positions and directions move shadow boundaries: edge terms even without vertices.
+  const bool moves_lights = request != nullptr && layout != nullptr &&
+                            ((request->params.light_positions && layout->light_positions) ||
+                             (request->params.light_directions && layout->light_directions));
+  if (job.want_derivatives && (request->params.vertices || moves_lights) &&
       options.pass == RenderPass::kColor) {
     job.edge_lists.resize(static_cast<size_t>(width) * height);
     render_internal::AddEdgeTerms(ctx, &job.edge_lists, &edge_stats,
@@ -347,6 +351,14 @@ Eigen::Vector3d CameraSampleDirection(const ViewSetup& view,
 Eigen::Matrix3d LightPositionJacobian(const ViewSetup& view, const PointLight& light) {
   if (!light.camera_frame) return Eigen::Matrix3d::Identity();
   return view.cam_from_world.rotation.toRotationMatrix().transpose();
+}
+
+Eigen::Matrix3d LightDirectionJacobian(const ViewSetup& view, const DirectionalLight& light) {
+  const Eigen::Vector3d& d = light.direction;
+  const Eigen::Matrix3d project = Eigen::Matrix3d::Identity() - d * d.transpose();
+  const Eigen::Matrix3d scaled = project / light.parameter_norm;
+  if (!light.camera_frame) return scaled;
+  return scaled * view.cam_from_world.rotation.toRotationMatrix().transpose();
 }
 
 void RenderView(const RenderScene& scene, const Material& material, const ViewSetup& view,

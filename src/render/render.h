@@ -1,8 +1,8 @@
 // The forward path tracer (docs/architecture.md, "Render core"): camera rays through a box pixel
-// filter, next-event estimation to point and environment lights, BSDF sampling with multiple
-// importance sampling (power heuristic) against the environment, a fixed number of path segments.
-// Deterministic: sample s of pixel p of view v uses Sampler(seed, v, p, s) only, so the image is
-// identical for any thread count.
+// filter, next-event estimation to point, directional and environment lights, BSDF sampling with
+// multiple importance sampling (power heuristic) against the environment, a fixed number of path
+// segments. Deterministic: sample s of pixel p of view v uses Sampler(seed, v, p, s) only, so the
+// image is identical for any thread count.
 #ifndef SFT_RENDER_RENDER_H_
 #define SFT_RENDER_RENDER_H_
 
@@ -94,11 +94,27 @@ struct PointLight {
   bool camera_frame = false;
 };
 
+// A light at infinity (the sun): parallel rays along `direction`, irradiance E on a surface
+// facing them, so a point with normal n receives E·max(0, n·wi), wi = −direction. A delta light,
+// like a point light: reached by next-event estimation only.
+struct DirectionalLight {
+  Eigen::Vector3d direction;   // unit, world frame: the direction the light travels.
+  Eigen::Vector3d irradiance;  // W/m² on a surface facing the light, RGB.
+  int light_index = -1;        // dataset light index (its intensity-scale parameter); -1 none.
+  // Whether the light turns with the camera: its direction parameters are then in the camera
+  // frame, direction = Rᵀ·v/|v| for the view's rotation R (cam_from_world).
+  bool camera_frame = false;
+  // |v| of the direction parameters v (ParameterLayout::light_directions), > 0: the scale of the
+  // normalization's Jacobian (LightDirectionJacobian). 1 when v is kept unit.
+  double parameter_norm = 1.0;
+};
+
 // Everything one view needs besides the scene and material.
 struct ViewSetup {
   Camera camera;
   Rigid3d cam_from_world;
   std::vector<PointLight> point_lights;
+  std::vector<DirectionalLight> directional_lights;
   const EnvironmentMap* environment = nullptr;  // not owned; may be null.
   bool environment_background = false;          // camera rays that miss see the environment.
   int environment_light_index = -1;             // dataset light index of `environment`.
@@ -109,6 +125,11 @@ struct ViewSetup {
 // ∂(world position)/∂(position parameters) of point light `light` in `view`: the identity for a
 // world-frame light, Rᵀ (the camera's world-from-camera rotation) for a camera-frame one.
 Eigen::Matrix3d LightPositionJacobian(const ViewSetup& view, const PointLight& light);
+
+// ∂(world direction)/∂(direction parameters v) of directional light `light` in `view`:
+// (I − d dᵀ)·M/|v| with d the world direction and M the identity for a world-frame light, Rᵀ for
+// a camera-frame one (d = M·v/|v|).
+Eigen::Matrix3d LightDirectionJacobian(const ViewSetup& view, const DirectionalLight& light);
 
 // Counters of one render: rays (for throughput measurements) and values lost to overflow.
 struct RenderStats {

@@ -27,6 +27,7 @@
 #include "src/optim/schedule_config.h"
 #include "src/render/render.h"
 #include "src/render/scene.h"
+#include "tests/testing/light_fits.h"
 #include "tests/testing/synth_dataset.h"
 #include "tests/testing/temp_dir.h"
 
@@ -71,15 +72,20 @@ TEST(LightPositionParametersTest, LayoutBlocksAndValues) {
   EXPECT_EQ(kind, ParameterKind::kLightPosition);
 }
 
-TEST(LightPositionConfigTest, KeyIsParsedAndWritten) {
-  ReconstructOptions options;
-  EXPECT_FALSE(options.fit_light_positions);
-  ASSERT_TRUE(ApplyReconstructConfig({{"fit_light_positions", true}}, "c.json", &options).ok());
-  EXPECT_TRUE(options.fit_light_positions);
-  EXPECT_EQ(ReconstructConfigJson(options)["fit_light_positions"], true);
-  const Status status = ApplyReconstructConfig({{"fit_light_positions", 1}}, "c.json", &options);
-  EXPECT_THAT(status.message(),
-              ::testing::HasSubstr("c.json: fit_light_positions: expected true or false"));
+// The keys of fitted point-light positions and directional-light directions.
+TEST(LightConfigTest, PositionAndDirectionKeysAreParsedAndWritten) {
+  for (const std::string key : {"fit_light_positions", "fit_light_directions"}) {
+    ReconstructOptions options;
+    const bool& value =
+        key == "fit_light_positions" ? options.fit_light_positions : options.fit_light_directions;
+    EXPECT_FALSE(value) << key;
+    ASSERT_TRUE(ApplyReconstructConfig({{key, true}}, "c.json", &options).ok()) << key;
+    EXPECT_TRUE(value) << key;
+    EXPECT_EQ(ReconstructConfigJson(options)[key], true) << key;
+    const Status status = ApplyReconstructConfig({{key, 1}}, "c.json", &options);
+    EXPECT_THAT(status.message(),
+                ::testing::HasSubstr("c.json: " + key + ": expected true or false"));
+  }
 }
 
 class LightPositionFitTest : public ::testing::Test {
@@ -88,56 +94,20 @@ class LightPositionFitTest : public ::testing::Test {
     dir_ = new testing::TempDir();
     const std::string flash = "--light-offset " + std::to_string(kTrueFlash.x()) + "," +
                               std::to_string(kTrueFlash.y()) + "," + std::to_string(kTrueFlash.z());
-    ASSERT_EQ(testing::SynthIcosphere(
-                  dir_->Join("flash"),
-                  "--cameras 6 --zooms 1 --res 32 --spp 64 --bounces 1 --shading flat " + flash +
-                      " --material '{\"albedo\": [0.6, 0.5, 0.4], \"roughness\": 0.4, "
-                      "\"specular\": 0.2}'"),
+    ASSERT_EQ(testing::SynthLightFitIcosphere(dir_->Join("flash"), flash), "");
+    // A copy lit by a world-frame light at kTrueWorld instead of the flash.
+    ASSERT_EQ(testing::RelightDataset(dir_->Join("flash"), dir_->Join("world"),
+                                      [](Dataset* dataset) {
+                                        LightSpec& light = dataset->lights.at(0);
+                                        light.frame = LightFrame::kWorld;
+                                        light.position = kTrueWorld;
+                                        light.intensity *= 2.0;  // farther than the flash.
+                                      }),
               "");
-    MakeWorldLightDataset(dir_->Join("flash"), dir_->Join("world"));
   }
   static void TearDownTestSuite() {
     delete dir_;
     dir_ = nullptr;
-  }
-
-  // A copy of the flash dataset lit by a world-frame light at kTrueWorld instead, its images
-  // rendered by sft's renderer (64 spp, one segment, flat shading, as `sft synth` renders).
-  static void MakeWorldLightDataset(const std::string& from, const std::string& to) {
-    Dataset dataset;
-    ASSERT_TRUE(ReadDataset(from, &dataset).ok());
-    ASSERT_EQ(dataset.lights.size(), 1u);
-    dataset.lights[0].frame = LightFrame::kWorld;
-    dataset.lights[0].position = kTrueWorld;
-    dataset.lights[0].intensity *= 2.0;  // farther than the flash.
-    TriMesh mesh;
-    ASSERT_TRUE(ReadMesh(JoinPath(from, "gt/mesh.ply"), &mesh).ok());
-    Material truth;
-    ASSERT_TRUE(LoadMaterial(JoinPath(from, "gt/material.json"), mesh, &truth).ok());
-    ASSERT_TRUE(MakeDirectories(JoinPath(to, "images")).ok());
-    ASSERT_TRUE(MakeDirectories(JoinPath(to, "masks")).ok());
-    std::error_code error;
-    std::filesystem::copy(JoinPath(from, "gt"), JoinPath(to, "gt"),
-                          std::filesystem::copy_options::recursive, error);
-    ASSERT_FALSE(error) << error.message();
-    DatasetViews views;
-    ASSERT_TRUE(MakeDatasetViews(dataset, &views).ok());
-    std::vector<Eigen::Vector3d> positions;
-    std::vector<Eigen::Vector3i> faces;
-    MeshToArrays(mesh, &positions, &faces);
-    const RenderScene scene(positions, faces);
-    RenderOptions render;
-    render.spp = 64;
-    render.bounces = 1;
-    render.shading = Shading::kFlat;
-    for (size_t v = 0; v < dataset.views.size(); ++v) {
-      Image image, mask;
-      RenderView(scene, truth, views.views[v], render, &image);
-      ASSERT_TRUE(WriteImage(JoinPath(to, dataset.views[v].image), image).ok());
-      ASSERT_TRUE(LoadViewMask(dataset, static_cast<int>(v), &mask).ok());
-      ASSERT_TRUE(WritePng(JoinPath(to, dataset.views[v].mask), mask, /*srgb=*/false).ok());
-    }
-    ASSERT_TRUE(WriteSceneJson(dataset, to).ok());
   }
 
   // Fits `dataset_dir`'s light from kDisplacement off the truth (texture phases: LM over albedo,
@@ -145,32 +115,13 @@ class LightPositionFitTest : public ::testing::Test {
   // to `truth` before and after; also checks that lights.json round-trips the fitted position.
   void Fit(const std::string& dataset_dir, const Eigen::Vector3d& truth, double* before,
            double* after) {
-    Dataset dataset;
-    ASSERT_TRUE(ReadDataset(dataset_dir, &dataset).ok());
-    TriMesh mesh;
-    ASSERT_TRUE(ReadMesh(JoinPath(dataset_dir, "gt/mesh.ply"), &mesh).ok());
-    Material material;
-    ASSERT_TRUE(LoadMaterial(JoinPath(dataset_dir, "gt/material.json"), mesh, &material).ok());
-    ReconstructOptions options;
-    options.cache.render.spp = 8;
-    options.cache.render.bounces = 1;
-    options.cache.render.shading = Shading::kFlat;
-    options.shading = "flat";
-    options.cache.pyramid_levels = 3;
-    options.phases = PhaseSchedule::kTexture;
-    options.outer_iterations = 3;
-    options.solver.steps = 5;
-    options.fit_light_positions = true;
-    // The albedo is constant: texels seen by one view alone cannot absorb the light's shading.
-    options.regularizers.albedo_smoothness = 0.1;
+    testing::LightFit fit;
+    ASSERT_EQ(testing::ReadLightFit(dataset_dir, &fit), "");
+    fit.options.fit_light_positions = true;
     const Eigen::Vector3d start = truth + kDisplacement;
     std::unique_ptr<Reconstruction> r;
-    const Status created =
-        Reconstruction::Create(dataset, mesh, material, {}, options, &r, {}, Image(), {start});
-    ASSERT_TRUE(created.ok()) << created.message();
-    for (int outer = 0; outer < options.outer_iterations; ++outer) {
-      ASSERT_TRUE(r->RunOuter(outer, nullptr).ok());
-    }
+    ASSERT_EQ(testing::RunLightFit(fit, {start}, {}, &r), "");
+    Dataset& dataset = fit.dataset;
     const std::vector<Eigen::Vector3d> fitted = r->LightPositions();
     ASSERT_EQ(fitted.size(), 1u);
     *before = (start - truth).norm();
@@ -265,21 +216,16 @@ TEST_F(LightPositionFitTest, LightsFileRefusesBadPositions) {
   Dataset dataset;
   ASSERT_TRUE(ReadDataset(dir_->Join("flash"), &dataset).ok());
   const std::string path = dir_->Join("bad_lights.json");
-  const auto read_error = [&](const std::string& entry) {
-    EXPECT_TRUE(
-        WriteTextFile(path, R"({"format": "sft-light-scales/1", "lights": [)" + entry + "]}").ok());
-    std::vector<double> scales;
-    std::vector<Eigen::Vector3d> positions;
-    return ReadLightScales(path, dataset, &scales, &positions).message();
+  const auto read_error = [&](const std::string& members) {
+    return testing::LightsFileError(path, dataset, members);
   };
-  const std::string id = "\"id\": \"" + dataset.lights[0].id + "\", \"scale\": 1";
-  EXPECT_THAT(read_error("{" + id + ", \"frame\": \"camera\", \"position\": [1, 2]}"),
+  EXPECT_THAT(read_error(R"("frame": "camera", "position": [1, 2])"),
               ::testing::HasSubstr("bad_lights.json: lights[0].position: expected 3 numbers"));
-  EXPECT_THAT(read_error("{" + id + ", \"frame\": \"world\", \"position\": [1, 2, 3]}"),
+  EXPECT_THAT(read_error(R"("frame": "world", "position": [1, 2, 3])"),
               ::testing::HasSubstr("lights[0].frame: expected \"camera\""));
   std::vector<double> scales;
   std::vector<Eigen::Vector3d> positions = {Eigen::Vector3d::Ones()};
-  read_error("{" + id + "}");
+  read_error("");
   ASSERT_TRUE(ReadLightScales(path, dataset, &scales, &positions).ok());
   EXPECT_TRUE(positions.empty()) << "no positions in the file: none read";
 }

@@ -1,10 +1,18 @@
 #include "tests/testing/synth_dataset.h"
 
 #include <cstdlib>
+#include <filesystem>
+#include <system_error>
+#include <vector>
 
 #include "src/core/file_util.h"
+#include "src/geometry/material.h"
+#include "src/geometry/mesh.h"
 #include "src/image/image_io.h"
 #include "src/io/dataset.h"
+#include "src/io/scene_setup.h"
+#include "src/render/render.h"
+#include "src/render/scene.h"
 #include "tests/testing/temp_dir.h"
 
 namespace sft {
@@ -16,6 +24,44 @@ std::string SynthIcosphere(const std::string& dir, const std::string& args) {
                                   "/meshes/icosphere_r1_320f.obj --out " + dir + " " + args,
                               &output);
   return code == 0 ? std::string() : "sft synth failed (" + std::to_string(code) + "): " + output;
+}
+
+std::string RelightDataset(const std::string& from, const std::string& to,
+                           const std::function<void(Dataset*)>& relight) {
+  Dataset dataset;
+  TriMesh mesh;
+  Material truth;
+  Status status = ReadDataset(from, &dataset);
+  if (status.ok()) status = ReadMesh(JoinPath(from, "gt/mesh.ply"), &mesh);
+  if (status.ok()) status = LoadMaterial(JoinPath(from, "gt/material.json"), mesh, &truth);
+  if (status.ok()) status = MakeDirectories(JoinPath(to, "images"));
+  if (status.ok()) status = MakeDirectories(JoinPath(to, "masks"));
+  if (!status.ok()) return status.message();
+  std::error_code error;
+  std::filesystem::copy(JoinPath(from, "gt"), JoinPath(to, "gt"),
+                        std::filesystem::copy_options::recursive, error);
+  if (error) return error.message();
+  relight(&dataset);
+  DatasetViews views;
+  status = MakeDatasetViews(dataset, &views);
+  if (!status.ok()) return status.message();
+  std::vector<Eigen::Vector3d> positions;
+  std::vector<Eigen::Vector3i> faces;
+  MeshToArrays(mesh, &positions, &faces);
+  const RenderScene scene(positions, faces);
+  RenderOptions render;
+  render.spp = 64;
+  render.bounces = 1;
+  render.shading = Shading::kFlat;
+  for (size_t v = 0; v < dataset.views.size() && status.ok(); ++v) {
+    Image image, mask;
+    RenderView(scene, truth, views.views[v], render, &image);
+    status = WriteImage(JoinPath(to, dataset.views[v].image), image);
+    if (status.ok()) status = LoadViewMask(dataset, static_cast<int>(v), &mask);
+    if (status.ok()) status = WritePng(JoinPath(to, dataset.views[v].mask), mask, /*srgb=*/false);
+  }
+  if (status.ok()) status = WriteSceneJson(dataset, to);
+  return status.message();
 }
 
 std::string CorruptMask(const std::string& dir, int view, bool hole) {

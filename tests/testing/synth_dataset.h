@@ -2,7 +2,10 @@
 #ifndef SFT_TESTS_TESTING_SYNTH_DATASET_H_
 #define SFT_TESTS_TESTING_SYNTH_DATASET_H_
 
+#include <functional>
 #include <string>
+
+#include "src/io/dataset.h"
 
 namespace sft {
 namespace testing {
@@ -15,6 +18,13 @@ std::string SynthIcosphere(const std::string& dir, const std::string& args);
 // of the image's size becomes background (carving would cut a tunnel through the hull); without,
 // every pixel does (an empty mask, which carving refuses). Returns "" on success, else the error.
 std::string CorruptMask(const std::string& dir, int view, bool hole);
+
+// Copies the dataset at `from` (with its gt/ folder) to `to` with its lights changed by
+// `relight`, its images rendered anew by sft's renderer from gt/mesh.ply and gt/material.json
+// (64 spp, one segment, flat shading, as `sft synth` renders) and its masks rewritten. Returns ""
+// on success, else the error.
+std::string RelightDataset(const std::string& from, const std::string& to,
+                           const std::function<void(Dataset*)>& relight);
 
 }  // namespace testing
 }  // namespace sft

@@ -106,6 +106,27 @@ void AddPointLights(const Context& ctx, const PathVertex& v, PathState* state) {
   }
 }
 
+void AddDirectionalLights(const Context& ctx, const PathVertex& v, PathState* state) {
+  for (const DirectionalLight& light : ctx.view.directional_lights) {
+    PointLightSample ls;
+    if (!SampleDirectionalLightVisible(ctx, light, v.sp.p, v.sp.n, v.sp.wo, v.surface.params,
+                                       v.offset, ctx.options.effects.shadows,
+                                       /*skip_black=*/state->path == nullptr, state->stats, &ls)) {
+      continue;
+    }
+    LightTerm term;
+    term.q = light.irradiance;
+    term.c = ls.cos_i;
+    term.dc_dn = ls.wi;
+    if (state->path != nullptr && ctx.request->params.light_directions &&
+        ctx.layout->FitsLightDirection(light.light_index)) {
+      term.direction_param = ctx.layout->LightDirectionOffset() + 3 * light.light_index;
+      term.d_direction_d_param = LightDirectionJacobian(ctx.view, light);
+    }
+    Contribute(v, ls.wi, ls.f, term, light.light_index, state);
+  }
+}
+
 // Fills `term`'s fitted-environment texels along wi when the path takes derivatives of them:
 // `factor` multiplies the map's radiance in term.q (light scale, MIS weight, 1/pdf).
 void SetEnvironmentTexels(const Context& ctx, const Eigen::Vector3d& wi, double factor,
@@ -152,11 +173,12 @@ void AddEnvironmentLight(const Context& ctx, const PathVertex& v, Sampler* sampl
   Contribute(v, wi, f, term, ctx.view.environment_light_index, state);
 }
 
-// Light reaching v directly (when it counts there): the point lights and a light-sampled
-// environment direction.
+// Light reaching v directly (when it counts there): the point and directional lights and a
+// light-sampled environment direction.
 void AddDirectLight(const Context& ctx, const PathVertex& v, Sampler* sampler, PathState* state) {
   if (!v.lit) return;
   AddPointLights(ctx, v, state);
+  AddDirectionalLights(ctx, v, state);
   if (ctx.environment != nullptr) AddEnvironmentLight(ctx, v, sampler, state);
 }
 
@@ -381,24 +403,75 @@ bool SamplePointLightVisible(const Context& ctx, const PointLight& light, int fa
   return !ctx.scene.Occluded(p, sample->wi, offset, sample->dist - offset);
 }
 
-bool DirectAtReceiver(const Context& ctx, const PointLight& light, const Eigen::Vector3d& origin,
-                      const Eigen::Vector3d& dir, double t_near, int receiver, RenderStats* stats,
-                      Eigen::Vector3d* radiance) {
+bool SampleDirectionalLightVisible(const Context& ctx, const DirectionalLight& light,
+                                   const Eigen::Vector3d& p, const Eigen::Vector3d& n,
+                                   const Eigen::Vector3d& wo, const BsdfParams& params,
+                                   double offset, bool shadows, bool skip_black, RenderStats* stats,
+                                   PointLightSample* sample) {
+  sample->wi = -light.direction;
+  sample->dist = kInfinity;
+  sample->cos_i = n.dot(sample->wi);
+  if (!(sample->cos_i > 0.0)) return false;
+  sample->f = EvalBsdf(params, n, wo, sample->wi);
+  if (skip_black && sample->f.isZero()) return false;
+  if (!shadows) return true;
+  ++stats->shadow_rays;
+  return !ctx.scene.Occluded(p, sample->wi, offset, kInfinity);
+}
+
+namespace {
+
+// The first hit of the ray from `origin` along `dir` (from t_near on), shaded, with its material
+// and ray offset.
+struct Receiver {
+  int face = -1;
+  ShadingPoint sp;
+  BsdfParams params;
+  double offset = 0.0;
+};
+
+// False when the first hit is not on face `receiver`. A degenerate face has n = 0, so light
+// samples fail there.
+bool ShadeReceiver(const Context& ctx, const Eigen::Vector3d& origin, const Eigen::Vector3d& dir,
+                   double t_near, int receiver, RenderStats* stats, Receiver* out) {
   const RayHit hit = ctx.scene.Intersect(origin, dir, t_near, kInfinity);
   ++stats->bounce_rays;
   if (!hit.hit || hit.face != receiver) return false;
+  Shade(ctx, dir, hit, &out->sp);
+  out->params = LookUpMaterial(ctx, ctx.material, hit.face, hit.u, hit.v).params;
+  out->face = hit.face;
+  out->offset = RayOffset(ctx, hit.face, out->sp.p);
+  return true;
+}
+
+}  // namespace
+
+bool DirectAtReceiver(const Context& ctx, const PointLight& light, const Eigen::Vector3d& origin,
+                      const Eigen::Vector3d& dir, double t_near, int receiver, RenderStats* stats,
+                      Eigen::Vector3d* radiance) {
+  Receiver r;
+  if (!ShadeReceiver(ctx, origin, dir, t_near, receiver, stats, &r)) return false;
   radiance->setZero();
-  ShadingPoint sp;
-  Shade(ctx, dir, hit, &sp);  // a degenerate face has n = 0: the light sample fails below.
-  const BsdfParams params = LookUpMaterial(ctx, ctx.material, hit.face, hit.u, hit.v).params;
   PointLightSample ls;
-  if (!SamplePointLightVisible(ctx, light, hit.face, sp.p, sp.n, sp.wo, params,
-                               RayOffset(ctx, hit.face, sp.p), /*shadows=*/true,
-                               /*skip_black=*/false, stats, &ls)) {
-    return true;
+  if (SamplePointLightVisible(ctx, light, r.face, r.sp.p, r.sp.n, r.sp.wo, r.params, r.offset,
+                              /*shadows=*/true, /*skip_black=*/false, stats, &ls)) {
+    const LightTerm term = PointLightTerm(ls, light, r.sp.n, /*derivatives=*/false);
+    *radiance = ls.f.cwiseProduct(term.q) * term.c;
   }
-  const LightTerm term = PointLightTerm(ls, light, sp.n, /*derivatives=*/false);
-  *radiance = ls.f.cwiseProduct(term.q) * term.c;
+  return true;
+}
+
+bool DirectAtReceiver(const Context& ctx, const DirectionalLight& light,
+                      const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, double t_near,
+                      int receiver, RenderStats* stats, Eigen::Vector3d* radiance) {
+  Receiver r;
+  if (!ShadeReceiver(ctx, origin, dir, t_near, receiver, stats, &r)) return false;
+  radiance->setZero();
+  PointLightSample ls;
+  if (SampleDirectionalLightVisible(ctx, light, r.sp.p, r.sp.n, r.sp.wo, r.params, r.offset,
+                                    /*shadows=*/true, /*skip_black=*/false, stats, &ls)) {
+    *radiance = ls.f.cwiseProduct(light.irradiance) * ls.cos_i;
+  }
   return true;
 }
 

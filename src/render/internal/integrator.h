@@ -1,6 +1,6 @@
-// Internal to src/render: the path tracer of one camera sample — next-event estimation to point and
-// environment lights, BSDF sampling with multiple importance sampling (power heuristic) against the
-// environment — and the auxiliary first-hit passes.
+// Internal to src/render: the path tracer of one camera sample — next-event estimation to point,
+// directional and environment lights, BSDF sampling with multiple importance sampling (power
+// heuristic) against the environment — and the auxiliary first-hit passes.
 #ifndef SFT_RENDER_INTERNAL_INTEGRATOR_H_
 #define SFT_RENDER_INTERNAL_INTEGRATOR_H_
 
@@ -37,12 +37,25 @@ bool SamplePointLightVisible(const Context& ctx, const PointLight& light, int fa
                              bool shadows, bool skip_black, RenderStats* stats,
                              PointLightSample* sample);
 
+// Directional light `light`'s next-event sample at p (as SamplePointLightVisible; dist = ∞ is
+// not used): false when the light is below the surface, f = 0 and `skip_black`, or (with
+// `shadows`) the shadow ray towards the light, to infinity, is blocked.
+bool SampleDirectionalLightVisible(const Context& ctx, const DirectionalLight& light,
+                                   const Eigen::Vector3d& p, const Eigen::Vector3d& n,
+                                   const Eigen::Vector3d& wo, const BsdfParams& params,
+                                   double offset, bool shadows, bool skip_black, RenderStats* stats,
+                                   PointLightSample* sample);
+
 // The direct term of point light `light`, shadow ray included, at the first hit of the ray from
 // `origin` along the unit direction `dir` (from t_near `t_near` on), as TraceRadiance computes
 // it there. False when that hit is not on face `receiver`.
 bool DirectAtReceiver(const Context& ctx, const PointLight& light, const Eigen::Vector3d& origin,
                       const Eigen::Vector3d& dir, double t_near, int receiver, RenderStats* stats,
                       Eigen::Vector3d* radiance);
+// The same for directional light `light`.
+bool DirectAtReceiver(const Context& ctx, const DirectionalLight& light,
+                      const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, double t_near,
+                      int receiver, RenderStats* stats, Eigen::Vector3d* radiance);
 
 // Radiance along the camera ray with direction `dir` whose first intersection is `hit` (traced
 // by the caller, in packets). When `path` is non-null (its Reset called by the caller), the

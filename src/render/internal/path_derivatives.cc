@@ -47,12 +47,19 @@ void PathDerivatives::AddContribution(const Eigen::Vector3d& prefix, const Surfa
     AddEnvironmentTexels(light.env_texel, light.env_weight, light.env_count, base);
   }
   const bool light_position = light.follows_point && light.position_param >= 0;
-  if (!vertices_ && !light_position) return;
+  const bool light_direction = light.direction_param >= 0;
+  if (!vertices_ && !light_position && !light_direction) return;
   // ∂(f ⊙ q·c) = (f ⊙ q)·∂c + c·q·∂g, g the glossy term (the diffuse term is constant).
   Eigen::Vector3d dg_dn, dg_dwi;
   EvalGlossyWithGradient(surface.params, n, wo, wi, &dg_dn, &dg_dwi);
   const Eigen::Vector3d base = prefix.cwiseProduct(light.q);
   const Eigen::Vector3d base_f = base.cwiseProduct(f);
+  if (light_direction) {
+    // c = n·wi and g(wi) with wi = −d: ∂/∂d = −(base_f·nᵀ + c·base·∂g/∂wiᵀ).
+    const Eigen::Matrix3d d_wi = base_f * n.transpose() + light.c * base * dg_dwi.transpose();
+    const Eigen::Matrix3d g = -d_wi * light.d_direction_d_param;
+    for (int k = 0; k < 3; ++k) Emit(light.direction_param + k, g.col(k));
+  }
   if (light.follows_point) {
     // ∂/∂x of the contribution at this vertex (rows: channels), x moving alone.
     const Eigen::Matrix3d d_x =

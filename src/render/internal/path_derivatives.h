@@ -117,7 +117,8 @@ class RowAccumulator : public ParamSums<Eigen::Vector3d> {
 
 // The light term Q of a contribution, split as Q = q·c with c the part that depends on the
 // geometry of the shading point: point light q = I, c = (n·wi)/d² (wi and d follow the point x);
-// environment (light- or BSDF-sampled, direction fixed) q = L·scale·w_MIS/pdf, c = n·wi.
+// directional light q = E, c = n·wi (wi fixed); environment (light- or BSDF-sampled, direction
+// fixed) q = L·scale·w_MIS/pdf, c = n·wi.
 struct LightTerm {
   Eigen::Vector3d q;
   double c = 0.0;
@@ -130,6 +131,11 @@ struct LightTerm {
   // camera) for a camera-frame one. c and wi depend on L − x only, so ∂/∂L = −∂/∂x.
   int position_param = -1;
   Eigen::Matrix3d d_light_d_param = Eigen::Matrix3d::Identity();
+  // A directional light whose direction is a parameter (ParameterLayout::FitsLightDirection): the
+  // first of its three parameters and ∂d/∂(parameters) (LightDirectionJacobian); wi = −d, and c
+  // = n·wi and the BSDF depend on it.
+  int direction_param = -1;
+  Eigen::Matrix3d d_direction_d_param = Eigen::Matrix3d::Zero();
   // A fitted environment's term (ParameterLayout::FitsEnvironment): q's channel c is
   // Σ_k env_weight[k]·T_kc over the env_count texels T_k it blends, so ∂q_c/∂T_kc = env_weight[k]
   // (the bilinear weight times the map's and the light's scales, the MIS weight and 1/pdf).

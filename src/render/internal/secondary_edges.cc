@@ -310,8 +310,8 @@ void SampleTexelBoundary(const SecondaryVertex& v, Sampler* texel_sampler, PathD
                     -m_row);
 }
 
-// (B) Point-light shadow boundaries on the surfaces a further bounce sees: a light uniformly
-// (u_light), then one of its pool's shadow points by resampled importance sampling:
+// (B) Point- and directional-light shadow boundaries on the surfaces a further bounce sees: a light
+// uniformly (u_light), then one of its pool's shadow points by resampled importance sampling:
 // kShadowPoolCandidates entries drawn uniformly, target p̂ = Σ_rgb f·(n·ω)·|dω/ds|/p (the
 // integrand's geometry: the jump is left out), one kept ∝ p̂. The estimate of the pool's sum
 // over entries, F_kept/p̂_kept·(1/K)Σ_k p̂_k·n, divided by the pool's attempts, is unbiased for
@@ -360,41 +360,50 @@ void SampleShadowBoundary(const SecondaryVertex& v, double u_light, Sampler* sam
           v, p.y - v.x, [&](const Eigen::Matrix3d& t) { return (t * p.dy_ds).eval(); }, &point)) {
     return;
   }
-  const PointLight& light = v.ctx.view.point_lights[l];
-  Eigen::Vector3d direct[2];
-  for (int k = 0; k < 2; ++k) {
-    if (!DirectAtReceiver(v.ctx, light, v.x, point.sides[k], v.offset, e.shadow.receiver, stats,
-                          &direct[k])) {
-      return;
+  const size_t num_point = v.ctx.view.point_lights.size();
+  // The pools are the point lights' and then the directional lights'.
+  const auto finish = [&](const auto& light) {
+    Eigen::Vector3d direct[2];
+    for (int k = 0; k < 2; ++k) {
+      if (!DirectAtReceiver(v.ctx, light, v.x, point.sides[k], v.offset, e.shadow.receiver, stats,
+                            &direct[k])) {
+        return;
+      }
     }
+    const Eigen::Vector3d jump =
+        v.Integrand(point.sides[0], direct[0]) - v.Integrand(point.sides[1], direct[1]);
+    if (jump.isZero()) return;
+    // F/p̂ = jump·speed·(1/p)/p̂, times (1/K)Σ p̂_k·n, over the attempts, lights and samples.
+    const double resampling = w_sum * n / (kept_target * kShadowPoolCandidates);
+    const double weight = point.speed * p.inverse_probability * resampling * num_lights /
+                          (static_cast<double>(pool.attempts) * v.num_samples);
+    const Eigen::Vector3d m_row = point.m / point.r;
+    BoundaryRows rows;
+    if (secondary.vertices) ShadowPointRows(e.shadow, scene, edge, e.s, m_row, &rows);
+    // The light's parameters move y too (∂y/∂light, shadow_edges.h).
+    Eigen::Matrix3d d_light_d_param;
+    const int light_param = LightShadowParams(v.ctx, light, &d_light_d_param);
+    if (light_param >= 0) {
+      rows.light_param = light_param;
+      rows.light_row = (e.shadow.d_y_d_light * d_light_d_param).transpose() * m_row;
+    }
+    path->AddBoundary(v.throughput.cwiseProduct(jump) * weight, rows.vertices, rows.rows,
+                      rows.count, -m_row, rows.light_param, rows.light_row);
+  };
+  if (static_cast<size_t>(l) < num_point) {
+    finish(v.ctx.view.point_lights[l]);
+  } else {
+    finish(v.ctx.view.directional_lights[l - num_point]);
   }
-  const Eigen::Vector3d jump =
-      v.Integrand(point.sides[0], direct[0]) - v.Integrand(point.sides[1], direct[1]);
-  if (jump.isZero()) return;
-  // F/p̂ = jump·speed·(1/p)/p̂, times (1/K)Σ p̂_k·n, over the attempts, lights and samples.
-  const double resampling = w_sum * n / (kept_target * kShadowPoolCandidates);
-  const double weight = point.speed * p.inverse_probability * resampling * num_lights /
-                        (static_cast<double>(pool.attempts) * v.num_samples);
-  const Eigen::Vector3d m_row = point.m / point.r;
-  BoundaryRows rows;
-  if (secondary.vertices) ShadowPointRows(e.shadow, scene, edge, e.s, m_row, &rows);
-  // The light's position parameters move y too (∂y/∂light, shadow_edges.h).
-  if (v.ctx.request->params.light_positions && v.ctx.layout->FitsLightPosition(light.light_index)) {
-    rows.light_param = v.ctx.layout->LightPositionOffset() + 3 * light.light_index;
-    rows.light_row =
-        (e.shadow.d_y_d_light * LightPositionJacobian(v.ctx.view, light)).transpose() * m_row;
-  }
-  path->AddBoundary(v.throughput.cwiseProduct(jump) * weight, rows.vertices, rows.rows, rows.count,
-                    -m_row, rows.light_param, rows.light_row);
 }
 
-// The shadow pool of the light at `light` (ShadowPool), drawn with `pool_sampler`; rays counted
-// in *stats.
-ShadowPool BuildShadowPool(const RenderScene& scene, const Eigen::Vector3d& light, int64_t attempts,
+// The shadow pool of `light` (ShadowPool; a PointLight or a DirectionalLight), drawn with
+// `pool_sampler`; rays counted in *stats.
+template <typename Light>
+ShadowPool BuildShadowPool(const RenderScene& scene, const Light& light, int64_t attempts,
                            const Sampler& pool_sampler, RenderStats* stats) {
   ShadowPool pool;
-  const std::shared_ptr<const std::vector<EdgeCandidate>> shared =
-      ShadowEdgeCandidates(scene, light);
+  const std::shared_ptr<const std::vector<EdgeCandidate>> shared = LightCandidates(scene, light);
   const std::vector<EdgeCandidate>& candidates = *shared;
   std::vector<double> angles;
   for (const EdgeCandidate& c : candidates) angles.push_back(c.weight);
@@ -409,7 +418,7 @@ ShadowPool BuildShadowPool(const RenderScene& scene, const Eigen::Vector3d& ligh
     e.edge = candidates[c].edge;
     e.s = sampler.Next1D();
     const MeshEdge& edge = scene.edges()[e.edge];
-    if (!CastShadowPoint(scene, light, edge, e.s, stats, &e.shadow)) continue;
+    if (!CastLightShadow(scene, light, edge, e.s, stats, &e.shadow)) continue;
     ShadowPoolPoint p;
     p.y = e.shadow.y;
     p.dy_ds = e.shadow.d_y_d_point * (scene.positions()[edge.v1] - scene.positions()[edge.v0]);
@@ -441,10 +450,16 @@ SecondaryEdges BuildSecondaryEdges(const RenderScene& scene, const Material& mat
     const int64_t attempts = std::clamp<int64_t>(
         static_cast<int64_t>(std::ceil(expected * kShadowPoolAttemptsPerSample)),
         kMinShadowPoolAttempts, kMaxShadowPoolAttempts);
-    for (size_t l = 0; l < view.point_lights.size(); ++l) {
+    const size_t num_point = view.point_lights.size();
+    for (size_t l = 0; l < num_point; ++l) {
       const Sampler pool_sampler(options.seed, view.view_index, kShadowPoolKey + l, 0);
       out.shadow_pools.push_back(
-          BuildShadowPool(scene, view.point_lights[l].position, attempts, pool_sampler, stats));
+          BuildShadowPool(scene, view.point_lights[l], attempts, pool_sampler, stats));
+    }
+    for (size_t l = 0; l < view.directional_lights.size(); ++l) {
+      const Sampler pool_sampler(options.seed, view.view_index, kShadowPoolKey + num_point + l, 0);
+      out.shadow_pools.push_back(
+          BuildShadowPool(scene, view.directional_lights[l], attempts, pool_sampler, stats));
     }
   }
   return out;

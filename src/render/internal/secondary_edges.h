@@ -79,7 +79,8 @@ struct SecondaryTexels {
 // The candidates of one view's secondary edge samples.
 struct SecondaryEdges {
   // Whether vertex derivatives are requested: without them only the (B) samples run, for the
-  // point lights' position parameters (their shadow boundaries move with the light).
+  // point lights' positions and directional lights' directions (their shadow boundaries move
+  // with the light).
   bool vertices = true;
   // Mesh edges where radiance can jump for some viewpoint (per mesh state).
   std::shared_ptr<const MeshEdgeTable> mesh_edges;
@@ -87,8 +88,9 @@ struct SecondaryEdges {
   // Texel boundaries (when a further bounce is traced and the material has any), per mesh
   // state and material (shared by every view).
   std::shared_ptr<const SecondaryTexels> texels;
-  // Per point light of the view (when shadows and a further bounce exist): shadow points its
-  // silhouette edges cast, drawn once per view (ShadowPool) and shared by the view's (B) samples.
+  // Per point light of the view, then per directional light (when shadows and a further bounce
+  // exist): shadow points its silhouette edges cast, drawn once per view (ShadowPool) and shared
+  // by the view's (B) samples.
   std::vector<ShadowPool> shadow_pools;
 };
 
