@@ -222,9 +222,9 @@ TEST(ReconstructCliTest, UnknownLightingStartsWithTheEnvironmentStage) {
       1);
   EXPECT_THAT(out, HasSubstr("environment_stage/environment_size"));
   // The run fitted a world-fixed map; a resume keeps that frame (the same frame is accepted).
-  EXPECT_EQ(RunSft("reconstruct --quiet --resume " + tmp.Join("o") + " --environment-frame camera",
-                   &out),
-            1);
+  EXPECT_EQ(
+      RunSft("reconstruct --quiet --resume " + tmp.Join("o") + " --environment-frame camera", &out),
+      1);
   EXPECT_THAT(out, HasSubstr("environment_frame camera: the run in " + tmp.Join("o") +
                              " fits a world-fixed environment"));
   EXPECT_EQ(CountLines(out), 1) << out;
