@@ -89,16 +89,17 @@ Status ScoreCell(const SweepContext& context, const std::string& dir, const std:
 }
 
 // Runs the schedule of `stages` in `dir`; *seconds is its wall time, *ended_by why it stopped.
-Status Reconstruct(const SweepContext& context, const std::vector<StageOptions>& stages,
-                   const std::string& dir, const CellCallbacks& callbacks, json* line,
-                   bool* interrupted) {
+Status Reconstruct(const SweepContext& context, const CellStart& start,
+                   const std::vector<StageOptions>& stages, const std::string& dir,
+                   const CellCallbacks& callbacks, json* line, bool* interrupted) {
   const json run_info = {{"dataset", context.grid->dataset},
-                         {"start", context.start.Describe()},
-                         {"init", context.start.path},
+                         {"start", start.choice.Describe()},
+                         {"init", start.choice.path},
+                         {"material", start.material},
                          {"sweep_cell", (*line)["id"]}};
   std::unique_ptr<Schedule> schedule;
   SFT_RETURN_IF_ERROR(
-      Schedule::Start(context.dataset, dir, stages, context.start_state, run_info, &schedule));
+      Schedule::Start(context.dataset, dir, stages, start.state, run_info, &schedule));
   const double budget = context.grid->time_budget;
   bool budget_spent = false;
   ScheduleCallbacks hooks;
@@ -125,6 +126,45 @@ Status Reconstruct(const SweepContext& context, const std::vector<StageOptions>&
 }
 
 }  // namespace
+
+Status LoadCellStart(const SweepContext& context, const SweepCell& cell, CellStart* start) {
+  const SweepGrid& grid = *context.grid;
+  start->choice = context.start;
+  start->material = grid.material;
+  if (cell.init.empty() && cell.material.empty()) {
+    start->state = context.start_state;
+    return Status::Ok();
+  }
+  if (cell.init == "reference") {
+    if (grid.reference.empty()) {
+      return Status::Error("init \"reference\": the grid gives no reference mesh");
+    }
+    SFT_RETURN_IF_ERROR(ChooseStart(context.dataset, grid.reference, &start->choice));
+    SFT_RETURN_IF_ERROR(ReadMesh(grid.reference, &start->state.mesh));
+  } else if (!cell.init.empty()) {
+    SFT_RETURN_IF_ERROR(ChooseStart(context.dataset, cell.init, &start->choice));
+    SFT_RETURN_IF_ERROR(ReadMesh(cell.init, &start->state.mesh));
+  } else {
+    start->state.mesh = context.start_state.mesh;
+  }
+  if (cell.material == "grey") {
+    start->material.clear();
+  } else if (cell.material == "ground_truth") {
+    const json& gt = context.dataset.ground_truth;
+    std::string why;
+    if (!gt.is_object() || !gt.contains("material") || !gt["material"].is_string() ||
+        !IsContainedRelativePath(gt["material"].get<std::string>(), &why)) {
+      return Status::Error(
+          "material \"ground_truth\": " + JoinPath(context.dataset.root, "scene.json") +
+          " has no ground_truth.material inside the dataset");
+    }
+    start->material = JoinPath(context.dataset.root, gt["material"].get<std::string>());
+  } else if (!cell.material.empty()) {
+    start->material = cell.material;
+  }
+  return LoadMaterial(start->material.empty() ? kInitialMaterial : start->material,
+                      start->state.mesh, &start->state.material);
+}
 
 Status LoadSweepContext(const SweepGrid& grid, SweepContext* context) {
   context->grid = &grid;
@@ -156,7 +196,9 @@ Status CellStages(const SweepContext& context, const SweepCell& cell,
         EvenlySpacedViews(cell.views, static_cast<int>(context.dataset.views.size()), &views));
     SFT_RETURN_IF_ERROR(MergeScheduleConfig({{"views", views}}, "axes", &config));
   }
-  return ResolveStages(config, context.start.kind == StartKind::kCarved, stages);
+  // A cell with its own start mesh is never carved.
+  const bool carved = cell.init.empty() && context.start.kind == StartKind::kCarved;
+  return ResolveStages(config, carved, stages);
 }
 
 bool IsDefaultStages(const SweepContext& context, const std::vector<StageOptions>& stages) {
@@ -173,11 +215,14 @@ Status RunCell(const SweepContext& context, const SweepCell& cell, const std::st
     (*line)["error"] = status.message();
     return Status::Ok();
   };
+  CellStart start;
+  Status status = LoadCellStart(context, cell, &start);
+  if (!status.ok()) return fail(status.Prefixed("start"));
   std::vector<StageOptions> stages;
-  Status status = CellStages(context, cell, &stages);
+  status = CellStages(context, cell, &stages);
   if (!status.ok()) return fail(status);
   (*line)["default"] = IsDefaultStages(context, stages);
-  status = Reconstruct(context, stages, dir, callbacks, line, interrupted);
+  status = Reconstruct(context, start, stages, dir, callbacks, line, interrupted);
   if (*interrupted) return Status::Ok();
   if (!status.ok()) return fail(status);
   std::vector<int> views;
@@ -185,10 +230,10 @@ Status RunCell(const SweepContext& context, const SweepCell& cell, const std::st
       SelectViews(stages.back().fit.views, static_cast<int>(context.dataset.views.size()), &views);
   if (!status.ok()) return fail(status);
   (*line)["views"] = views.size();
-  const double start = NowSeconds();
+  const double scoring_start = NowSeconds();
   status = ScoreCell(context, dir, views, line);
   if (!status.ok()) return fail(status.Prefixed("scoring"));
-  (*line)["eval_seconds"] = NowSeconds() - start;
+  (*line)["eval_seconds"] = NowSeconds() - scoring_start;
   (*line)["status"] = "ok";
   return Status::Ok();
 }

@@ -34,6 +34,18 @@ struct SweepContext {
 // and the dataset none), and the base stages.
 Status LoadSweepContext(const SweepGrid& grid, SweepContext* context);
 
+// What a cell starts from: the context's start, or the mesh and material its axis values name
+// (SweepCell::init, material).
+struct CellStart {
+  StartChoice choice;
+  std::string material;  // the initial material as loaded (file or inline JSON); "" = grey.
+  ScheduleStart state;   // the start mesh and initial material.
+};
+
+// Loads the cell's start. Errors (the cell's): "reference" without a grid reference, a
+// "ground_truth" material the dataset does not name, a mesh or material that does not load.
+Status LoadCellStart(const SweepContext& context, const SweepCell& cell, CellStart* start);
+
 // The cell's stages: the base config, the grid's outer_iterations (or 10000 with a time budget
 // and none given), the cell's keys, its evenly spaced views. Errors are the cell's (recorded,
 // the sweep goes on): a key the configuration rejects, more views than the dataset has.

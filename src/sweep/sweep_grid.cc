@@ -31,9 +31,16 @@ const std::map<std::string, std::string>& IdPrefixes() {
   return prefixes;
 }
 
-// The ablations of the research report (docs/cli.md, "--preset ablations").
+// The ablations of the research report (docs/cli.md, "--preset ablations"). One Adam stage as
+// the large_steps geometry stages run it (docs/reconstruct.md), so that a cell spends its budget
+// on one fit. Geometry cells start from the grid's init and hold the dataset's true material;
+// texture cells fit from the default grey start on the reference mesh: each phase is measured on
+// what it fits.
 const char kAblationsPreset[] = R"({
-  "config": {"spp": 16},
+  "config": {"spp": 16, "stages": [{"name": "fit", "solver": "adam", "image_scale": 1,
+    "pyramid_levels": 3, "steps": 25, "adam_lr_vertices": 0.001, "adam_large_steps": 25,
+    "adam_uniform": true, "adam_resample": true, "adam_views_per_step": 8,
+    "independent_gradient": true, "image_loss": "relative", "fit_specular": true}]},
   "time_budget": 300,
   "axes": {
     "variant": [
@@ -41,7 +48,8 @@ const char kAblationsPreset[] = R"({
       {"name": "local+shadows",
        "config": {"bounces": 1, "effects": "direct,shadows,specular,environment"}},
       {"name": "global", "config": {"bounces": 2, "effects": "all"}}],
-    "phases": ["geometry", "texture"],
+    "phases": [{"name": "geometry", "material": "ground_truth"},
+               {"name": "texture", "init": "reference", "material": "grey"}],
     "views": [8, 16, 32, 64]
   }
 })";
@@ -109,26 +117,59 @@ Status ParseEval(const json& v, const std::string& where, SweepEvalOptions* eval
   return Status::Ok();
 }
 
-// One axis value: a number or string (views: a positive integer; variant: {"name", "config"}).
-Status ParseAxisValue(const std::string& axis, const json& v, const std::string& where,
-                      SweepAxisValue* out) {
-  out->value = v;
-  if (axis == "variant") {
-    if (!v.is_object())
-      return Status::Error(where + ": expected {\"name\": ..., \"config\": {...}}");
-    for (const auto& [key, value] : v.items()) {
-      if (key != "name" && key != "config") {
-        return Status::Error(where + "." + key + ": unknown key (expected name and config)");
-      }
+// The start keys of an object value: "init" (a mesh file or "reference") and "material" (a
+// file, inline JSON, "ground_truth" or "grey"); files are resolved against base_dir.
+Status ParseValueStart(const json& v, const std::string& where, const std::string& base_dir,
+                       SweepAxisValue* out) {
+  if (v.contains("init")) {
+    SFT_RETURN_IF_ERROR(ParseString(v["init"], where + ".init", &out->init));
+    if (out->init != "reference") out->init = AbsolutePath(base_dir, out->init);
+  }
+  if (v.contains("material")) {
+    SFT_RETURN_IF_ERROR(ParseString(v["material"], where + ".material", &out->material));
+    const std::string& m = out->material;
+    if (m != "ground_truth" && m != "grey" && m[0] != '{') {
+      out->material = AbsolutePath(base_dir, m);
     }
-    if (!v.contains("name")) return Status::Error(where + ".name: missing");
-    SFT_RETURN_IF_ERROR(ParseString(v["name"], where + ".name", &out->label));
+  }
+  return Status::Ok();
+}
+
+// A variant ({"name", "config"}) or a phases value as an object ({"name"}), each with the
+// optional start keys.
+Status ParseObjectValue(const std::string& axis, const json& v, const std::string& where,
+                        const std::string& base_dir, SweepAxisValue* out) {
+  const bool variant = axis == "variant";
+  const char* expected = variant ? "name, config, init and material" : "name, init and material";
+  for (const auto& [key, value] : v.items()) {
+    if (key != "name" && key != "init" && key != "material" && !(variant && key == "config")) {
+      return Status::Error(where + "." + key + ": unknown key (expected " + expected + ")");
+    }
+  }
+  if (!v.contains("name")) return Status::Error(where + ".name: missing");
+  SFT_RETURN_IF_ERROR(ParseString(v["name"], where + ".name", &out->label));
+  out->value = v["name"];
+  if (variant) {
     if (!v.contains("config") || !v["config"].is_object()) {
       return Status::Error(where + ".config: expected a JSON object of reconstruct keys");
     }
     out->config = v["config"];
-    out->value = v["name"];
-    return Status::Ok();
+  } else {
+    out->config = {{axis, v["name"]}};
+  }
+  return ParseValueStart(v, where, base_dir, out);
+}
+
+// One axis value: a number or string (views: a positive integer; variant: {"name", "config"};
+// phases: a string or {"name", ...}).
+Status ParseAxisValue(const std::string& axis, const json& v, const std::string& where,
+                      const std::string& base_dir, SweepAxisValue* out) {
+  out->value = v;
+  if (axis == "variant" && !v.is_object()) {
+    return Status::Error(where + ": expected {\"name\": ..., \"config\": {...}}");
+  }
+  if ((axis == "variant" || axis == "phases") && v.is_object()) {
+    return ParseObjectValue(axis, v, where, base_dir, out);
   }
   if (axis == "views") {
     if (!v.is_number_integer() || v.get<int64_t>() < 1 || v.get<int64_t>() > 1000000) {
@@ -147,7 +188,8 @@ Status ParseAxisValue(const std::string& axis, const json& v, const std::string&
   return Status::Ok();
 }
 
-Status ParseAxes(const json& v, const std::string& where, std::vector<SweepAxis>* axes) {
+Status ParseAxes(const json& v, const std::string& where, const std::string& base_dir,
+                 std::vector<SweepAxis>* axes) {
   if (!v.is_object()) return Status::Error(where + ": expected a JSON object of axes");
   std::string known;
   for (const char* name : kSweepAxes) known += (known.empty() ? "" : ", ") + std::string(name);
@@ -168,7 +210,7 @@ Status ParseAxes(const json& v, const std::string& where, std::vector<SweepAxis>
     for (size_t k = 0; k < list.size(); ++k) {
       SweepAxisValue value;
       const std::string item = at + "[" + std::to_string(k) + "]";
-      SFT_RETURN_IF_ERROR(ParseAxisValue(name, list[k], item, &value));
+      SFT_RETURN_IF_ERROR(ParseAxisValue(name, list[k], item, base_dir, &value));
       if (!labels.insert(IdSafe(value.label)).second) {
         return Status::Error(item + ": \"" + value.label + "\" repeats a value of the axis");
       }
@@ -263,7 +305,7 @@ Status ParseSweepGrid(const json& grid, const std::string& source, const std::st
     } else if (key == "eval") {
       SFT_RETURN_IF_ERROR(ParseEval(value, where, &g.eval));
     } else if (key == "axes") {
-      SFT_RETURN_IF_ERROR(ParseAxes(value, where, &g.axes));
+      SFT_RETURN_IF_ERROR(ParseAxes(value, where, base_dir, &g.axes));
     } else {
       return Status::Error(source + ": " + key +
                            ": unknown key (expected dataset, init, material, reference, config, "
@@ -327,8 +369,14 @@ json SweepGridJson(const SweepGrid& grid) {
   for (const SweepAxis& axis : grid.axes) {
     json values = json::array();
     for (const SweepAxisValue& v : axis.values) {
-      values.push_back(axis.name == "variant" ? json{{"name", v.label}, {"config", v.config}}
-                                              : v.value);
+      json value = v.value;
+      if (axis.name == "variant") value = {{"name", v.label}, {"config", v.config}};
+      if (!v.init.empty() || !v.material.empty()) {
+        if (!value.is_object()) value = {{"name", v.label}};
+        if (!v.init.empty()) value["init"] = v.init;
+        if (!v.material.empty()) value["material"] = v.material;
+      }
+      values.push_back(value);
     }
     axes[axis.name] = values;
   }
@@ -366,6 +414,8 @@ std::vector<SweepCell> EnumerateCells(const SweepGrid& grid) {
       cell.settings[axis.name] = v.value;
       cell.config.update(v.config);
       if (axis.name == "views") cell.views = v.views;
+      if (!v.init.empty()) cell.init = v.init;
+      if (!v.material.empty()) cell.material = v.material;
       id += "_" + IdSafe(IdPrefixes().at(axis.name) + v.label);
     }
     cell.id = id;

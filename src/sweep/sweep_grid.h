@@ -7,7 +7,7 @@
 //    "eval": {"spp": 64, "bounces": 2, "f1_tolerance": 0.005, "mesh_samples": 200000},
 //    "axes": {"spp": [4, 16], "image_scale": [0.5, 1], "bounces": [1, 2, "auto"],
 //             "effects": ["all", "auto"], "solver": ["lm", "adam"], "views": [8, 16],
-//             "steps": [2, 5], "phases": ["texture", "geometry"],
+//             "steps": [2, 5], "phases": ["texture", {"name": "geometry", "material": "m.json"}],
 //             "variant": [{"name": "local", "config": {"bounces": 1}}]}}
 //
 // Relative paths are relative to the grid file's folder. Axis values of the reconstruct keys
@@ -15,6 +15,10 @@
 // configuration as they are ("effects": "auto" runs the effect planner): a value it rejects
 // (such as "bounces": "auto") makes that cell an error recorded in sweep.jsonl, and the sweep goes
 // on. `views` counts evenly spaced view indices; a `variant` sets several keys under one name.
+// A `variant` or `phases` value given as an object may also give its cells their own start:
+// "init" (a mesh file, or "reference": the grid's reference mesh) and "material" (a file, inline
+// JSON, "ground_truth": the dataset's ground_truth.material, or "grey": the default start), so
+// that a texture cell can start from the true shape and a geometry cell hold the true material.
 // Cells are the product of the axes in the order of kSweepAxes, the first outermost. A structural
 // error (unknown key, an axis that is not a non-empty array, a duplicate value, a bad variant) is
 // one line naming the field.
@@ -48,6 +52,11 @@ struct SweepAxisValue {
   nlohmann::json value;   // as given (a number or string; a variant's name).
   nlohmann::json config;  // the reconstruct keys it sets; views: {} (resolved per dataset).
   int views = 0;          // the views axis: how many evenly spaced views; 0 otherwise.
+  // The start of the value's cells (variant and phases objects); "" = the grid's. init: a mesh
+  // file (resolved) or "reference"; material: a file (resolved), inline JSON, "ground_truth" or
+  // "grey".
+  std::string init;
+  std::string material;
 };
 
 struct SweepAxis {
@@ -80,6 +89,9 @@ struct SweepCell {
   nlohmann::json settings = nlohmann::json::object();  // axis name -> value as given.
   nlohmann::json config = nlohmann::json::object();    // reconstruct keys of the axes (no views).
   int views = 0;  // evenly spaced views to fit; 0 = the config's (all by default).
+  // The cell's own start from its axis values (SweepAxisValue::init, material); "" = the grid's.
+  std::string init;
+  std::string material;
 };
 
 // Parses a grid object; `source` names the file in errors, relative paths are resolved against

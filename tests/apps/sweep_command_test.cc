@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "src/geometry/mesh.h"
 #include "tests/testing/synth_dataset.h"
 #include "tests/testing/temp_dir.h"
 
@@ -157,6 +158,65 @@ TEST_F(SweepCommandTest, ViewsAxisAndOuterIterations) {
   EXPECT_EQ(eval["views"], json::parse("[0, 2]"));
   EXPECT_EQ(nine["status"], "error");
   EXPECT_THAT(nine["error"].get<std::string>(), HasSubstr("9 views asked, the dataset has 4"));
+}
+
+// Phases values with a start of their own (what the ablations preset uses): the geometry cell
+// holds the dataset's true material, the texture cell fits on the reference mesh. A cell that
+// asks for a reference the grid lacks is the cell's error.
+TEST_F(SweepCommandTest, PhaseValuesStartWhereTheyAsk) {
+  const std::string phases = R"("axes": {"phases": [
+      {"name": "geometry", "material": "ground_truth"},
+      {"name": "texture", "init": "reference", "material": "grey"}]}})";
+  const std::string base = R"({"dataset": "ds", "init": "init.ply", "outer_iterations": 1,
+    "config": {"steps": 1, "spp": 2}, "eval": {"spp": 2, "bounces": 1, "mesh_samples": 1000},
+    )";
+  testing::WriteTestFile(tmp_.Join("grid.json"),
+                         base + R"("reference": "ds/gt/mesh.ply", )" + phases);
+  std::string out;
+  ASSERT_EQ(
+      RunSft("sweep --quiet --grid " + tmp_.Join("grid.json") + " --out " + tmp_.Join("o"), &out),
+      0)
+      << out;
+  const std::vector<std::string> lines = ReadLines(tmp_.Join("o/sweep.jsonl"));
+  ASSERT_EQ(lines.size(), 2u);
+  for (const std::string& line : lines) EXPECT_EQ(json::parse(line)["status"], "ok") << line;
+  // The geometry cell kept the true material (a geometry phase does not change it).
+  const json gt = json::parse(testing::ReadTestFile(tmp_.Join("ds/gt/material.json")));
+  const json held =
+      json::parse(testing::ReadTestFile(tmp_.Join("o/cells/00_geometry/material.json")));
+  EXPECT_EQ(testing::ReadTestFile(
+                tmp_.Join("o/cells/00_geometry/" + held["mesh_colors"].get<std::string>())),
+            testing::ReadTestFile(tmp_.Join("ds/gt/" + gt["mesh_colors"].get<std::string>())));
+  // The texture cell started from the reference mesh (a texture phase does not move it).
+  TriMesh reference, fitted, perturbed;
+  ASSERT_TRUE(ReadMesh(tmp_.Join("ds/gt/mesh.ply"), &reference).ok());
+  ASSERT_TRUE(ReadMesh(tmp_.Join("o/cells/01_texture/mesh.ply"), &fitted).ok());
+  ASSERT_TRUE(ReadMesh(tmp_.Join("init.ply"), &perturbed).ok());
+  auto max_distance = [&fitted](const TriMesh& other) {
+    EXPECT_EQ(other.n_vertices(), fitted.n_vertices());
+    double d = 0.0;
+    for (const auto& v : fitted.vertices()) {
+      d = std::max(d, (fitted.point(v) - other.point(v)).norm());
+    }
+    return d;
+  };
+  EXPECT_LT(max_distance(reference), 1e-6);
+  EXPECT_GT(max_distance(perturbed), 1e-3);
+  const json metrics =
+      json::parse(testing::ReadTestFile(tmp_.Join("o/cells/01_texture/metrics.json")));
+  EXPECT_EQ(metrics["init"], tmp_.Join("ds/gt/mesh.ply"));
+  EXPECT_EQ(metrics["material"], "");
+  // Without a reference the texture cell is an error line; the geometry cell still runs.
+  testing::WriteTestFile(tmp_.Join("noref.json"), base + phases);
+  ASSERT_EQ(
+      RunSft("sweep --quiet --grid " + tmp_.Join("noref.json") + " --out " + tmp_.Join("n"), &out),
+      0)
+      << out;
+  const std::vector<std::string> noref = ReadLines(tmp_.Join("n/sweep.jsonl"));
+  ASSERT_EQ(noref.size(), 2u);
+  EXPECT_EQ(json::parse(noref[0])["status"], "ok");
+  EXPECT_THAT(json::parse(noref[1])["error"].get<std::string>(),
+              HasSubstr("init \"reference\": the grid gives no reference mesh"));
 }
 
 TEST_F(SweepCommandTest, BadInputsAreOneLineAndWriteNothing) {

@@ -77,6 +77,11 @@ TEST(SweepGridTest, BadGridsAreOneLineNamingTheField) {
       {R"({"axes": {"variant": [{"config": {}}]}})", "axes.variant[0].name: missing"},
       {R"({"axes": {"variant": [{"name": "a", "config": {}, "x": 1}]}})", "axes.variant[0].x"},
       {R"({"axes": {"variant": ["local"]}})", "axes.variant[0]: expected {"},
+      {R"({"axes": {"phases": [{"name": "texture", "config": {}}]}})", "axes.phases[0].config"},
+      {R"({"axes": {"phases": [{"init": "a.ply"}]}})", "axes.phases[0].name: missing"},
+      {R"({"axes": {"phases": [{"name": "texture", "init": 3}]}})", "axes.phases[0].init"},
+      {R"({"axes": {"variant": [{"name": "a", "config": {}, "material": ""}]}})",
+       "axes.variant[0].material: expected a non-empty string"},
       {R"({"time_budget": -1})", "time_budget: expected seconds"},
       {R"({"time_budget": "60"})", "time_budget"},
       {R"({"outer_iterations": 0})", "outer_iterations: expected an integer"},
@@ -141,6 +146,38 @@ TEST(SweepGridTest, EnumeratesTheProductOfTheAxes) {
   EXPECT_EQ(EnumerateCells(single)[0].id, "00");
 }
 
+// Variant and phases values as objects give their cells a start of their own; files resolve
+// against the grid's folder, the words "reference", "ground_truth" and "grey" and inline JSON
+// stay; the grid's JSON form keeps them.
+TEST(SweepGridTest, ObjectValuesGiveTheirCellsAStart) {
+  SweepGrid grid;
+  ASSERT_TRUE(ParseSweepGrid(json::parse(R"({"dataset": "ds", "axes": {
+      "variant": [{"name": "a", "config": {"bounces": 1}, "init": "start.ply"},
+                  {"name": "b", "config": {}, "material": "{\"albedo\": [0.2, 0.2, 0.2]}"}],
+      "phases": [{"name": "geometry", "material": "ground_truth"},
+                 {"name": "texture", "init": "reference", "material": "grey"}, "both"]}})"),
+                             "g", "/grids", &grid)
+                  .ok());
+  const std::vector<SweepCell> cells = EnumerateCells(grid);
+  ASSERT_EQ(cells.size(), 6u);
+  EXPECT_EQ(cells[0].id, "00_a_geometry");
+  EXPECT_EQ(cells[0].init, "/grids/start.ply");
+  EXPECT_EQ(cells[0].material, "ground_truth");
+  EXPECT_EQ(cells[0].config, json::parse(R"({"bounces": 1, "phases": "geometry"})"));
+  EXPECT_EQ(cells[0].settings, json::parse(R"({"variant": "a", "phases": "geometry"})"));
+  EXPECT_EQ(cells[1].init, "reference");  // the later axis wins.
+  EXPECT_EQ(cells[1].material, "grey");
+  EXPECT_EQ(cells[2].init, "/grids/start.ply");
+  EXPECT_EQ(cells[2].material, "");
+  EXPECT_EQ(cells[5].id, "05_b_both");
+  EXPECT_EQ(cells[5].init, "");
+  EXPECT_EQ(cells[5].material, "{\"albedo\": [0.2, 0.2, 0.2]}");
+  SweepGrid again;
+  ASSERT_TRUE(ParseSweepGrid(SweepGridJson(grid), "grid.json", "/", &again).ok());
+  EXPECT_EQ(SweepGridJson(again), SweepGridJson(grid));
+  EXPECT_EQ(EnumerateCells(again)[1].init, "reference");
+}
+
 TEST(SweepGridTest, EvenlySpacedViews) {
   std::vector<int> views;
   ASSERT_TRUE(EvenlySpacedViews(4, 10, &views).ok());
@@ -159,7 +196,9 @@ TEST(SweepGridTest, EvenlySpacedViews) {
 TEST(SweepGridTest, AblationsPreset) {
   SweepGrid grid;
   ASSERT_TRUE(PresetSweepGrid("ablations", &grid).ok());
-  EXPECT_EQ(grid.config, json::parse(R"({"spp": 16})"));
+  EXPECT_EQ(grid.config["spp"], 16);
+  ASSERT_EQ(grid.config["stages"].size(), 1u);  // one Adam stage spends the budget.
+  EXPECT_EQ(grid.config["stages"][0]["solver"], "adam");
   EXPECT_GT(grid.time_budget, 0.0);
   const std::vector<SweepCell> cells = EnumerateCells(grid);
   ASSERT_EQ(cells.size(), 24u);
@@ -167,7 +206,11 @@ TEST(SweepGridTest, AblationsPreset) {
   EXPECT_EQ(cells[0].views, 8);
   EXPECT_EQ(cells[0].config, json::parse(R"({"bounces": 1, "effects": "direct,specular,environment",
                                            "phases": "geometry"})"));
+  EXPECT_EQ(cells[0].init, "");  // geometry: the grid's start, holding the true material.
+  EXPECT_EQ(cells[0].material, "ground_truth");
   EXPECT_EQ(cells[7].id, "07_local_texture_views64");
+  EXPECT_EQ(cells[7].init, "reference");  // texture: the true shape, from grey.
+  EXPECT_EQ(cells[7].material, "grey");
   EXPECT_EQ(cells[8].config["effects"], "direct,shadows,specular,environment");
   EXPECT_EQ(cells[23].id, "23_global_texture_views64");
   EXPECT_EQ(cells[23].config, json::parse(R"({"bounces": 2, "effects": "all",
@@ -187,7 +230,9 @@ TEST(SweepGridTest, OverridesReplaceTheGridsValuesAndNameTheFlag) {
   o.eval_spp = 16;
   ASSERT_TRUE(ApplySweepOverrides(o, &grid).ok());
   EXPECT_EQ(grid.dataset, tmp.Join("ds"));
-  EXPECT_EQ(grid.config, json::parse(R"({"spp": 16, "steps": 2})"));  // the preset's spp wins.
+  EXPECT_EQ(grid.config["spp"], 16);  // the preset's spp wins.
+  EXPECT_EQ(grid.config["steps"], 2);
+  EXPECT_EQ(grid.config["stages"].size(), 1u);
   EXPECT_EQ(grid.time_budget, 30.0);
   EXPECT_EQ(grid.eval.spp, 16);
   auto with = [](const std::function<void(SweepOverrides*)>& set) {
