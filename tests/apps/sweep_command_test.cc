@@ -57,6 +57,15 @@ class SweepCommandTest : public ::testing::Test {
               0)
         << out;
   }
+  // Writes `grid` as <out>.json beside the dataset, runs `sft sweep --quiet` into <out> and
+  // returns the lines of its sweep.jsonl (a failed sweep is a test failure).
+  std::vector<std::string> RunGrid(const std::string& grid, const std::string& out) {
+    const std::string path = tmp_.Join(out + ".json");
+    testing::WriteTestFile(path, grid);
+    std::string log;
+    EXPECT_EQ(RunSft("sweep --quiet --grid " + path + " --out " + tmp_.Join(out), &log), 0) << log;
+    return ReadLines(tmp_.Join(out + "/sweep.jsonl"));
+  }
   testing::TempDir tmp_;
 };
 
@@ -132,17 +141,12 @@ TEST_F(SweepCommandTest, InterruptedAndKilledSweepsContinue) {
 // Views counts become evenly spaced view indices; more views than the dataset has is the cell's
 // error. Outer iterations instead of a budget end the cells.
 TEST_F(SweepCommandTest, ViewsAxisAndOuterIterations) {
-  testing::WriteTestFile(tmp_.Join("grid.json"), R"({
+  const std::vector<std::string> lines = RunGrid(R"({
     "dataset": "ds", "init": "init.ply", "outer_iterations": 1,
     "config": {"steps": 1, "spp": 2, "phases": "texture"},
     "eval": {"spp": 2, "bounces": 1},
-    "axes": {"views": [2, 9]}})");
-  std::string out;
-  ASSERT_EQ(
-      RunSft("sweep --quiet --grid " + tmp_.Join("grid.json") + " --out " + tmp_.Join("o"), &out),
-      0)
-      << out;
-  const std::vector<std::string> lines = ReadLines(tmp_.Join("o/sweep.jsonl"));
+    "axes": {"views": [2, 9]}})",
+                                                 "o");
   ASSERT_EQ(lines.size(), 2u);
   const json two = json::parse(lines[0]), nine = json::parse(lines[1]);
   EXPECT_EQ(two["status"], "ok");
@@ -170,14 +174,8 @@ TEST_F(SweepCommandTest, PhaseValuesStartWhereTheyAsk) {
   const std::string base = R"({"dataset": "ds", "init": "init.ply", "outer_iterations": 1,
     "config": {"steps": 1, "spp": 2}, "eval": {"spp": 2, "bounces": 1, "mesh_samples": 1000},
     )";
-  testing::WriteTestFile(tmp_.Join("grid.json"),
-                         base + R"("reference": "ds/gt/mesh.ply", )" + phases);
-  std::string out;
-  ASSERT_EQ(
-      RunSft("sweep --quiet --grid " + tmp_.Join("grid.json") + " --out " + tmp_.Join("o"), &out),
-      0)
-      << out;
-  const std::vector<std::string> lines = ReadLines(tmp_.Join("o/sweep.jsonl"));
+  const std::vector<std::string> lines =
+      RunGrid(base + R"("reference": "ds/gt/mesh.ply", )" + phases, "o");
   ASSERT_EQ(lines.size(), 2u);
   for (const std::string& line : lines) EXPECT_EQ(json::parse(line)["status"], "ok") << line;
   // The geometry cell kept the true material (a geometry phase does not change it).
@@ -207,12 +205,7 @@ TEST_F(SweepCommandTest, PhaseValuesStartWhereTheyAsk) {
   EXPECT_EQ(metrics["init"], tmp_.Join("ds/gt/mesh.ply"));
   EXPECT_EQ(metrics["material"], "");
   // Without a reference the texture cell is an error line; the geometry cell still runs.
-  testing::WriteTestFile(tmp_.Join("noref.json"), base + phases);
-  ASSERT_EQ(
-      RunSft("sweep --quiet --grid " + tmp_.Join("noref.json") + " --out " + tmp_.Join("n"), &out),
-      0)
-      << out;
-  const std::vector<std::string> noref = ReadLines(tmp_.Join("n/sweep.jsonl"));
+  const std::vector<std::string> noref = RunGrid(base + phases, "n");
   ASSERT_EQ(noref.size(), 2u);
   EXPECT_EQ(json::parse(noref[0])["status"], "ok");
   EXPECT_THAT(json::parse(noref[1])["error"].get<std::string>(),
