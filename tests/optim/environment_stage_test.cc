@@ -77,11 +77,7 @@ class EnvironmentStageTest : public ::testing::Test {
   }
   void SetUp() override {
     ASSERT_TRUE(ReadDataset(dir_->Join("ds"), &dataset_).ok());
-    dataset_.lights.clear();
-    for (ViewSpec& view : dataset_.views) {
-      view.lights.clear();
-      view.light_ids.clear();
-    }
+    testing::RemoveLights(&dataset_);
     ASSERT_TRUE(ReadMesh(dir_->Join("ds/gt/mesh.ply"), &mesh_).ok());
     ASSERT_TRUE(LoadMaterial(kTrueMaterial, mesh_, &truth_).ok());
     EnvironmentEstimateOptions estimate;

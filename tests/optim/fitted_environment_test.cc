@@ -23,15 +23,6 @@ namespace {
 
 using ::testing::HasSubstr;
 
-// Unknown lighting: `dataset` with every light and every view's light list removed.
-void RemoveLights(Dataset* dataset) {
-  dataset->lights.clear();
-  for (ViewSpec& view : dataset->views) {
-    view.lights.clear();
-    view.light_ids.clear();
-  }
-}
-
 // A texture fit of the map jointly with the albedo on these tests' 6 views at 32²: 8 spp, one
 // bounce, a nearly constant albedo (on a convex object a varying albedo could otherwise explain
 // the shading: the ambiguity docs/reconstruct.md describes), and a light map prior (its default
@@ -85,7 +76,7 @@ class FittedEnvironmentTest : public ::testing::Test {
   void SetUp() override {
     ASSERT_TRUE(ReadDataset(dir_->Join("ds"), &dataset_).ok());
     ASSERT_FALSE(LightingUnknown(dataset_));
-    RemoveLights(&dataset_);
+    testing::RemoveLights(&dataset_);
     ASSERT_TRUE(ReadMesh(dir_->Join("ds/gt/mesh.ply"), &mesh_).ok());
   }
 
@@ -260,7 +251,7 @@ class CameraFixedEnvironmentTest : public ::testing::Test {
   double Fit(LightFrame frame, Image* env) {
     Dataset dataset;
     EXPECT_TRUE(ReadDataset(dir_->Join("ds"), &dataset).ok());
-    RemoveLights(&dataset);
+    testing::RemoveLights(&dataset);
     TriMesh mesh;
     EXPECT_TRUE(ReadMesh(dir_->Join("ds/gt/mesh.ply"), &mesh).ok());
     EnvironmentEstimateOptions estimate;

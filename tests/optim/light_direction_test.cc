@@ -33,11 +33,7 @@ double AngleDegrees(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
 }
 
 TEST(LightDirectionParametersTest, LayoutBlocksAndValues) {
-  const std::vector<Eigen::Vector3d> positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
-  const Material material =
-      ConstantMaterial(1, Eigen::Vector3d::Constant(0.5), 0.5, 0.0, /*resolution=*/1);
-  SceneParameters params(positions, material, /*num_lights=*/2, /*num_gain_views=*/2);
-  params.values()[params.GainIndex(1, 2)] = 1.5;
+  SceneParameters params = testing::LayoutTestParameters();
   const int size = params.size();
   EXPECT_TRUE(params.LightDirections().empty());
   params.AddLightDirections({{0, 0, -1}, {0.6, 0, 0.8}});

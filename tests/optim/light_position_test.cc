@@ -42,11 +42,7 @@ const Eigen::Vector3d kTrueWorld(0.9, -0.7, 1.1);
 const Eigen::Vector3d kDisplacement = 0.2 * Eigen::Vector3d(-0.6, 0.6, 0.5).normalized();
 
 TEST(LightPositionParametersTest, LayoutBlocksAndValues) {
-  const std::vector<Eigen::Vector3d> positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
-  const Material material =
-      ConstantMaterial(1, Eigen::Vector3d::Constant(0.5), 0.5, 0.0, /*resolution=*/1);
-  SceneParameters params(positions, material, /*num_lights=*/2, /*num_gain_views=*/2);
-  params.values()[params.GainIndex(1, 2)] = 1.5;
+  SceneParameters params = testing::LayoutTestParameters();
   const int size = params.size();
   EXPECT_FALSE(params.has_light_positions());
   EXPECT_TRUE(params.LightPositions().empty());

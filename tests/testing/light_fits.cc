@@ -57,5 +57,14 @@ std::string LightsFileError(const std::string& path, const Dataset& dataset,
   return ReadLightScales(path, dataset, &scales, &positions, &directions).message();
 }
 
+SceneParameters LayoutTestParameters() {
+  const std::vector<Eigen::Vector3d> positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  const Material material =
+      ConstantMaterial(1, Eigen::Vector3d::Constant(0.5), 0.5, 0.0, /*resolution=*/1);
+  SceneParameters params(positions, material, /*num_lights=*/2, /*num_gain_views=*/2);
+  params.values()[params.GainIndex(1, 2)] = 1.5;
+  return params;
+}
+
 }  // namespace testing
 }  // namespace sft

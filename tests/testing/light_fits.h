@@ -12,6 +12,7 @@
 #include "src/geometry/material.h"
 #include "src/geometry/mesh.h"
 #include "src/io/dataset.h"
+#include "src/optim/parameters.h"
 #include "src/optim/reconstruct.h"
 
 namespace sft {
@@ -49,6 +50,10 @@ std::string RunLightFit(const LightFit& fit, const std::vector<Eigen::Vector3d>&
 // reads).
 std::string LightsFileError(const std::string& path, const Dataset& dataset,
                             const std::string& members);
+
+// The parameters the layout tests add light blocks to: three vertices, a constant material
+// (resolution 1), two lights' scales and two views' gains, view 1's blue gain set to 1.5.
+SceneParameters LayoutTestParameters();
 
 }  // namespace testing
 }  // namespace sft

@@ -81,5 +81,13 @@ std::string CorruptMask(const std::string& dir, int view, bool hole) {
   return status.ok() ? std::string() : status.message();
 }
 
+void RemoveLights(Dataset* dataset) {
+  dataset->lights.clear();
+  for (ViewSpec& view : dataset->views) {
+    view.lights.clear();
+    view.light_ids.clear();
+  }
+}
+
 }  // namespace testing
 }  // namespace sft

@@ -26,6 +26,9 @@ std::string CorruptMask(const std::string& dir, int view, bool hole);
 std::string RelightDataset(const std::string& from, const std::string& to,
                            const std::function<void(Dataset*)>& relight);
 
+// Unknown lighting: `dataset` with every light and every view's light list removed.
+void RemoveLights(Dataset* dataset);
+
 }  // namespace testing
 }  // namespace sft
 
