@@ -242,6 +242,7 @@ Status PrepareSchedule(ReconstructCommandOptions* cli, Dataset* dataset,
       {"dataset", cli->dataset},
       {"start", start.Describe()},
       {"init", start.path},
+      {"material", cli->material},
       {"config", config.flat},
       {"schedule", config.stages.is_null() ? config.schedule : "explicit"}};
   if (before_start) SFT_RETURN_IF_ERROR(before_start(cli->dataset, *dataset, stages));
