@@ -19,6 +19,31 @@ std::string Num(double v) {
   return buffer;
 }
 
+// Enough significant digits that neighbouring ticks (a quarter of [lo, hi] apart) read
+// differently: a narrow range far from zero, such as 300–301 s, needs more than 3.
+int TickDigits(double lo, double hi) {
+  const double step = (hi - lo) / 4.0, size = std::max(std::abs(lo), std::abs(hi));
+  if (!(step > 0.0) || !(size > 0.0)) return 3;
+  return std::clamp(static_cast<int>(std::ceil(std::log10(size / step))) + 1, 3, 10);
+}
+
+// The legend's mark (a line and/or a dot) and name for `series`, starting at x, centred on y.
+std::string LegendEntry(const LineSeries& series, const std::string& color, const std::string& fill,
+                        double x, double y) {
+  std::string svg;
+  if (series.line) {
+    svg += "<line x1=\"" + Num(x) + "\" y1=\"" + Num(y) + "\" x2=\"" + Num(x + 18) + "\" y2=\"" +
+           Num(y) + "\" stroke=\"" + color + "\" stroke-width=\"2\"/>";
+  }
+  if (series.marker_radius > 0.0) {
+    svg += "<circle cx=\"" + Num(x + 9) + "\" cy=\"" + Num(y) + "\" r=\"" +
+           Num(std::min(series.marker_radius, 5.0)) + "\" fill=\"" + fill + "\" stroke=\"" + color +
+           "\" stroke-width=\"" + (series.hollow_markers ? "2" : "1") + "\"/>";
+  }
+  return svg + "<text x=\"" + Num(x + 22) + "\" y=\"" + Num(y + 4) + "\">" +
+         HtmlEscape(series.name) + "</text>\n";
+}
+
 }  // namespace
 
 std::string LineChartSvg(const LineChart& chart) {
@@ -62,14 +87,16 @@ std::string LineChartSvg(const LineChart& chart) {
   auto py = [&](double y) { return top + (1.0 - (ty(y) - y_lo) / (y_hi - y_lo)) * plot_h; };
   svg += "<rect x=\"" + Num(left) + "\" y=\"" + Num(top) + "\" width=\"" + Num(plot_w) +
          "\" height=\"" + Num(plot_h) + "\" fill=\"none\" stroke=\"#888\"/>\n";
+  const int x_digits = TickDigits(x_lo, x_hi);
+  const int y_digits = chart.log_y ? 3 : TickDigits(y_lo, y_hi);
   for (int k = 0; k <= 4; ++k) {
     const double fx = x_lo + (x_hi - x_lo) * k / 4.0;
     const double fy = y_lo + (y_hi - y_lo) * k / 4.0;
     const double y_value = chart.log_y ? std::pow(10.0, fy) : fy;
     svg += "<text x=\"" + Num(px(fx)) + "\" y=\"" + Num(top + plot_h + 14) +
-           "\" text-anchor=\"middle\">" + FormatNumber(fx, 3) + "</text>\n";
+           "\" text-anchor=\"middle\">" + FormatNumber(fx, x_digits) + "</text>\n";
     svg += "<text x=\"" + Num(left - 4) + "\" y=\"" + Num(py(y_value) + 4) +
-           "\" text-anchor=\"end\">" + FormatNumber(y_value, 3) + "</text>\n";
+           "\" text-anchor=\"end\">" + FormatNumber(y_value, y_digits) + "</text>\n";
   }
   svg += "<text x=\"" + Num(left + plot_w / 2) + "\" y=\"" + Num(height - 6) +
          "\" text-anchor=\"middle\">" + HtmlEscape(chart.x_label) + "</text>\n";
@@ -98,19 +125,7 @@ std::string LineChartSvg(const LineChart& chart) {
              points + "\"/>\n";
     }
     svg += dots;
-    const double ly = top + 14 * s + 8;
-    if (series.line) {
-      svg += "<line x1=\"" + Num(left + plot_w + 10) + "\" y1=\"" + Num(ly) + "\" x2=\"" +
-             Num(left + plot_w + 28) + "\" y2=\"" + Num(ly) + "\" stroke=\"" + color +
-             "\" stroke-width=\"2\"/>";
-    }
-    if (series.marker_radius > 0.0) {
-      svg += "<circle cx=\"" + Num(left + plot_w + 19) + "\" cy=\"" + Num(ly) + "\" r=\"" +
-             Num(std::min(series.marker_radius, 5.0)) + "\" fill=\"" + fill + "\" stroke=\"" +
-             color + "\" stroke-width=\"" + (series.hollow_markers ? "2" : "1") + "\"/>";
-    }
-    svg += "<text x=\"" + Num(left + plot_w + 32) + "\" y=\"" + Num(ly + 4) + "\">" +
-           HtmlEscape(series.name) + "</text>\n";
+    svg += LegendEntry(series, color, fill, left + plot_w + 10, top + 14 * s + 8);
   }
   return svg + "</svg>\n";
 }

@@ -149,6 +149,12 @@ Status WriteSweepReport(const std::string& out, const SweepGrid& grid,
       "(scoring not included). The line joins the Pareto front: the cells that no other cell "
       "beats in both time and accuracy. For a time you can afford, the front's cell at or left "
       "of it is the setting to choose. The ring marks the default configuration.");
+  if (grid.time_budget > 0.0) {
+    html.AddParagraph(
+        "Every cell had the same wall-time budget, so the times differ only by where a cell's "
+        "last solver iteration ended: the charts compare the cells' accuracy at equal time, and "
+        "their fronts say little. Read the table below.");
+  }
   std::map<std::string, std::string> fronts;
   const char* const letters[] = {"C", "F", "P", "A", "R"};
   for (int k = 0; k < 5; ++k) {

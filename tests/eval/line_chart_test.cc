@@ -61,5 +61,18 @@ TEST(LineChartTest, MarginKeepsPointsOffTheFrame) {
   EXPECT_THAT(svg, HasSubstr("cx=\"85.0\" cy=\"258.0\""));
 }
 
+// Tick labels: 3 significant digits on a wide range, enough to tell neighbours apart on a narrow
+// one far from zero (equal-budget sweep cells end within a second of 300 s).
+TEST(LineChartTest, TickLabelsTellNeighboursApart) {
+  LineChart chart;
+  chart.series = {LineSeries{"s", {300, 301}, {0, 100}}};
+  const std::string svg = LineChartSvg(chart);
+  for (const char* tick : {">300<", ">300.25<", ">300.5<", ">300.75<", ">301<"}) {
+    EXPECT_THAT(svg, HasSubstr(tick)) << tick;
+  }
+  EXPECT_THAT(svg, HasSubstr(">25<"));  // the y axis, 0–100: no extra digits.
+  EXPECT_THAT(svg, HasSubstr(">75<"));
+}
+
 }  // namespace
 }  // namespace sft

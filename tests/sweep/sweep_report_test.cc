@@ -14,6 +14,7 @@ namespace {
 
 using json = nlohmann::json;
 using ::testing::HasSubstr;
+using ::testing::Not;
 
 json Line(const std::string& id, double seconds, double chamfer, double f1, double psnr,
           bool is_default = false) {
@@ -66,6 +67,12 @@ TEST(SweepReportTest, WritesFrontsTableAndDefault) {
   EXPECT_THAT(html.substr(row2, html.find("</tr>", row2) - row2), HasSubstr("<td></td><td></td>"));
   // The default cell is ringed in every chart.
   EXPECT_THAT(html, HasSubstr("default: " + cells[1].id));
+  EXPECT_THAT(html, Not(HasSubstr("same wall-time budget")));
+  // With a time budget the report says that the fronts compare equal times.
+  grid.time_budget = 300;
+  ASSERT_TRUE(WriteSweepReport(tmp.path(), grid, cells, lines).ok());
+  EXPECT_THAT(testing::ReadTestFile(tmp.Join("report.html")),
+              HasSubstr("Every cell had the same wall-time budget"));
 }
 
 TEST(SweepReportTest, WithoutReferenceOrResultsSaysSo) {
