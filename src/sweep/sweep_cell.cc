@@ -140,10 +140,11 @@ Status LoadCellStart(const SweepContext& context, const SweepCell& cell, CellSta
       return Status::Error("init \"reference\": the grid gives no reference mesh");
     }
     SFT_RETURN_IF_ERROR(ChooseStart(context.dataset, grid.reference, &start->choice));
-    SFT_RETURN_IF_ERROR(ReadMesh(grid.reference, &start->state.mesh));
+    start->state.mesh = context.reference;  // read once, by LoadSweepContext.
   } else if (!cell.init.empty()) {
     SFT_RETURN_IF_ERROR(ChooseStart(context.dataset, cell.init, &start->choice));
-    SFT_RETURN_IF_ERROR(ReadMesh(cell.init, &start->state.mesh));
+    SFT_RETURN_IF_ERROR(
+        LoadStartMesh(context.dataset, start->choice, InitialMeshOptions(), &start->state.mesh));
   } else {
     start->state.mesh = context.start_state.mesh;
   }
