@@ -29,17 +29,18 @@ Material PerturbMaterial(const Material& base, const ParameterLayout& layout,
 }
 
 // The view with its lights at parameters + t·δ. An environment whose rotation is a parameter is
-// turned by exp([t·δ]×) in its frame (the camera's for a camera-fixed one: Rᵀ·exp([t·δ]×)·R in
-// the world), into *turned, which the view then points at.
+// turned by exp([t·δ]×) in its frame, `world_from_frame` (I for a world-fixed probe, Rᵀ of the
+// camera for a camera-fixed one: Rᵀ·exp([t·δ]×)·R in the world), into *turned, which the view
+// then points at. The frame comes from the dataset, not from the view's
+// environment_rotation_jacobian, so that a wrong Jacobian shows.
 ViewSetup PerturbView(const ViewSetup& base, const ParameterLayout& layout,
                       const std::vector<double>& delta, double t,
+                      const Eigen::Matrix3d& world_from_frame,
                       std::unique_ptr<EnvironmentMap>* turned) {
   ViewSetup view = base;
   if (view.environment != nullptr && layout.FitsEnvironmentRotation(view.environment_light_index)) {
     const Eigen::Vector3d d(
         &delta[layout.EnvironmentRotationOffset() + 3 * view.environment_light_index]);
-    // environment_rotation_jacobian at θ = 0 is the world-from-frame rotation (I or Rᵀ).
-    const Eigen::Matrix3d& world_from_frame = view.environment_rotation_jacobian;
     *turned = std::make_unique<EnvironmentMap>(view.environment->Rotated(
         world_from_frame * RotationFromVector(t * d) * world_from_frame.transpose()));
     view.environment = turned->get();
@@ -395,10 +396,16 @@ Status RunGradcheck(const Dataset& dataset, const TriMesh& mesh, const Material&
     RenderViewWithDerivatives(scene, material, view, view_render, request, layout, &image, &out,
                               &stats[0]);
     std::unique_ptr<EnvironmentMap> plus_map, minus_map;
+    const Eigen::Matrix3d world_from_frame =
+        views.view_environments[v] != nullptr
+            ? view.cam_from_world.rotation.conjugate().toRotationMatrix()
+            : Eigen::Matrix3d::Identity();
     RenderView(vertices ? *plus_scene : scene, plus_material,
-               PerturbView(view, layout, delta, step, &plus_map), view_render, &plus, &stats[1]);
+               PerturbView(view, layout, delta, step, world_from_frame, &plus_map), view_render,
+               &plus, &stats[1]);
     RenderView(vertices ? *minus_scene : scene, minus_material,
-               PerturbView(view, layout, delta, -step, &minus_map), view_render, &minus, &stats[2]);
+               PerturbView(view, layout, delta, -step, world_from_frame, &minus_map), view_render,
+               &minus, &stats[2]);
 
     // The directional derivative images, RGB per pixel.
     const size_t pixels = static_cast<size_t>(width) * height;
