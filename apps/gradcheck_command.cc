@@ -80,7 +80,8 @@ int RunGradcheckCommand(const GradcheckCommandOptions& opts) {
     // A fitted environment exists in a fit only (its finite-difference test is in tests/render/).
     return PrintError("gradcheck", Status::Error("--param: unknown parameter kind '" + opts.param +
                                                  "' (vertices, albedo, roughness, specular, "
-                                                 "light, light_position, light_direction)"));
+                                                 "light, light_position, light_direction, "
+                                                 "environment_rotation)"));
   }
   std::string why;
   if (!Effects::Parse(opts.effects, &check.render.effects, &why)) {
@@ -193,7 +194,7 @@ CommandRunner SetupGradcheckCommand(CLI::App* app) {
   app->add_option(
          "--param", opts->param,
          "Parameter kind: vertices | albedo | roughness | specular | light | light_position | "
-         "light_direction")
+         "light_direction | environment_rotation")
       ->required();
   app->add_option("--spp", opts->check.render.spp,
                   "Samples per pixel (vertices: finite differences of moving edges need many: "

@@ -28,9 +28,23 @@ Material PerturbMaterial(const Material& base, const ParameterLayout& layout,
   return m;
 }
 
+// The view with its lights at parameters + t·δ. An environment whose rotation is a parameter is
+// turned by exp([t·δ]×) in its frame, `world_from_frame` (I for a world-fixed probe, Rᵀ of the
+// camera for a camera-fixed one: Rᵀ·exp([t·δ]×)·R in the world), into *turned, which the view
+// then points at. The frame comes from the dataset, not from the view's
+// environment_rotation_jacobian, so that a wrong Jacobian shows.
 ViewSetup PerturbView(const ViewSetup& base, const ParameterLayout& layout,
-                      const std::vector<double>& delta, double t) {
+                      const std::vector<double>& delta, double t,
+                      const Eigen::Matrix3d& world_from_frame,
+                      std::unique_ptr<EnvironmentMap>* turned) {
   ViewSetup view = base;
+  if (view.environment != nullptr && layout.FitsEnvironmentRotation(view.environment_light_index)) {
+    const Eigen::Vector3d d(
+        &delta[layout.EnvironmentRotationOffset() + 3 * view.environment_light_index]);
+    *turned = std::make_unique<EnvironmentMap>(view.environment->Rotated(
+        world_from_frame * RotationFromVector(t * d) * world_from_frame.transpose()));
+    view.environment = turned->get();
+  }
   for (PointLight& light : view.point_lights) {
     if (light.light_index >= 0) {
       light.intensity *= 1.0 + t * delta[layout.LightOffset() + light.light_index];
@@ -98,6 +112,9 @@ double RelativeError(double err2, double ref2) {
 
 // The automatic vertex step, relative to the bounding-box diagonal (see GradcheckOptions::step).
 constexpr double kAutomaticVertexStep = 5e-3;
+// The automatic environment-rotation step, radians: small against a texel of a typical probe
+// (2π/1024 ≈ 6e-3 rad), so that few lookups cross a texel centre's kink between the two renders.
+constexpr double kAutomaticRotationStep = 1e-4;
 
 // Factor on the automatic vertex step for a glossy lobe of width α = roughness² (the sharpest
 // texel's): the step rotates face normals by up to ~0.05 rad, and the central difference of a
@@ -284,6 +301,14 @@ Status PrepareGradcheck(const Dataset& dataset, const GradcheckOptions& options,
                                               options.kind == ParameterKind::kLightDirection
                                           ? 8
                                           : 1);
+  if (options.kind == ParameterKind::kEnvironmentRotation) {
+    bool any = false;
+    for (int v : setup->selected) any |= setup->views.views[v].environment != nullptr;
+    if (!any) {
+      return Status::Error(
+          "--param environment_rotation: no selected view has an environment light");
+    }
+  }
   return Status::Ok();
 }
 
@@ -300,6 +325,7 @@ Status RunGradcheck(const Dataset& dataset, const TriMesh& mesh, const Material&
       MakeParameterLayout(scene, material, static_cast<int>(dataset.lights.size()));
   layout.light_positions = options.kind == ParameterKind::kLightPosition;
   layout.light_directions = options.kind == ParameterKind::kLightDirection;
+  layout.environment_rotations = options.kind == ParameterKind::kEnvironmentRotation;
   const bool vertices = options.kind == ParameterKind::kVertex;
 
   std::vector<double> delta =
@@ -322,7 +348,8 @@ Status RunGradcheck(const Dataset& dataset, const TriMesh& mesh, const Material&
                             scene.extent()
            : options.kind == ParameterKind::kLightPosition  ? kAutomaticVertexStep * scene.extent()
            : options.kind == ParameterKind::kLightDirection ? kAutomaticVertexStep
-                                                            : 1e-3;
+           : options.kind == ParameterKind::kEnvironmentRotation ? kAutomaticRotationStep
+                                                                 : 1e-3;
   }
 
   RenderOptions render = options.render;
@@ -362,12 +389,23 @@ Status RunGradcheck(const Dataset& dataset, const TriMesh& mesh, const Material&
     Image image, plus, minus;
     DerivativeOutput out;
     RenderStats stats[3];
-    RenderViewWithDerivatives(scene, material, view, render, request, layout, &image, &out,
+    // A turned environment is sampled as the unturned one (detached sampling): the three renders
+    // follow the same paths.
+    RenderOptions view_render = render;
+    if (view.environment != nullptr) view_render.sampling_environment = view.environment;
+    RenderViewWithDerivatives(scene, material, view, view_render, request, layout, &image, &out,
                               &stats[0]);
+    std::unique_ptr<EnvironmentMap> plus_map, minus_map;
+    const Eigen::Matrix3d world_from_frame =
+        views.view_environments[v] != nullptr
+            ? view.cam_from_world.rotation.conjugate().toRotationMatrix()
+            : Eigen::Matrix3d::Identity();
     RenderView(vertices ? *plus_scene : scene, plus_material,
-               PerturbView(view, layout, delta, step), render, &plus, &stats[1]);
+               PerturbView(view, layout, delta, step, world_from_frame, &plus_map), view_render,
+               &plus, &stats[1]);
     RenderView(vertices ? *minus_scene : scene, minus_material,
-               PerturbView(view, layout, delta, -step), render, &minus, &stats[2]);
+               PerturbView(view, layout, delta, -step, world_from_frame, &minus_map), view_render,
+               &minus, &stats[2]);
 
     // The directional derivative images, RGB per pixel.
     const size_t pixels = static_cast<size_t>(width) * height;

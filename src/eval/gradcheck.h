@@ -69,7 +69,8 @@ struct GradcheckOptions {
                       // diagonal for light positions, which move each point light by h·δ_l in
                       // its own frame, ParameterLayout::light_positions; 5e-3 for light
                       // directions, about 5e-3 rad of each directional light's unit direction
-                      // in its frame).
+                      // in its frame; 1e-4 rad for environment rotations, which turn each probe
+                      // by exp([h·δ_l]×) in its frame).
   // Side B of the pixel blocks summed before comparing; 0 = automatic: 8 for vertices, light
   // positions and light directions (edge
   // sampling puts silhouette and shadow-boundary derivatives at random pixels along the edge, and

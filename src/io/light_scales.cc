@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 
 #include "src/core/file_util.h"
+#include "src/render/environment.h"
 
 namespace sft {
 
@@ -22,8 +23,11 @@ Status ReadLightVector(const nlohmann::json& entry, const std::string& where,
   if (!entry.contains(key)) return Status::Ok();
   const std::string field = where + "." + key;
   if (light.type != type) {
-    return Status::Error(field + ": light \"" + light.id + "\" is not a " +
-                         (type == LightType::kPoint ? "point" : "directional") + " light");
+    return Status::Error(field + ": light \"" + light.id + "\" is not " +
+                         (type == LightType::kPoint         ? "a point"
+                          : type == LightType::kDirectional ? "a directional"
+                                                            : "an environment") +
+                         " light");
   }
   const nlohmann::json& p = entry[key];
   if (!p.is_array() || p.size() != 3) return Status::Error(field + ": expected 3 numbers");
@@ -49,7 +53,8 @@ Status ReadLightVector(const nlohmann::json& entry, const std::string& where,
 Status WriteLightScales(const std::string& path, const Dataset& dataset,
                         const std::vector<double>& scales,
                         const std::vector<Eigen::Vector3d>& positions,
-                        const std::vector<Eigen::Vector3d>& directions) {
+                        const std::vector<Eigen::Vector3d>& directions,
+                        const std::vector<Eigen::Vector3d>& rotations) {
   nlohmann::ordered_json json;
   json["format"] = "sft-light-scales/1";
   json["lights"] = nlohmann::ordered_json::array();
@@ -66,6 +71,11 @@ Status WriteLightScales(const std::string& path, const Dataset& dataset,
       entry["frame"] = FrameName(light.frame);
       entry["direction"] = {d.x(), d.y(), d.z()};
     }
+    if (!rotations.empty() && light.type == LightType::kEnvironment) {
+      const Eigen::Vector3d& r = rotations.at(l);
+      entry["frame"] = FrameName(light.frame);
+      entry["rotation"] = {r.x(), r.y(), r.z()};
+    }
     json["lights"].push_back(entry);
   }
   return WriteTextFile(path, json.dump(1) + "\n");
@@ -73,7 +83,8 @@ Status WriteLightScales(const std::string& path, const Dataset& dataset,
 
 Status ReadLightScales(const std::string& path, const Dataset& dataset, std::vector<double>* scales,
                        std::vector<Eigen::Vector3d>* positions,
-                       std::vector<Eigen::Vector3d>* directions) {
+                       std::vector<Eigen::Vector3d>* directions,
+                       std::vector<Eigen::Vector3d>* rotations) {
   std::string text;
   SFT_RETURN_IF_ERROR(ReadTextFile(path, &text));
   const nlohmann::json json = nlohmann::json::parse(text, nullptr, /*allow_exceptions=*/false);
@@ -91,7 +102,8 @@ Status ReadLightScales(const std::string& path, const Dataset& dataset, std::vec
     read[l] = dataset.lights[l].position;
     read_directions[l] = dataset.lights[l].direction;
   }
-  bool any_position = false, any_direction = false;
+  std::vector<Eigen::Vector3d> read_rotations(dataset.lights.size(), Eigen::Vector3d::Zero());
+  bool any_position = false, any_direction = false, any_rotation = false;
   for (size_t i = 0; i < lights->size(); ++i) {
     const nlohmann::json& entry = (*lights)[i];
     const std::string where = path + ": lights[" + std::to_string(i) + "]";
@@ -116,6 +128,9 @@ Status ReadLightScales(const std::string& path, const Dataset& dataset, std::vec
         SFT_RETURN_IF_ERROR(ReadLightVector(entry, where, light, "direction",
                                             LightType::kDirectional, &has, &read_directions[l]));
         any_direction = any_direction || has;
+        SFT_RETURN_IF_ERROR(ReadLightVector(entry, where, light, "rotation",
+                                            LightType::kEnvironment, &has, &read_rotations[l]));
+        any_rotation = any_rotation || has;
       }
     }
     if (!found) return Status::Error(where + ".id: the dataset has no light with this id");
@@ -132,6 +147,10 @@ Status ReadLightScales(const std::string& path, const Dataset& dataset, std::vec
   if (directions != nullptr) {
     directions->clear();
     if (any_direction) *directions = std::move(read_directions);
+  }
+  if (rotations != nullptr) {
+    rotations->clear();
+    if (any_rotation) *rotations = std::move(read_rotations);
   }
   return Status::Ok();
 }
@@ -150,13 +169,24 @@ void ApplyLightDirections(const std::vector<Eigen::Vector3d>& directions, Datase
   }
 }
 
+void ApplyEnvironmentRotations(const std::vector<Eigen::Vector3d>& rotations, Dataset* dataset) {
+  for (size_t l = 0; l < dataset->lights.size() && l < rotations.size(); ++l) {
+    LightSpec& light = dataset->lights[l];
+    if (light.type == LightType::kEnvironment) {
+      light.world_from_env = RotationFromVector(rotations[l]) * light.world_from_env;
+    }
+  }
+}
+
 Status ApplyLightsFile(const std::string& path, Dataset* dataset) {
   std::vector<double> scales;
-  std::vector<Eigen::Vector3d> positions, directions;
-  SFT_RETURN_IF_ERROR(ReadLightScales(path, *dataset, &scales, &positions, &directions));
+  std::vector<Eigen::Vector3d> positions, directions, rotations;
+  SFT_RETURN_IF_ERROR(
+      ReadLightScales(path, *dataset, &scales, &positions, &directions, &rotations));
   ApplyLightScales(scales, dataset);
   ApplyLightPositions(positions, dataset);
   ApplyLightDirections(directions, dataset);
+  ApplyEnvironmentRotations(rotations, dataset);
   return Status::Ok();
 }
 

@@ -7,7 +7,11 @@
 // dataset light's) and "position" [x, y, z]: the fitted position in that frame, which replaces
 // the dataset's. Likewise with fitted directional-light directions (`fit_light_directions`): each
 // directional light's entry has "frame" and "direction" [x, y, z], the unit direction the light
-// travels in that frame. Readers that do not know these keys ignore them (the format name stays).
+// travels in that frame. With fitted probe rotations (`fit_environment_rotation`) each
+// environment light's entry has "frame" and "rotation" [x, y, z]: the rotation vector θ (radians,
+// axis·angle, in that frame) that turns the probe as world_from_env ← exp([θ]×)·world_from_env
+// (camera-fixed: cam_from_env ← exp([θ]×)·cam_from_env). Readers that do not know these keys
+// ignore them (the format name stays).
 #ifndef SFT_IO_LIGHT_SCALES_H_
 #define SFT_IO_LIGHT_SCALES_H_
 
@@ -22,19 +26,22 @@ namespace sft {
 
 // `positions`: empty, or one per dataset light (each point light's in its frame; the entries of
 // other lights are not written). `directions` the same for directional lights (normalized on
-// writing).
+// writing), `rotations` for environment lights.
 Status WriteLightScales(const std::string& path, const Dataset& dataset,
                         const std::vector<double>& scales,
                         const std::vector<Eigen::Vector3d>& positions = {},
-                        const std::vector<Eigen::Vector3d>& directions = {});
+                        const std::vector<Eigen::Vector3d>& directions = {},
+                        const std::vector<Eigen::Vector3d>& rotations = {});
 // Reads scales for `dataset`'s lights (every dataset light must be listed, by id; scales finite
 // and > 0). With `positions`: empty when no entry has a position, else one per dataset light,
 // the file's where it has one (a point light's only, its frame must be the dataset light's) and
-// the dataset's elsewhere. The same with `directions` for directional lights' "direction". Errors
-// name the file and the entry.
+// the dataset's elsewhere. The same with `directions` for directional lights' "direction" and
+// `rotations` for environment lights' "rotation" (0 where the file has none). Errors name the
+// file and the entry.
 Status ReadLightScales(const std::string& path, const Dataset& dataset, std::vector<double>* scales,
                        std::vector<Eigen::Vector3d>* positions = nullptr,
-                       std::vector<Eigen::Vector3d>* directions = nullptr);
+                       std::vector<Eigen::Vector3d>* directions = nullptr,
+                       std::vector<Eigen::Vector3d>* rotations = nullptr);
 // Multiplies the dataset's light intensities (point), irradiances (directional) and scales
 // (environment) by `scales`.
 void ApplyLightScales(const std::vector<double>& scales, Dataset* dataset);
@@ -43,8 +50,11 @@ void ApplyLightPositions(const std::vector<Eigen::Vector3d>& positions, Dataset*
 // Sets the dataset's directional-light directions (in their frames, normalized) to `directions`
 // (empty: no change).
 void ApplyLightDirections(const std::vector<Eigen::Vector3d>& directions, Dataset* dataset);
-// Reads lights file `path` (ReadLightScales) and applies its scales, positions and directions to
-// the dataset's lights: renders then reproduce the fit.
+// Turns the dataset's environment lights by `rotations` (rotation vectors in their frames:
+// world_from_env ← exp([θ]×)·world_from_env; empty: no change).
+void ApplyEnvironmentRotations(const std::vector<Eigen::Vector3d>& rotations, Dataset* dataset);
+// Reads lights file `path` (ReadLightScales) and applies its scales, positions, directions and
+// rotations to the dataset's lights: renders then reproduce the fit.
 Status ApplyLightsFile(const std::string& path, Dataset* dataset);
 
 }  // namespace sft

@@ -89,6 +89,8 @@ Status MakeDatasetViews(const Dataset& dataset, DatasetViews* out) {
         out->view_environments[v] = std::make_unique<EnvironmentMap>(
             probes[l], ViewWorldFromEnv(light, spec.cam_from_world), light.scale);
         view.environment = out->view_environments[v].get();
+        // Its rotation parameters turn the map in the camera frame: δ_world = Rᵀ·θ.
+        view.environment_rotation_jacobian = world_from_cam.rotation.toRotationMatrix();
       } else {
         if (out->environments[l] == nullptr) {
           out->environments[l] =

@@ -268,6 +268,7 @@ const std::map<std::string, Key>& Keys() {
       {"fit_lights", Bool([](O* o) -> bool& { return o->fit_lights; })},
       {"fit_light_positions", Bool([](O* o) -> bool& { return o->fit_light_positions; })},
       {"fit_light_directions", Bool([](O* o) -> bool& { return o->fit_light_directions; })},
+      {"fit_environment_rotation", Bool([](O* o) -> bool& { return o->fit_environment_rotation; })},
       {"fit_exposure", Bool([](O* o) -> bool& { return o->fit_exposure; })},
       {"exposure_prior",
        Real([](O* o) -> double& { return o->regularizers.exposure_prior; }, 0, 1e12)},

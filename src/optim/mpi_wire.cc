@@ -106,6 +106,7 @@ std::vector<std::vector<char> > StateParts(const RenderState& s) {
   settings.PutVector(s.light_scales);
   settings.PutVector(s.light_positions);
   settings.PutVector(s.light_directions);
+  settings.PutVector(s.environment_rotations);
   PutRenderOptions(s.render, &settings);
   PutRequest(s.request, &settings);
   settings.Put(s.layout);
@@ -142,6 +143,7 @@ void ApplyStatePart(int part, const std::vector<char>& bytes, RenderState* s) {
       s->light_scales = r.GetVector<double>();
       s->light_positions = r.GetVector<Eigen::Vector3d>();
       s->light_directions = r.GetVector<Eigen::Vector3d>();
+      s->environment_rotations = r.GetVector<Eigen::Vector3d>();
       s->render = GetRenderOptions(&r);
       s->request = GetRequest(&r);
       s->layout = r.Get<ParameterLayout>();

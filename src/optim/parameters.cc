@@ -18,6 +18,10 @@ bool ParameterBounds::Check(std::string* why) const {
     *why = "light_scale_min/light_scale_max: need 0 < min < max < infinity";
     return false;
   }
+  if (!(environment_rotation_max > 0.0 && environment_rotation_max <= M_PI)) {
+    *why = "environment_rotation_max: must be in (0, pi]";
+    return false;
+  }
   if (!(environment_max > 0.0 && std::isfinite(environment_max))) {
     *why = "environment_max: must be finite and > 0";
     return false;
@@ -39,6 +43,7 @@ ParameterSelection ActiveParameters::ToSelection() const {
   selection.environment = environment;
   selection.light_positions = light_positions;
   selection.light_directions = light_directions;
+  selection.environment_rotations = environment_rotations;
   return selection;
 }
 
@@ -91,16 +96,34 @@ SceneParameters::SceneParameters(const std::vector<Eigen::Vector3d>& positions,
   }
 }
 
+bool& SceneParameters::LightVectorsPresent(ParameterKind kind) {
+  if (kind == ParameterKind::kLightPosition) return layout_.light_positions;
+  if (kind == ParameterKind::kLightDirection) return layout_.light_directions;
+  CHECK(kind == ParameterKind::kEnvironmentRotation);
+  return layout_.environment_rotations;
+}
+
+bool SceneParameters::HasLightVectors(ParameterKind kind) const {
+  if (kind == ParameterKind::kLightPosition) return layout_.light_positions;
+  if (kind == ParameterKind::kLightDirection) return layout_.light_directions;
+  return layout_.environment_rotations;
+}
+
+int SceneParameters::LightVectorsOffset(ParameterKind kind) const {
+  if (kind == ParameterKind::kLightPosition) return layout_.LightPositionOffset();
+  if (kind == ParameterKind::kLightDirection) return layout_.LightDirectionOffset();
+  return layout_.EnvironmentRotationOffset();
+}
+
 void SceneParameters::AddLightVectors(const std::vector<Eigen::Vector3d>& vectors,
-                                      bool directions) {
+                                      ParameterKind kind) {
   CHECK_EQ(static_cast<int>(vectors.size()), layout_.num_lights);
   std::vector<double> packed(3 * vectors.size());
   for (size_t l = 0; l < vectors.size(); ++l) {
     for (int k = 0; k < 3; ++k) packed[3 * l + k] = vectors[l][k];
   }
-  bool& present = directions ? layout_.light_directions : layout_.light_positions;
-  const auto first = values_.begin() +
-                     (directions ? layout_.LightDirectionOffset() : layout_.LightPositionOffset());
+  bool& present = LightVectorsPresent(kind);
+  const auto first = values_.begin() + LightVectorsOffset(kind);
   if (present) {
     std::copy(packed.begin(), packed.end(), first);
     return;
@@ -110,10 +133,10 @@ void SceneParameters::AddLightVectors(const std::vector<Eigen::Vector3d>& vector
   present = true;
 }
 
-std::vector<Eigen::Vector3d> SceneParameters::LightVectors(bool directions) const {
+std::vector<Eigen::Vector3d> SceneParameters::LightVectors(ParameterKind kind) const {
   std::vector<Eigen::Vector3d> vectors;
-  if (!(directions ? layout_.light_directions : layout_.light_positions)) return vectors;
-  const int offset = directions ? layout_.LightDirectionOffset() : layout_.LightPositionOffset();
+  if (!HasLightVectors(kind)) return vectors;
+  const int offset = LightVectorsOffset(kind);
   for (int l = 0; l < layout_.num_lights; ++l) {
     const double* p = &values_[offset + 3 * l];
     vectors.emplace_back(p[0], p[1], p[2]);
@@ -165,6 +188,10 @@ std::vector<BlockSpan> SceneParameters::Blocks() const {
   for (int l = 0; layout_.light_directions && l < layout_.num_lights; ++l) {
     blocks.push_back({layout_.LightDirectionOffset() + 3 * l, 3, ParameterKind::kLightDirection});
   }
+  for (int l = 0; layout_.environment_rotations && l < layout_.num_lights; ++l) {
+    blocks.push_back(
+        {layout_.EnvironmentRotationOffset() + 3 * l, 3, ParameterKind::kEnvironmentRotation});
+  }
   for (int v = 0; v < num_gain_views_; ++v) {
     blocks.push_back({GainIndex(v, 0), 3, ParameterKind::kLight, /*exposure=*/true});
   }
@@ -201,6 +228,10 @@ BlockSpan SceneParameters::BlockOf(int index) const {
     case ParameterKind::kLightDirection: {
       const int local = index - layout_.LightDirectionOffset();
       return {index - local % 3, 3, ParameterKind::kLightDirection};
+    }
+    case ParameterKind::kEnvironmentRotation: {
+      const int local = index - layout_.EnvironmentRotationOffset();
+      return {index - local % 3, 3, ParameterKind::kEnvironmentRotation};
     }
   }
   return {index, 1, ParameterKind::kLight};
@@ -244,6 +275,8 @@ double SceneParameters::Lower(int index, const ParameterBounds& bounds) const {
       return bounds.light_scale_min;
     case ParameterKind::kEnvironment:
       return 0.0;
+    case ParameterKind::kEnvironmentRotation:
+      return -bounds.environment_rotation_max;
   }
   return 0.0;
 }
@@ -259,6 +292,8 @@ double SceneParameters::Upper(int index, const ParameterBounds& bounds) const {
       return bounds.light_scale_max;
     case ParameterKind::kEnvironment:
       return bounds.environment_max;
+    case ParameterKind::kEnvironmentRotation:
+      return bounds.environment_rotation_max;
     default:
       return 1.0;
   }

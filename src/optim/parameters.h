@@ -5,13 +5,14 @@
 // AddLightPositions three position coordinates per dataset light (a point light's position in its
 // own frame: world, or the camera frame for a flash; ParameterLayout::light_positions), with
 // AddLightDirections three direction numbers per dataset light (ParameterLayout::
-// light_directions) —
+// light_directions), with AddEnvironmentRotations a rotation vector per dataset light
+// (ParameterLayout::environment_rotations) —
 // followed by the fit-only exposure gains: 3 per fitted view (R, G, B), which multiply that view's
 // rendered image before the residual (the renderer never sees them; docs/reconstruct.md,
 // "Exposure and white balance"). Ceres parameter blocks point into this vector: one block per
 // vertex (3), per albedo texel (3), per roughness texel (1), the specular weight (1), each light
-// scale (1), each environment texel (3), each light position (3), each light direction (3) and
-// each view's gains (3), so
+// scale (1), each environment texel (3), each light position (3), each light direction (3), each
+// environment rotation (3) and each view's gains (3), so
 // the mapping between Ceres
 // blocks and indices is the block's offset in the vector.
 #ifndef SFT_OPTIM_PARAMETERS_H_
@@ -45,6 +46,10 @@ struct ParameterBounds {
   // Fitted environment texels (linear radiance) stay in [0, environment_max]: the renderer
   // clamps negative texels to 0, and a texel beyond the bound means a runaway fit.
   double environment_max = 1e6;
+  // Each component of an environment's rotation vector (ParameterLayout::environment_rotations)
+  // stays in [−max, max], radians: a refinement of a given alignment by a few degrees, not a
+  // search (0.1 rad ≈ 5.7°; docs/reconstruct.md, "Probe rotation").
+  double environment_rotation_max = 0.1;
 
   bool Check(std::string* why) const;
 };
@@ -60,13 +65,14 @@ struct ActiveParameters {
   bool environment = false;      // the fitted environment's texels (when the parameters have them).
   bool light_positions = false;  // point-light positions (when the parameters have them).
   bool light_directions = false;  // directional-light directions (when the parameters have them).
+  bool environment_rotations = false;  // environment rotations (when the parameters have them).
 
   // The renderer's kinds (exposure gains are applied by the render cache, not the renderer).
   ParameterSelection ToSelection() const;
   bool Includes(ParameterKind kind) const;
   bool Any() const {
     return vertices || albedo || roughness || specular || lights || exposure || environment ||
-           light_positions || light_directions;
+           light_positions || light_directions || environment_rotations;
   }
 };
 
@@ -124,19 +130,33 @@ class SceneParameters {
   // `positions` (one per dataset light, each in its light's frame; entries of lights that are
   // not point lights are kept but get no derivatives). The exposure gains keep their values.
   void AddLightPositions(const std::vector<Eigen::Vector3d>& positions) {
-    AddLightVectors(positions, /*directions=*/false);
+    AddLightVectors(positions, ParameterKind::kLightPosition);
   }
   bool has_light_positions() const { return layout_.light_positions; }
   // The lights' position parameters, one per dataset light (empty without them).
-  std::vector<Eigen::Vector3d> LightPositions() const { return LightVectors(false); }
+  std::vector<Eigen::Vector3d> LightPositions() const {
+    return LightVectors(ParameterKind::kLightPosition);
+  }
   // The same for directional lights' directions (ParameterLayout::light_directions): three
   // numbers v per dataset light in its frame, the light travelling along v/|v| (entries of lights
   // that are not directional are kept but get no derivatives).
   void AddLightDirections(const std::vector<Eigen::Vector3d>& directions) {
-    AddLightVectors(directions, /*directions=*/true);
+    AddLightVectors(directions, ParameterKind::kLightDirection);
   }
   bool has_light_directions() const { return layout_.light_directions; }
-  std::vector<Eigen::Vector3d> LightDirections() const { return LightVectors(true); }
+  std::vector<Eigen::Vector3d> LightDirections() const {
+    return LightVectors(ParameterKind::kLightDirection);
+  }
+  // The same for environments' rotation vectors (ParameterLayout::environment_rotations, radians,
+  // in each environment's frame; entries of lights that are not environments are kept but get no
+  // derivatives).
+  void AddEnvironmentRotations(const std::vector<Eigen::Vector3d>& rotations) {
+    AddLightVectors(rotations, ParameterKind::kEnvironmentRotation);
+  }
+  bool has_environment_rotations() const { return layout_.environment_rotations; }
+  std::vector<Eigen::Vector3d> EnvironmentRotations() const {
+    return LightVectors(ParameterKind::kEnvironmentRotation);
+  }
 
   // Current state, for rendering and output. `material` must have the layout's texel counts;
   // its fresnel mode and resolutions are kept.
@@ -151,16 +171,21 @@ class SceneParameters {
   int environment_height() const { return environment_height_; }
 
   // Lower/upper bound of parameter `index` (±infinity for vertices, light positions and
-  // directions).
+  // directions; ±environment_rotation_max for environment rotations).
   double Lower(int index, const ParameterBounds& bounds) const;
   double Upper(int index, const ParameterBounds& bounds) const;
   // Clamps every value into the bounds (projection onto the feasible set).
   void Project(const ParameterBounds& bounds, std::vector<double>* values) const;
 
  private:
-  // AddLightPositions (`directions` false) or AddLightDirections, and their getters.
-  void AddLightVectors(const std::vector<Eigen::Vector3d>& vectors, bool directions);
-  std::vector<Eigen::Vector3d> LightVectors(bool directions) const;
+  // AddLightPositions, AddLightDirections or AddEnvironmentRotations (`kind`: their kind), and
+  // their getters.
+  void AddLightVectors(const std::vector<Eigen::Vector3d>& vectors, ParameterKind kind);
+  std::vector<Eigen::Vector3d> LightVectors(ParameterKind kind) const;
+  // The layout's flag and first index of `kind`'s three numbers per light.
+  bool& LightVectorsPresent(ParameterKind kind);
+  bool HasLightVectors(ParameterKind kind) const;
+  int LightVectorsOffset(ParameterKind kind) const;
 
   ParameterLayout layout_;
   int num_gain_views_ = 0;

@@ -27,6 +27,7 @@ ActiveParameters TexturePhase(const ReconstructOptions& options) {
   active.lights = options.fit_lights;
   active.light_positions = options.fit_light_positions;
   active.light_directions = options.fit_light_directions;
+  active.environment_rotations = options.fit_environment_rotation;
   active.exposure = options.fit_exposure;
   active.environment = options.fit_environment;
   return active;
@@ -67,6 +68,34 @@ Status AddLightGeometry(const Dataset& dataset, const ReconstructOptions& option
       params->AddLightPositions(start);
     }
   }
+  return Status::Ok();
+}
+
+// Environment rotations are parameters whenever an earlier fit turned a probe (`rotations` not
+// empty) or this fit refines them (starting at 0, the dataset's alignment). Only given probes
+// have an alignment to refine: a fitted environment's texels are the map in its own frame.
+Status AddEnvironmentRotations(const Dataset& dataset, const ReconstructOptions& options,
+                               const std::vector<Eigen::Vector3d>& rotations,
+                               SceneParameters* params) {
+  if (!options.fit_environment_rotation && rotations.empty()) return Status::Ok();
+  const size_t num_lights = dataset.lights.size();
+  if (!rotations.empty() && rotations.size() != num_lights) {
+    return Status::Error("environment rotations: " + std::to_string(rotations.size()) +
+                         " given, the dataset has " + std::to_string(num_lights) + " lights");
+  }
+  if (FittedEnvironmentLight(dataset) >= 0) {
+    return Status::Error(
+        "fit_environment_rotation: the lighting is unknown (a fitted environment); only a given "
+        "probe's alignment can be refined");
+  }
+  bool any_probe = false;
+  for (const LightSpec& light : dataset.lights) any_probe |= light.type == LightType::kEnvironment;
+  if (!any_probe) {
+    return Status::Error("fit_environment_rotation: the dataset has no environment light");
+  }
+  params->AddEnvironmentRotations(
+      rotations.empty() ? std::vector<Eigen::Vector3d>(num_lights, Eigen::Vector3d::Zero())
+                        : rotations);
   return Status::Ok();
 }
 
@@ -152,7 +181,8 @@ Status Reconstruction::Create(const Dataset& dataset, const TriMesh& mesh, const
                               const std::vector<Eigen::Vector3d>& view_gains,
                               const Image& environment,
                               const std::vector<Eigen::Vector3d>& light_positions,
-                              const std::vector<Eigen::Vector3d>& light_directions) {
+                              const std::vector<Eigen::Vector3d>& light_directions,
+                              const std::vector<Eigen::Vector3d>& environment_rotations) {
   std::string why;
   if (!options.Check(&why)) return Status::Error(why);
   std::unique_ptr<Reconstruction> r(new Reconstruction());
@@ -201,6 +231,8 @@ Status Reconstruction::Create(const Dataset& dataset, const TriMesh& mesh, const
   }
   SFT_RETURN_IF_ERROR(
       AddLightGeometry(dataset, options, light_positions, light_directions, &r->params_));
+  SFT_RETURN_IF_ERROR(
+      AddEnvironmentRotations(dataset, options, environment_rotations, &r->params_));
   SFT_RETURN_IF_ERROR(RenderCache::Create(dataset, &r->views_, views, r->faces_, material,
                                           &r->params_, r->options_.cache, &r->cache_));
   r->start_time_ = NowSeconds();

@@ -46,6 +46,10 @@ struct ReconstructOptions {
   // The texture phase also fits the directional lights' directions (3 numbers v per light in its
   // frame, the light travelling along v/|v|; docs/reconstruct.md, "Fitted directional lights").
   bool fit_light_directions = false;
+  // The texture phase also refines the rotation of each given probe (environment light): a
+  // rotation vector θ per probe, radians, in its frame, 0 at the dataset's alignment and bounded
+  // by ParameterBounds::environment_rotation_max (docs/reconstruct.md, "Probe rotation").
+  bool fit_environment_rotation = false;
   // The texture phase also fits per-view exposure gains (3 per fitted view, the first fitted view
   // the fixed gauge; src/optim/parameters.h, kExposureGaugeView).
   bool fit_exposure = false;
@@ -98,7 +102,8 @@ class Reconstruction {
                        const std::vector<Eigen::Vector3d>& view_gains = {},
                        const Image& environment = Image(),
                        const std::vector<Eigen::Vector3d>& light_positions = {},
-                       const std::vector<Eigen::Vector3d>& light_directions = {});
+                       const std::vector<Eigen::Vector3d>& light_directions = {},
+                       const std::vector<Eigen::Vector3d>& environment_rotations = {});
 
   // Runs the effect planner for outer iteration `outer` (its renders use the chosen plan from
   // now on). The ceiling is the configured effects and budgets; `image_signal_scale` and
@@ -120,6 +125,11 @@ class Reconstruction {
   // The directional lights' direction parameters per dataset light (empty when they are not
   // parameters).
   std::vector<Eigen::Vector3d> LightDirections() const { return params_.LightDirections(); }
+  // The environments' rotation parameters per dataset light (empty when they are not
+  // parameters).
+  std::vector<Eigen::Vector3d> EnvironmentRotations() const {
+    return params_.EnvironmentRotations();
+  }
   // The fitted environment's texels (empty without one).
   Image EnvironmentTexels() const { return params_.EnvironmentTexels(); }
   // The exposure gains per dataset view: the fitted views' current ones, the others' as given to

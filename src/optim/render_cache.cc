@@ -232,6 +232,7 @@ void RenderCache::UpdateScene() {
     fitted_environment_.Update(params_->EnvironmentTexels(), *dataset_,
                                params_->layout().environment_light);
   }
+  rotated_environments_.Update(params_->EnvironmentRotations(), *views_);
 }
 
 ViewSetup RenderCache::ScaledView(int v) const {
@@ -239,6 +240,7 @@ ViewSetup RenderCache::ScaledView(int v) const {
       ScaledViewSetup(*views_, view_indices_[v], options_.image_scale_log2, params_->LightScales(),
                       params_->LightPositions(), params_->LightDirections());
   UseFittedEnvironment(params_->layout(), fitted_environment_, view_indices_[v], &view);
+  rotated_environments_.Use(view_indices_[v], &view);
   return view;
 }
 
@@ -261,6 +263,7 @@ RenderState RenderCache::CurrentState(const RenderOptions& render,
   state.light_scales = params_->LightScales();
   state.light_positions = params_->LightPositions();
   state.light_directions = params_->LightDirections();
+  state.environment_rotations = params_->EnvironmentRotations();
   state.render = render;
   state.request = request;
   state.layout = params_->layout();

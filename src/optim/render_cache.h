@@ -233,6 +233,7 @@ class RenderCache : public ceres::EvaluationCallback {
   // views of that light render with instead of the dataset's, rebuilt when its texels change.
   // The maps of the fitted environment's texels (SceneParameters::EnvironmentTexels).
   FittedEnvironmentMaps fitted_environment_;
+  RotatedEnvironmentMaps rotated_environments_;  // given probes turned by their fitted rotations.
   // The scene's identity for other ranks (RenderState::scene_id), its faces and first positions.
   int64_t scene_id_ = 0;
   std::vector<Eigen::Vector3i> faces_;

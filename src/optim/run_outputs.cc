@@ -136,7 +136,8 @@ Status ReadRunState(const std::string& out, RunState* state) {
 Status WriteRunSnapshot(const std::string& out, const Dataset& dataset, const TriMesh& mesh,
                         const Material& material, const std::vector<double>& light_scales,
                         const std::vector<Eigen::Vector3d>& light_positions,
-                        const std::vector<Eigen::Vector3d>& light_directions) {
+                        const std::vector<Eigen::Vector3d>& light_directions,
+                        const std::vector<Eigen::Vector3d>& environment_rotations) {
   SFT_RETURN_IF_ERROR(WriteMesh(JoinPath(out, "mesh.ply"), mesh));
   if (material.has_uv_textures()) {
     // UV textures: mesh.obj carries the corner UVs that material.json's "uv_mesh" names.
@@ -151,18 +152,19 @@ Status WriteRunSnapshot(const std::string& out, const Dataset& dataset, const Tr
   std::vector<double> scales = light_scales;
   if (scales.empty()) scales.assign(dataset.lights.size(), 1.0);
   return WriteLightScales(JoinPath(out, "lights.json"), dataset, scales, light_positions,
-                          light_directions);
+                          light_directions, environment_rotations);
 }
 
 Status ReadRunSnapshot(const std::string& out, const Dataset& dataset, TriMesh* mesh,
                        Material* material, std::vector<double>* light_scales,
                        std::vector<Eigen::Vector3d>* light_positions,
-                       std::vector<Eigen::Vector3d>* light_directions) {
+                       std::vector<Eigen::Vector3d>* light_directions,
+                       std::vector<Eigen::Vector3d>* environment_rotations) {
   SFT_RETURN_IF_ERROR(ReadMesh(JoinPath(out, "mesh.ply"), mesh));
   SFT_RETURN_IF_ERROR(
       LoadMaterial(JoinPath(out, "material.json"), *mesh, material, MaterialUse::kCheckpoint));
   return ReadLightScales(JoinPath(out, "lights.json"), dataset, light_scales, light_positions,
-                         light_directions);
+                         light_directions, environment_rotations);
 }
 
 Status WriteExposure(const std::string& out, const Dataset& dataset,

@@ -56,15 +56,17 @@ Status ReadRunState(const std::string& out, RunState* state);
 // mesh.ply, mesh.obj, material.json (+ .mc files), lights.json.
 // `light_positions`: the fitted point-light positions (empty: none fitted; lights.json then has
 // no positions and ReadRunSnapshot returns them empty); `light_directions` the same for the
-// fitted directional-light directions.
+// fitted directional-light directions and `environment_rotations` the fitted probe rotations.
 Status WriteRunSnapshot(const std::string& out, const Dataset& dataset, const TriMesh& mesh,
                         const Material& material, const std::vector<double>& light_scales,
                         const std::vector<Eigen::Vector3d>& light_positions = {},
-                        const std::vector<Eigen::Vector3d>& light_directions = {});
+                        const std::vector<Eigen::Vector3d>& light_directions = {},
+                        const std::vector<Eigen::Vector3d>& environment_rotations = {});
 Status ReadRunSnapshot(const std::string& out, const Dataset& dataset, TriMesh* mesh,
                        Material* material, std::vector<double>* light_scales,
                        std::vector<Eigen::Vector3d>* light_positions = nullptr,
-                       std::vector<Eigen::Vector3d>* light_directions = nullptr);
+                       std::vector<Eigen::Vector3d>* light_directions = nullptr,
+                       std::vector<Eigen::Vector3d>* environment_rotations = nullptr);
 
 // exposure.json: {"format": "sft-exposure/1", "gauge_view": G, "views": [{"view": i, "image":
 // its image path in the dataset, "gains": [R, G, B]}, ...]} for every dataset view; gains

@@ -155,7 +155,8 @@ Status Schedule::Resume(const Dataset& dataset, const std::string& out,
   }
   SFT_RETURN_IF_ERROR(ReadRunSnapshot(out, dataset, &s->current_.mesh, &s->current_.material,
                                       &s->current_.light_scales, &s->current_.light_positions,
-                                      &s->current_.light_directions));
+                                      &s->current_.light_directions,
+                                      &s->current_.environment_rotations));
   if (!view_gains.empty() && view_gains.size() != dataset.views.size()) {
     return Status::Error(JoinPath(out, "state.json") +
                          ": exposure_gains: " + std::to_string(view_gains.size()) +
@@ -201,10 +202,10 @@ double Schedule::Elapsed() const { return seconds_at_start_ + NowSeconds() - ses
 
 Status Schedule::CreateReconstruction() {
   const StageOptions& stage = stages_[progress_.stage];
-  SFT_RETURN_IF_ERROR(Reconstruction::Create(*dataset_, current_.mesh, current_.material,
-                                             current_.light_scales, stage.fit, &reconstruction_,
-                                             current_.view_gains, current_.environment,
-                                             current_.light_positions, current_.light_directions));
+  SFT_RETURN_IF_ERROR(Reconstruction::Create(
+      *dataset_, current_.mesh, current_.material, current_.light_scales, stage.fit,
+      &reconstruction_, current_.view_gains, current_.environment, current_.light_positions,
+      current_.light_directions, current_.environment_rotations));
   reconstruction_->elapsed_offset = Elapsed();
   reconstruction_stage_ = progress_.stage;
   phases_seen_ = 0;
@@ -243,6 +244,8 @@ void Schedule::SyncCurrent() {
   if (!light_positions.empty()) current_.light_positions = std::move(light_positions);
   std::vector<Eigen::Vector3d> light_directions = reconstruction_->LightDirections();
   if (!light_directions.empty()) current_.light_directions = std::move(light_directions);
+  std::vector<Eigen::Vector3d> rotations = reconstruction_->EnvironmentRotations();
+  if (!rotations.empty()) current_.environment_rotations = std::move(rotations);
   current_.view_gains = reconstruction_->ViewGains();
   Image environment = reconstruction_->EnvironmentTexels();
   if (!environment.empty()) current_.environment = std::move(environment);
@@ -483,6 +486,31 @@ Status Schedule::PlanEffects(const ScheduleCallbacks& callbacks, json* record) {
   return Status::Ok();
 }
 
+namespace {
+
+// One console line per environment light of a fitted rotation: the angle and axis (in the
+// probe's frame) it is turned by from the dataset's alignment.
+std::vector<std::string> ProbeRotationLines(const Dataset& dataset,
+                                            const std::vector<Eigen::Vector3d>& rotations) {
+  std::vector<std::string> lines;
+  for (size_t l = 0; l < rotations.size() && l < dataset.lights.size(); ++l) {
+    if (dataset.lights[l].type != LightType::kEnvironment) continue;
+    const Eigen::Vector3d& theta = rotations[l];
+    const double angle = theta.norm();
+    const Eigen::Vector3d axis =
+        angle > 0.0 ? Eigen::Vector3d(theta / angle) : Eigen::Vector3d::UnitZ();
+    char line[256];
+    std::snprintf(line, sizeof(line),
+                  "probe \"%s\" turned %.3f deg about (%.3f, %.3f, %.3f) (%s frame)",
+                  dataset.lights[l].id.c_str(), angle * 180.0 / M_PI, axis.x(), axis.y(), axis.z(),
+                  dataset.lights[l].frame == LightFrame::kCamera ? "camera" : "world");
+    lines.push_back(line);
+  }
+  return lines;
+}
+
+}  // namespace
+
 Status Schedule::RunStageOuter(const ScheduleCallbacks& callbacks, bool* stop) {
   const StageOptions& stage = stages_[progress_.stage];
   const int outer = progress_.outer_done;
@@ -497,6 +525,11 @@ Status Schedule::RunStageOuter(const ScheduleCallbacks& callbacks, bool* stop) {
     return go_on;
   }));
   SyncCurrent();
+  if (callbacks.on_event && stage.fit.fit_environment_rotation) {
+    for (const std::string& line : ProbeRotationLines(*dataset_, current_.environment_rotations)) {
+      callbacks.on_event(stage.name + ": " + line);
+    }
+  }
   json untangled;
   if (!*stop && stage.topology.untangle && stage.fit.phases != PhaseSchedule::kTexture) {
     SFT_RETURN_IF_ERROR(UntangleCurrent(callbacks, &untangled));
@@ -529,7 +562,7 @@ Status Schedule::Checkpoint() {
   progress_.seconds = Elapsed();
   SFT_RETURN_IF_ERROR(WriteRunSnapshot(out_, *dataset_, current_.mesh, current_.material,
                                        current_.light_scales, current_.light_positions,
-                                       current_.light_directions));
+                                       current_.light_directions, current_.environment_rotations));
   if (!current_.environment.empty()) {
     const LightSpec& light = dataset_->lights.at(FittedEnvironmentLight(*dataset_));
     SFT_RETURN_IF_ERROR(WriteFittedEnvironment(out_, current_.environment, light.frame));

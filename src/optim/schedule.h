@@ -81,6 +81,9 @@ struct ScheduleStart {
   // Fitted directional-light directions per dataset light, in each light's frame (lights.json);
   // empty = the dataset's (none fitted yet).
   std::vector<Eigen::Vector3d> light_directions;
+  // Fitted probe rotations per dataset light (rotation vectors, radians, in each environment's
+  // frame; lights.json); empty = the dataset's alignment (none fitted yet).
+  std::vector<Eigen::Vector3d> environment_rotations;
   // Exposure gains per dataset view (src/optim/parameters.h); empty = all 1.
   std::vector<Eigen::Vector3d> view_gains;
   // The fitted environment's texels (unknown lighting, src/optim/fitted_environment.h); empty =

@@ -24,6 +24,7 @@ Status StateRenderer::Update(const RenderState& state) {
     scene_positions_ = state.positions;
   }
   if (state.layout.num_environment_texels > 0) SFT_RETURN_IF_ERROR(UpdateEnvironment(state));
+  rotated_environments_.Update(state.environment_rotations, views_);
   return Status::Ok();
 }
 
@@ -51,6 +52,7 @@ void StateRenderer::Render(const RenderState& state, const ViewJob& job, ViewRes
       ScaledViewSetup(views_, state.view_indices[job.view], state.image_scale_log2,
                       state.light_scales, state.light_positions, state.light_directions);
   UseFittedEnvironment(state.layout, fitted_environment_, state.view_indices[job.view], &view);
+  rotated_environments_.Use(state.view_indices[job.view], &view);
   RenderViewJob(*scene_, state.material, view, state.render, state.request, state.layout, job,
                 result);
 }

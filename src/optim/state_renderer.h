@@ -44,7 +44,8 @@ class StateRenderer {
   std::unique_ptr<RenderScene> scene_;
   int64_t scene_id_ = -1;
   std::vector<Eigen::Vector3d> scene_positions_;
-  FittedEnvironmentMaps fitted_environment_;  // the maps of the state's environment texels.
+  FittedEnvironmentMaps fitted_environment_;     // the maps of the state's environment texels.
+  RotatedEnvironmentMaps rotated_environments_;  // given probes turned by the state's rotations.
 };
 
 }  // namespace sft

@@ -60,6 +60,48 @@ void FittedEnvironmentMaps::Update(const Image& texels, const Dataset& dataset, 
   texels_ = texels;
 }
 
+void RotatedEnvironmentMaps::Update(const std::vector<Eigen::Vector3d>& rotations,
+                                    const DatasetViews& views) {
+  if (rotations == rotations_ && maps_.size() == views.views.size()) return;
+  rotations_ = rotations;
+  maps_.assign(views.views.size(), nullptr);
+  jacobians_.assign(views.views.size(), Eigen::Matrix3d::Identity());
+  if (rotations.empty()) return;
+  // World-fixed probes are turned once and shared, as MakeDatasetViews shares them.
+  std::vector<std::shared_ptr<const EnvironmentMap>> shared(views.environments.size());
+  for (size_t v = 0; v < views.views.size(); ++v) {
+    const ViewSetup& view = views.views[v];
+    const int light = view.environment_light_index;
+    if (view.environment == nullptr || light < 0) continue;
+    const Eigen::Vector3d& theta = rotations.at(light);
+    const Eigen::Matrix3d turn = RotationFromVector(theta);
+    const Eigen::Matrix3d left = RotationLeftJacobian(theta);
+    if (views.view_environments[v] != nullptr) {
+      // Camera-fixed: cam_from_env ← exp([θ]×)·cam_from_env, i.e. the world turn Rᵀ·exp([θ]×)·R.
+      const Eigen::Matrix3d world_from_cam =
+          view.cam_from_world.rotation.conjugate().toRotationMatrix();
+      maps_[v] = std::make_shared<const EnvironmentMap>(
+          view.environment->Rotated(world_from_cam * turn * world_from_cam.transpose()));
+      jacobians_[v] = world_from_cam * left;
+      continue;
+    }
+    if (shared.at(light) == nullptr) {
+      shared[light] = std::make_shared<const EnvironmentMap>(view.environment->Rotated(turn));
+    }
+    maps_[v] = shared[light];
+    jacobians_[v] = left;
+  }
+}
+
+void RotatedEnvironmentMaps::Use(int dataset_view, ViewSetup* view) const {
+  if (rotations_.empty() || dataset_view < 0 || dataset_view >= static_cast<int>(maps_.size()) ||
+      maps_[dataset_view] == nullptr) {
+    return;
+  }
+  view->environment = maps_[dataset_view].get();
+  view->environment_rotation_jacobian = jacobians_[dataset_view];
+}
+
 const EnvironmentMap* FittedEnvironmentMaps::ForView(int dataset_view) const {
   if (maps_.empty()) return nullptr;
   if (!per_view_) return maps_[0].get();

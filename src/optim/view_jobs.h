@@ -15,6 +15,7 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <vector>
 
 #include "src/core/image.h"
@@ -67,6 +68,10 @@ struct RenderState {
   // Fitted directional-light directions per dataset light (v, the light travelling along v/|v|
   // in its frame); empty = the dataset's (SceneParameters::LightDirections).
   std::vector<Eigen::Vector3d> light_directions;
+  // Fitted environment rotations per dataset light (rotation vectors in radians, in each
+  // environment's frame); empty = the dataset's alignment (SceneParameters::
+  // EnvironmentRotations).
+  std::vector<Eigen::Vector3d> environment_rotations;
   RenderOptions render;       // spp, bounces, effects, threads, shading.
   DerivativeRequest request;  // derivative kinds and edge budgets (no weights).
   // The index space of rows and gradients (SceneParameters::layout): vertices, texels, lights
@@ -106,6 +111,25 @@ class FittedEnvironmentMaps {
   Image texels_;
   bool per_view_ = false;
   std::vector<std::unique_ptr<EnvironmentMap>> maps_;  // one, or one per dataset view.
+};
+
+// The renderer's maps of given probes turned by their fitted rotations θ (ParameterLayout::
+// environment_rotations): a world-fixed probe's map turned by exp([θ]×) once, a camera-fixed
+// probe's per view by Rᵀ·exp([θ]×)·R (R the view's cam_from_world rotation).
+class RotatedEnvironmentMaps {
+ public:
+  // Rebuilds the maps when `rotations` (one per dataset light; empty: none) differ from the last
+  // call's, from the dataset's maps in `views`.
+  void Update(const std::vector<Eigen::Vector3d>& rotations, const DatasetViews& views);
+  // Makes dataset view `dataset_view`'s setup render with its environment turned, and sets its
+  // ViewSetup::environment_rotation_jacobian; nothing without rotations.
+  void Use(int dataset_view, ViewSetup* view) const;
+
+ private:
+  std::vector<Eigen::Vector3d> rotations_;
+  // Per dataset view: its turned map (null when it has no environment) and the Jacobian.
+  std::vector<std::shared_ptr<const EnvironmentMap>> maps_;
+  std::vector<Eigen::Matrix3d> jacobians_;
 };
 
 // Makes dataset view `dataset_view`'s setup render with the fitted environment (the maps of the

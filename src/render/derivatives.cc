@@ -13,7 +13,8 @@ ParameterKind ParameterLayout::KindOf(int index) const {
   if (index < EnvironmentOffset()) return ParameterKind::kLight;
   if (index < LightPositionOffset()) return ParameterKind::kEnvironment;
   if (index < LightDirectionOffset()) return ParameterKind::kLightPosition;
-  return ParameterKind::kLightDirection;
+  if (index < EnvironmentRotationOffset()) return ParameterKind::kLightDirection;
+  return ParameterKind::kEnvironmentRotation;
 }
 
 std::string ParameterLayout::Describe(int index) const {
@@ -44,6 +45,10 @@ std::string ParameterLayout::Describe(int index) const {
       const int local = index - LightDirectionOffset();
       return "light_direction[" + std::to_string(local / 3) + "]." + kAxis[local % 3];
     }
+    case ParameterKind::kEnvironmentRotation: {
+      const int local = index - EnvironmentRotationOffset();
+      return "environment_rotation[" + std::to_string(local / 3) + "]." + kAxis[local % 3];
+    }
   }
   return "?";
 }
@@ -65,6 +70,8 @@ bool ParameterKindFromName(const std::string& name, ParameterKind* kind) {
     *kind = ParameterKind::kLightPosition;
   else if (name == "light_direction")
     *kind = ParameterKind::kLightDirection;
+  else if (name == "environment_rotation")
+    *kind = ParameterKind::kEnvironmentRotation;
   else
     return false;
   return true;
@@ -88,6 +95,8 @@ const char* ParameterKindName(ParameterKind kind) {
       return "light_position";
     case ParameterKind::kLightDirection:
       return "light_direction";
+    case ParameterKind::kEnvironmentRotation:
+      return "environment_rotation";
   }
   return "?";
 }
@@ -102,6 +111,7 @@ ParameterSelection ParameterSelection::Only(ParameterKind kind) {
   s.environment = kind == ParameterKind::kEnvironment;
   s.light_positions = kind == ParameterKind::kLightPosition;
   s.light_directions = kind == ParameterKind::kLightDirection;
+  s.environment_rotations = kind == ParameterKind::kEnvironmentRotation;
   return s;
 }
 
@@ -123,6 +133,8 @@ bool ParameterSelection::Selected(ParameterKind kind) const {
       return light_positions;
     case ParameterKind::kLightDirection:
       return light_directions;
+    case ParameterKind::kEnvironmentRotation:
+      return environment_rotations;
   }
   return false;
 }

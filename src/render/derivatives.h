@@ -37,6 +37,11 @@
 //     light); a delta light too, so no BSDF-sampled term. The shadow boundaries the light casts
 //     move with ∂y/∂d = t(I − d n_rᵀ/(n_r·d)) (t from the edge point to the shadow point;
 //     internal/shadow_edges.h), seen directly and through a bounce, as for light positions;
+//   environment rotations (given probes, ParameterLayout::environment_rotations): every
+//   contribution of the probe's radiance — camera rays that escape, BSDF-sampled escapes (MIS),
+//   next-event samples — through the lookup direction e = world_from_envᵀ·exp(−[θ]×)·d
+//   (EnvironmentMap::RotationJacobian); the probe is at infinity, so turning it moves no
+//   visibility boundary and there are no edge terms;
 //   vertices, interior terms (geometry_derivatives.h): through every path vertex's shading
 //     normal (BSDF, cosines) — the face normal, or under smooth shading the interpolated vertex
 //     normals with their two-ring and the hit's sliding barycentrics (internal/shading_normal.h)
@@ -93,7 +98,8 @@ enum class ParameterKind {
   kLight,
   kEnvironment,
   kLightPosition,
-  kLightDirection
+  kLightDirection,
+  kEnvironmentRotation
 };
 
 struct ParameterLayout {
@@ -120,10 +126,20 @@ struct ParameterLayout {
   // (DirectionalLight::parameter_norm) makes the one free direction, the length, a null direction
   // of every row. Entries of lights that are not directional get no derivatives.
   bool light_directions = false;
+  // Environment rotations as parameters: 3 per dataset light (component k of light l at
+  // EnvironmentRotationOffset() + 3l + k), a rotation vector θ (axis·angle, radians) that turns
+  // the environment map as world_from_env ← exp([θ]×)·world_from_env — for a camera-fixed
+  // environment in the camera frame (cam_from_env ← exp([θ]×)·cam_from_env, shared by every
+  // view). The render's map is turned by the current θ (EnvironmentMap::Rotated); the rows are
+  // ∂/∂θ through the world-frame turn δ of that map, exp([θ + dθ]×) = exp([J_l(θ)·dθ]×)·exp([θ]×)
+  // to first order (J_l the left Jacobian of SO(3); ViewSetup::environment_rotation_jacobian).
+  // Entries of lights that are not environments get no derivatives.
+  bool environment_rotations = false;
 
   // Index ranges, in this order: vertex v coordinate k at 3v + k; albedo texel t channel c;
   // roughness texel t; the specular weight; light l's scale; environment texel t channel c;
-  // light l's position coordinate k; light l's direction component k.
+  // light l's position coordinate k; light l's direction component k; light l's environment
+  // rotation component k.
   int VertexOffset() const { return 0; }
   int AlbedoOffset() const { return 3 * num_vertices; }
   int RoughnessOffset() const { return AlbedoOffset() + 3 * num_albedo_texels; }
@@ -134,7 +150,12 @@ struct ParameterLayout {
   int LightDirectionOffset() const {
     return LightPositionOffset() + (light_positions ? 3 * num_lights : 0);
   }
-  int size() const { return LightDirectionOffset() + (light_directions ? 3 * num_lights : 0); }
+  int EnvironmentRotationOffset() const {
+    return LightDirectionOffset() + (light_directions ? 3 * num_lights : 0);
+  }
+  int size() const {
+    return EnvironmentRotationOffset() + (environment_rotations ? 3 * num_lights : 0);
+  }
   // Whether dataset light `light`'s environment texels are parameters.
   bool FitsEnvironment(int light) const {
     return num_environment_texels > 0 && light >= 0 && light == environment_light;
@@ -149,14 +170,18 @@ struct ParameterLayout {
   bool FitsLightDirection(int light) const {
     return light_directions && light >= 0 && light < num_lights;
   }
+  // Whether dataset light `light`'s environment rotation components are parameters.
+  bool FitsEnvironmentRotation(int light) const {
+    return environment_rotations && light >= 0 && light < num_lights;
+  }
 
   // "vertex[12].y", "albedo[40].g", "roughness[3]", "specular", "light[0]", "environment[7].b",
-  // "light_position[0].z", "light_direction[0].x".
+  // "light_position[0].z", "light_direction[0].x", "environment_rotation[0].x".
   std::string Describe(int index) const;
 };
 
 // "vertices", "albedo", "roughness", "specular", "light", "environment", "light_position",
-// "light_direction" (the names of `--param`).
+// "light_direction", "environment_rotation" (the names of `--param`).
 bool ParameterKindFromName(const std::string& name, ParameterKind* kind);
 const char* ParameterKindName(ParameterKind kind);
 
@@ -167,9 +192,10 @@ struct ParameterSelection {
   bool roughness = true;
   bool specular = true;
   bool lights = true;
-  bool environment = true;       // fitted environment texels (when the layout has them).
-  bool light_positions = true;   // point-light positions (when the layout has them).
-  bool light_directions = true;  // directional-light directions (when the layout has them).
+  bool environment = true;            // fitted environment texels (when the layout has them).
+  bool light_positions = true;        // point-light positions (when the layout has them).
+  bool light_directions = true;       // directional-light directions (when the layout has them).
+  bool environment_rotations = true;  // environment rotations (when the layout has them).
 
   static ParameterSelection Only(ParameterKind kind);
   bool Selected(ParameterKind kind) const;

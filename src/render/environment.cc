@@ -1,5 +1,6 @@
 #include "src/render/environment.h"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 
@@ -155,6 +156,47 @@ void EnvironmentMap::TexelWeights(const Eigen::Vector3d& dir, int texel[4],
   weight[3] = p.t * p.s;
 }
 
+Eigen::Matrix3d EnvironmentMap::RotationJacobian(const Eigen::Vector3d& dir) const {
+  const double norm = dir.norm();
+  if (!(norm > 0.0) || !std::isfinite(norm)) return Eigen::Matrix3d::Zero();
+  const Eigen::Vector3d d = dir / norm;
+  const Eigen::Vector3d e = world_from_env_.transpose() * d;
+  const CellPoint p = CellOf(0.5 - std::atan2(e.y(), e.x()) / (2.0 * kPi),
+                             std::acos(std::clamp(e.z(), -1.0, 1.0)) / kPi);
+  const Band& band = bands_[p.j];
+  const int i1 = p.i + 1 == width_ ? 0 : p.i + 1;
+  const size_t top = static_cast<size_t>(band.row0) * width_;
+  const size_t bottom = static_cast<size_t>(band.row1) * width_;
+  const Eigen::Vector3d t00 = texels_[top + p.i].cast<double>();
+  const Eigen::Vector3d t01 = texels_[top + i1].cast<double>();
+  const Eigen::Vector3d t10 = texels_[bottom + p.i].cast<double>();
+  const Eigen::Vector3d t11 = texels_[bottom + i1].cast<double>();
+  // L = (1 − t)·((1 − s)·t00 + s·t01) + t·((1 − s)·t10 + s·t11), s = u·W − 0.5 − i and
+  // t = (v − v0)/dv within the cell.
+  const Eigen::Vector3d d_du = width_ * ((1.0 - p.t) * (t01 - t00) + p.t * (t11 - t10));
+  const Eigen::Vector3d d_dv = ((1.0 - p.s) * (t10 - t00) + p.s * (t11 - t01)) / band.dv;
+  // u = 0.5 − atan2(y, x)/(2π): ∂u/∂e = (y, −x, 0)/(2π ρ²); v = acos(z)/π: ∂v/∂e = (0, 0,
+  // −1/(π ρ)), with ρ = |e_xy| = sin of the polar angle (e is a unit vector, de ⟂ e).
+  const double rho2 = e.x() * e.x() + e.y() * e.y();
+  Eigen::Matrix<double, 3, 3> d_de = Eigen::Matrix3d::Zero();
+  if (rho2 > 1e-24) {
+    const double rho = std::sqrt(rho2);
+    const Eigen::RowVector3d du_de(e.y() / (2.0 * kPi * rho2), -e.x() / (2.0 * kPi * rho2), 0.0);
+    const Eigen::RowVector3d dv_de(0.0, 0.0, -1.0 / (kPi * rho));
+    d_de = d_du * du_de + d_dv * dv_de;
+  }
+  // e = Mᵀ·exp(−[θ]×)·d ≈ Mᵀ·(d − θ × d) = Mᵀ·(d + [d]×θ).
+  Eigen::Matrix3d cross;
+  cross << 0.0, -d.z(), d.y(), d.z(), 0.0, -d.x(), -d.y(), d.x(), 0.0;
+  return d_de * (world_from_env_.transpose() * cross);
+}
+
+EnvironmentMap EnvironmentMap::Rotated(const Eigen::Matrix3d& rotation) const {
+  EnvironmentMap out = *this;
+  out.world_from_env_ = rotation * world_from_env_;
+  return out;
+}
+
 bool EnvironmentMap::Sample(double u1, double u2, Eigen::Vector3d* dir, Eigen::Vector3d* radiance,
                             double* pdf) const {
   if (black_) return false;
@@ -194,6 +236,23 @@ double EnvironmentMap::Pdf(const Eigen::Vector3d& dir) const {
   const double sin_theta = std::sqrt(std::max(0.0, 1.0 - d.z() * d.z()));
   if (!(sin_theta > 1e-12)) return 0.0;
   return UvPdf(CellOfDirection(dir)) / (2.0 * kPi * kPi * sin_theta);
+}
+
+Eigen::Matrix3d RotationFromVector(const Eigen::Vector3d& theta) {
+  const double angle = theta.norm();
+  if (!(angle > 0.0)) return Eigen::Matrix3d::Identity();
+  return Eigen::AngleAxisd(angle, theta / angle).toRotationMatrix();
+}
+
+Eigen::Matrix3d RotationLeftJacobian(const Eigen::Vector3d& theta) {
+  const double a = theta.norm();
+  Eigen::Matrix3d k;
+  k << 0.0, -theta.z(), theta.y(), theta.z(), 0.0, -theta.x(), -theta.y(), theta.x(), 0.0;
+  // (1 − cos a)/a² = 1/2 − a²/24 + …, (a − sin a)/a³ = 1/6 − a²/120 + ….
+  const double a2 = a * a;
+  const double c1 = a < 1e-4 ? 0.5 - a2 / 24.0 : (1.0 - std::cos(a)) / a2;
+  const double c2 = a < 1e-4 ? 1.0 / 6.0 - a2 / 120.0 : (a - std::sin(a)) / (a2 * a);
+  return Eigen::Matrix3d::Identity() + c1 * k + c2 * k * k;
 }
 
 Eigen::Vector3d EnvironmentMap::MeanRadiance() const {

@@ -50,6 +50,22 @@ class EnvironmentMap {
   void TexelWeights(const Eigen::Vector3d& dir, int texel[4], double weight[4]) const;
   double scale() const { return scale_; }
 
+  // ∂Radiance/∂θ at θ = 0 (rows: R, G, B; columns: θ's components) for world direction `dir`
+  // (unit), where θ is a rotation vector (axis·angle, radians, world frame) that turns the map as
+  // world_from_env ← exp([θ]×)·world_from_env. Then the lookup is at e = world_from_envᵀ·
+  // exp(−[θ]×)·dir, so ∂e/∂θ = world_from_envᵀ·[dir]× at θ = 0, chained through (u, v)(e) and the
+  // bilinear interpolation (one-sided where dir lies on a texel centre's row or column: the cell
+  // Radiance() uses). The u term is dropped where |e_xy| ≤ 1e-12 (the poles, where u is
+  // undefined; the polar half band has no v term, its row's value holds). Zero for a zero or
+  // non-finite `dir`. The radiance environment of a probe whose alignment is refined
+  // (ParameterKind::kEnvironmentRotation).
+  Eigen::Matrix3d RotationJacobian(const Eigen::Vector3d& dir) const;
+
+  // A copy of this map turned by `rotation` (world_from_env ← rotation·world_from_env). Sampling
+  // tables are in the env frame, so they are copied unchanged.
+  EnvironmentMap Rotated(const Eigen::Matrix3d& rotation) const;
+  const Eigen::Matrix3d& world_from_env() const { return world_from_env_; }
+
   // Mean radiance over the sphere (solid-angle weighted, of the interpolated map), for tests and
   // planning.
   Eigen::Vector3d MeanRadiance() const;
@@ -95,6 +111,12 @@ class EnvironmentMap {
   double total_weight_ = 0.0;       // Σ CellWeight.
   bool black_ = true;
 };
+
+// exp([θ]×), the rotation by |θ| radians about θ/|θ| (the identity for θ = 0).
+Eigen::Matrix3d RotationFromVector(const Eigen::Vector3d& theta);
+// The left Jacobian of SO(3) at θ: exp([θ + dθ]×) = exp([J_l(θ)·dθ]×)·exp([θ]×) to first order,
+// J_l = I + (1 − cos a)/a²·[θ]× + (a − sin a)/a³·[θ]×² with a = |θ| (series below a = 1e-4).
+Eigen::Matrix3d RotationLeftJacobian(const Eigen::Vector3d& theta);
 
 }  // namespace sft
 

@@ -119,7 +119,12 @@ struct ViewSetup {
   bool environment_background = false;          // camera rays that miss see the environment.
   int environment_light_index = -1;             // dataset light index of `environment`.
   double environment_scale = 1.0;               // multiplies the environment's radiance, >= 0.
-  uint64_t view_index = 0;                      // part of the sample seed.
+  // ∂(world-frame turn δ of `environment`)/∂(its light's rotation parameters θ,
+  // ParameterLayout::environment_rotations): J_l(θ) for a world-fixed environment, Rᵀ·J_l(θ)
+  // for a camera-fixed one (R = cam_from_world's rotation, J_l = RotationLeftJacobian). The
+  // identity for a world-fixed environment at θ = 0.
+  Eigen::Matrix3d environment_rotation_jacobian = Eigen::Matrix3d::Identity();
+  uint64_t view_index = 0;  // part of the sample seed.
 };
 
 // ∂(world position)/∂(position parameters) of point light `light` in `view`: the identity for a

@@ -68,12 +68,14 @@ TEST(LightPositionParametersTest, LayoutBlocksAndValues) {
   EXPECT_EQ(kind, ParameterKind::kLightPosition);
 }
 
-// The keys of fitted point-light positions and directional-light directions.
-TEST(LightConfigTest, PositionAndDirectionKeysAreParsedAndWritten) {
-  for (const std::string key : {"fit_light_positions", "fit_light_directions"}) {
+// The keys of fitted point-light positions, directional-light directions and probe rotations.
+TEST(LightConfigTest, PositionDirectionAndRotationKeysAreParsedAndWritten) {
+  for (const std::string key :
+       {"fit_light_positions", "fit_light_directions", "fit_environment_rotation"}) {
     ReconstructOptions options;
-    const bool& value =
-        key == "fit_light_positions" ? options.fit_light_positions : options.fit_light_directions;
+    const bool& value = key == "fit_light_positions"    ? options.fit_light_positions
+                        : key == "fit_light_directions" ? options.fit_light_directions
+                                                        : options.fit_environment_rotation;
     EXPECT_FALSE(value) << key;
     ASSERT_TRUE(ApplyReconstructConfig({{key, true}}, "c.json", &options).ok()) << key;
     EXPECT_TRUE(value) << key;

@@ -39,10 +39,12 @@ LightDerivativeCheck::LightDerivativeCheck(const RenderScene& scene, const Mater
       x0_(x0),
       kind_(kind),
       layout_(MakeParameterLayout(scene, material, 1)) {
-  const bool position = kind == ParameterKind::kLightPosition;
-  layout_.light_positions = position;
-  layout_.light_directions = !position;
-  const int offset = position ? layout_.LightPositionOffset() : layout_.LightDirectionOffset();
+  layout_.light_positions = kind == ParameterKind::kLightPosition;
+  layout_.light_directions = kind == ParameterKind::kLightDirection;
+  layout_.environment_rotations = kind == ParameterKind::kEnvironmentRotation;
+  const int offset = layout_.light_positions    ? layout_.LightPositionOffset()
+                     : layout_.light_directions ? layout_.LightDirectionOffset()
+                                                : layout_.EnvironmentRotationOffset();
   direction_.assign(layout_.size(), 0.0);
   for (int k = 0; k < 3; ++k) direction_[offset + k] = delta[k];
   Image plus, minus;

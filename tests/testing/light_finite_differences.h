@@ -1,6 +1,7 @@
 // Finite-difference checks of light-parameter derivatives (point-light positions, directional-
-// light directions): the light's three parameters x moved along a fixed δ, images rendered at
-// x ± h·δ with the same seeds (the light does not change the sampled paths), against the Jacobian
+// light directions, environment rotations): the light's three parameters x moved along a fixed δ,
+// images rendered at x ± h·δ with the same seeds (the light does not change the sampled paths; an
+// environment's sampling map held, RenderOptions::sampling_environment), against the Jacobian
 // rows and the adjoint gradient at x, per pixel, on 8×8 block sums and on the image sum.
 #ifndef SFT_TESTS_TESTING_LIGHT_FINITE_DIFFERENCES_H_
 #define SFT_TESTS_TESTING_LIGHT_FINITE_DIFFERENCES_H_
@@ -33,7 +34,8 @@ struct LightComparison {
 class LightDerivativeCheck {
  public:
   // `view_at(x)`: the view with the light at parameters x (its light_index 0). `kind`:
-  // kLightPosition or kLightDirection, the layout's one light's parameters. Renders the central
+  // kLightPosition, kLightDirection or kEnvironmentRotation, the layout's one light's parameters.
+  // Renders the central
   // difference (I(x0 + hδ) − I(x0 − hδ))/(2h) once, here.
   LightDerivativeCheck(const RenderScene& scene, const Material& material,
                        const RenderOptions& options,

@@ -140,6 +140,31 @@ void SetEnvironmentTexels(const Context& ctx, const Eigen::Vector3d& wi, double 
   term->env_count = 4;
 }
 
+// The map's rotation parameters (ParameterLayout::environment_rotations) of the path's view, or
+// −1 when the path takes no derivatives of them.
+int EnvironmentRotationParam(const Context& ctx, const PathDerivatives* path) {
+  if (path == nullptr || !ctx.request->params.environment_rotations ||
+      !ctx.layout->FitsEnvironmentRotation(ctx.view.environment_light_index)) {
+    return -1;
+  }
+  return ctx.layout->EnvironmentRotationOffset() + 3 * ctx.view.environment_light_index;
+}
+
+// Fills `term`'s derivative with respect to the environment's rotation along wi: `factor`
+// multiplies the map's radiance in term.q (light scale, MIS weight, 1/pdf). The sampled direction,
+// its pdf and the MIS weight are held at their values (detached), which is unbiased: each
+// technique's estimate f·∂L·w/p has expectation ∫ f·∂L·w, and the held weights still sum to 1 at
+// every direction, so the sum is ∫ f·∂L, the derivative of ∫ f·L (f, the cosine and the domain do
+// not depend on θ). The environment is at infinity: turning it moves no visibility boundary, so
+// there are no edge terms.
+void SetEnvironmentRotation(const Context& ctx, const Eigen::Vector3d& wi, double factor,
+                            const PathState& state, LightTerm* term) {
+  term->env_rotation_param = EnvironmentRotationParam(ctx, state.path);
+  if (term->env_rotation_param < 0) return;
+  term->dq_d_rotation =
+      factor * ctx.environment->RotationJacobian(wi) * ctx.view.environment_rotation_jacobian;
+}
+
 // Light-sampled environment term (MIS against BSDF sampling when shadows are on).
 void AddEnvironmentLight(const Context& ctx, const PathVertex& v, Sampler* sampler,
                          PathState* state) {
@@ -170,6 +195,7 @@ void AddEnvironmentLight(const Context& ctx, const PathVertex& v, Sampler* sampl
   term.c = cos_i;
   term.dc_dn = wi;
   SetEnvironmentTexels(ctx, wi, factor, *state, &term);
+  SetEnvironmentRotation(ctx, wi, factor, *state, &term);
   Contribute(v, wi, f, term, ctx.view.environment_light_index, state);
 }
 
@@ -228,6 +254,7 @@ bool ApplyScatter(const Context& ctx, const PathVertex& v, const ScatterSample& 
       term.c = n.dot(wi);
       term.dc_dn = wi;
       SetEnvironmentTexels(ctx, wi, factor, *state, &term);
+      SetEnvironmentRotation(ctx, wi, factor, *state, &term);
       Contribute(v, wi, f, term, ctx.view.environment_light_index, state);
     }
     return false;
@@ -286,6 +313,14 @@ Eigen::Vector3d Background(const Context& ctx, const Eigen::Vector3d& dir, PathD
     ctx.environment->TexelWeights(dir, texel, weight);
     const double factor = ctx.view.environment_scale * ctx.environment->scale();
     path->AddEnvironmentTexels(texel, weight, 4, Eigen::Vector3d::Constant(factor));
+  }
+  const int rotation_param = EnvironmentRotationParam(ctx, path);
+  if (rotation_param >= 0) {
+    const Eigen::Matrix3d d = ctx.view.environment_scale * ctx.environment->RotationJacobian(dir) *
+                              ctx.view.environment_rotation_jacobian;
+    for (int k = 0; k < 3; ++k) {
+      if (!d.col(k).isZero()) path->Add(rotation_param + k, d.col(k));
+    }
   }
   return radiance;
 }

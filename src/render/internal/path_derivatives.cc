@@ -46,6 +46,11 @@ void PathDerivatives::AddContribution(const Eigen::Vector3d& prefix, const Surfa
     const Eigen::Vector3d base = prefix.cwiseProduct(f) * light.c;
     AddEnvironmentTexels(light.env_texel, light.env_weight, light.env_count, base);
   }
+  if (light.env_rotation_param >= 0) {
+    // ∂C/∂θ = prefix ⊙ f·c ⊙ ∂q/∂θ (the direction wi, hence f and c, held: the map turns).
+    const Eigen::Matrix3d g = (prefix.cwiseProduct(f) * light.c).asDiagonal() * light.dq_d_rotation;
+    for (int k = 0; k < 3; ++k) Emit(light.env_rotation_param + k, g.col(k));
+  }
   const bool light_position = light.follows_point && light.position_param >= 0;
   const bool light_direction = light.direction_param >= 0;
   if (!vertices_ && !light_position && !light_direction) return;

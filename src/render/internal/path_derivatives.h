@@ -142,6 +142,11 @@ struct LightTerm {
   int env_count = 0;
   int env_texel[4] = {0, 0, 0, 0};
   double env_weight[4] = {0.0, 0.0, 0.0, 0.0};
+  // An environment whose rotation is a parameter (ParameterLayout::FitsEnvironmentRotation): the
+  // first of its three parameters and ∂q/∂(parameters) (rows: channels; the map's
+  // RotationJacobian times the factor in q and ViewSetup::environment_rotation_jacobian).
+  int env_rotation_param = -1;
+  Eigen::Matrix3d dq_d_rotation = Eigen::Matrix3d::Zero();
 };
 
 // Bookkeeping of one path's derivatives. A path's light contributions have the form
