@@ -197,8 +197,7 @@ Status Measure(const EffectPlannerOptions& options, const PlannerContext& contex
                const EffectPlan& plan, const EffectPlan& variant, const DerivativeTerm* term,
                bool image, bool step, Measurer* measurer, References* refs,
                References* variant_refs, EffectDecision* decision, bool* matters) {
-  auto fill = [&](const Sample(&a)[2], const Sample(&b)[2], double scale, bool is_step,
-                  EffectMeasurement* m) {
+  auto fill = [&](const Sample(&a)[2], const Sample(&b)[2], double scale, EffectMeasurement* m) {
     const Comparison c = Compare(a, b);
     m->measured = true;
     m->change = c.change;
@@ -209,7 +208,6 @@ Status Measure(const EffectPlannerOptions& options, const PlannerContext& contex
     m->threshold = Threshold(options, context, c.noise);
     m->share_limit = options.max_share * std::max(c.signal, scale);
     m->outer_iterations = std::max(1, context.outer_iterations);
-    m->bias_rule = is_step && context.stochastic_solver;
   };
   variant_refs->Invalidate();
   decision->image = decision->step = EffectMeasurement();
@@ -219,7 +217,7 @@ Status Measure(const EffectPlannerOptions& options, const PlannerContext& contex
     refs->have_image = true;
     SFT_RETURN_IF_ERROR(measurer->Images(variant, variant_refs->image));
     variant_refs->have_image = true;
-    fill(refs->image, variant_refs->image, context.image_signal_scale, false, &decision->image);
+    fill(refs->image, variant_refs->image, context.image_signal_scale, &decision->image);
   }
   *matters = decision->image.Matters();
   if (step && !*matters) {
@@ -235,7 +233,7 @@ Status Measure(const EffectPlannerOptions& options, const PlannerContext& contex
           measurer->Gradients(variant, variant_refs->step, variant_refs->step_parts));
     }
     variant_refs->have_step = true;
-    fill(refs->step, variant_refs->step, context.step_signal_scale, true, &decision->step);
+    fill(refs->step, variant_refs->step, context.step_signal_scale, &decision->step);
     *matters = decision->step.Matters();
   }
   return Status::Ok();
@@ -440,8 +438,6 @@ json EffectPlanReport::ToJson() const {
                     {"noise_without", m->noise_without},
                     {"floor", m->floor},
                     {"share", m->signal > 0.0 ? m->change / m->signal : 0.0},
-                    {"rule", m->bias_rule ? "bias" : "noise"},
-                    {"upper_bound", m->UpperBound()},
                     {"matters", m->Matters()}};
     }
     if (d.name == "bounces") entry["bounces"] = d.bounces;
@@ -526,15 +522,7 @@ std::vector<std::string> PlanChangeLines(const EffectPlanReport& report,
       for (const auto& [key, m] :
            {std::make_pair("image", &d.image), std::make_pair("step", &d.step)}) {
         if (!m->measured) continue;
-        char part[200];
-        if (m->bias_rule) {
-          std::snprintf(part, sizeof(part),
-                        "%s change %.3g, at most %.3g: share limit %.3g, %.1f%% of the signal", key,
-                        m->change, m->UpperBound(), m->share_limit,
-                        m->signal > 0.0 ? 100.0 * m->change / m->signal : 0.0);
-          parts += (parts.empty() ? "" : "; ") + std::string(part);
-          continue;
-        }
+        char part[160];
         std::snprintf(part, sizeof(part),
                       "%s change %.3g: noise threshold %.3g, %.1f%% of the signal, added noise "
                       "%.3g, floor %.3g",

@@ -42,19 +42,6 @@
 // derivative terms are therefore measured on the current plan's two reference passes, and after
 // a drop the next reference is again that gradient minus the dropped parts.
 //
-// A stage whose solver is Adam with `resample` (a stochastic first-order method) is judged
-// differently on the step: Adam's per-parameter normalisation and the stage list's decaying
-// learning rates turn gradient noise into a jitter of about one learning rate per vertex, which
-// later stages shrink, while a bias moves the point the iterates settle at (where the expected
-// gradient is 0) and persists through every stage. The noise threshold and the added-noise rule
-// model a fit that averages K frozen samples, which Adam does not; for Adam a step measurement
-// only asks whether the term carries a share of the expected gradient, and drops the term only
-// when the measurement shows it is small: the upper bound of its change (the change² estimate
-// plus two standard errors, i.e. sqrt(change² + floor²)) below the share limit. An inconclusive
-// measurement keeps the term. On the glossy dragon the looser rule dropped secondary edges whose
-// change, at 10–18% of the gradient, was just under its floor, and the run ended 10% worse in
-// Chamfer than with them (docs/design-notes.md, "The effect planner").
-//
 // An effect whose parameters the stage fits is kept (specular when fit_specular: without the
 // lobe its weight has no derivative); an effect absent from the scene (no environment light, a
 // specular weight of 0 everywhere) is off without a measurement; pins override everything.
@@ -129,18 +116,13 @@ struct EffectMeasurement {
   double share_limit = 0.0;    // max_share × max(signal, the stage's signal scale).
   double noise_without = 0.0;  // σ of the values without the switch.
   int outer_iterations = 1;    // K.
-  // The stochastic-solver rule of the file comment (a step measurement in an Adam stage).
-  bool bias_rule = false;
   // Above the noise or too large a share to leave out, and larger than the noise the switch
   // itself adds (the file comment).
   double floor = 0.0;  // changes up to this are not distinguishable from 0 (2 SE).
   bool Matters() const {
-    if (bias_rule) return measured && UpperBound() > share_limit;
     return measured && change > floor && (change > threshold || change > share_limit) &&
            change > AddedNoise();
   }
-  // The change's upper bound: sqrt of change² plus two standard errors of its estimate.
-  double UpperBound() const { return std::hypot(change, floor); }
   // sqrt(max(0, σ² − σ_without²) / K): the noise the switch adds to the stage's average.
   double AddedNoise() const {
     return std::sqrt(std::max(0.0, noise * noise - noise_without * noise_without) /
@@ -187,9 +169,6 @@ struct PlannerContext {
   // K: the number of independent seeds the stage's noise averages over, >= 1: its outer
   // iterations (one seed each), or for Adam with `resample` its steps in full-view renders.
   int outer_iterations = 1;
-  // The stage's solver is Adam with `resample`: step measurements follow the stochastic-solver
-  // rule of the file comment.
-  bool stochastic_solver = false;
   // The largest signal (RMS of the mean values) measured earlier in the stage on the same
   // topology, for the images and the gradient; 0 = none. The share limit is taken of the larger
   // of it and the current signal: near convergence the gradient shrinks towards its noise, and a

@@ -259,7 +259,6 @@ Status Reconstruction::PlanEffects(int outer, EffectPlanReport* report, double i
     const int64_t renders =
         static_cast<int64_t>(options_.outer_iterations) * options_.solver.steps * batch / views;
     context.outer_iterations = static_cast<int>(std::clamp<int64_t>(renders, 1, 1 << 20));
-    context.stochastic_solver = true;
   }
   for (const LightSpec& light : dataset_->lights) {
     if (light.type == LightType::kEnvironment) {

@@ -7,8 +7,6 @@
 //     faces, so the bounce stays.
 #include "src/optim/effect_planner.h"
 
-#include <cmath>
-
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -91,38 +89,6 @@ TEST(EffectPlanTest, ConfigKeys) {
                                      "cfg.json", &options)
                   .message(),
               HasSubstr("planner_noise_factor: expected a number in [0.0, 100.0]"));
-}
-
-// The dragon's secondary edges in an Adam stage (docs/design-notes.md, "The effect planner"): a
-// change of 11% of the gradient, just under its floor, and with more added noise than change.
-// The noise rule drops the term; Adam's rule keeps it, since the measurement does not show it is
-// small. A term shown small is dropped by both.
-TEST(EffectMeasurementTest, AdamKeepsATermTheMeasurementCannotShowSmall) {
-  EffectMeasurement m;
-  m.measured = true;
-  m.change = 0.0812;
-  m.floor = 0.169;
-  m.noise = 1.29;
-  m.noise_without = 1.08;
-  m.signal = 0.72;
-  m.outer_iterations = 6;
-  m.threshold = m.noise / std::sqrt(6.0);
-  m.share_limit = 0.0428;
-  EXPECT_FALSE(m.Matters());
-  m.bias_rule = true;
-  EXPECT_NEAR(m.UpperBound(), std::hypot(0.0812, 0.169), 1e-12);
-  EXPECT_TRUE(m.Matters());
-  // Shown small: the change and two standard errors stay under the share limit.
-  m.change = 0.01;
-  m.floor = 0.02;
-  EXPECT_FALSE(m.Matters());
-  m.bias_rule = false;
-  EXPECT_FALSE(m.Matters());
-  // Not measured: never matters.
-  m.measured = false;
-  m.bias_rule = true;
-  m.change = 1.0;
-  EXPECT_FALSE(m.Matters());
 }
 
 class EffectPlannerTest : public ::testing::Test {
@@ -267,31 +233,6 @@ TEST_F(EffectPlannerTest, LightBouncingInsideACornerIsKept) {
   EXPECT_EQ(bounces.bounces, 2);
   EXPECT_GT(bounces.image.change, bounces.image.noise);
   EXPECT_GT(bounces.image.change, 0.01 * bounces.image.signal);
-}
-
-// Under Adam with resampling the step measurements follow the bias rule: the convex sphere still
-// needs no bounces, shadows or texel edges (each shown small), and the silhouettes still carry
-// the gradient.
-TEST_F(EffectPlannerTest, AdamJudgesTheStepByItsBias) {
-  const EffectPlanReport report =
-      Plan("sphere", R"({"spp": 16, "solver": "adam", "adam_resample": true})");
-  const EffectDecision& primary = Find(report, "primary_edges");
-  EXPECT_TRUE(primary.step.bias_rule);
-  EXPECT_TRUE(primary.on);
-  EXPECT_GT(primary.step.UpperBound(), primary.step.share_limit);
-  for (const char* name : {"bounces", "shadows", "texel_edges"}) {
-    const EffectDecision& d = Find(report, name);
-    EXPECT_EQ(d.reason, "measured") << name;
-    EXPECT_FALSE(d.on) << name;
-    EXPECT_TRUE(d.step.bias_rule) << name;
-    EXPECT_LE(d.step.UpperBound(), d.step.share_limit) << name;
-    EXPECT_FALSE(d.image.bias_rule) << name;  // the images keep the noise rule.
-  }
-  EXPECT_EQ(report.ToJson()["decisions"][4]["step"]["rule"], "bias");
-  // Levenberg-Marquardt keeps the noise rule.
-  const EffectPlanReport lm = Plan("sphere", R"({"spp": 16})");
-  EXPECT_FALSE(Find(lm, "primary_edges").step.bias_rule);
-  EXPECT_EQ(lm.ToJson()["decisions"][4]["step"]["rule"], "noise");
 }
 
 TEST_F(EffectPlannerTest, PinsAndTheNoiseFactorDecide) {
