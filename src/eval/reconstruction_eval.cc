@@ -24,21 +24,6 @@ namespace {
 
 using json = nlohmann::json;
 
-// A ground-truth pass folder named by `key` of the dataset's ground_truth, or "" when absent.
-Status PassFolder(const Dataset& dataset, const char* key, std::string* folder) {
-  folder->clear();
-  if (!dataset.ground_truth.is_object() || !dataset.ground_truth.contains(key)) return Status::Ok();
-  const json& value = dataset.ground_truth[key];
-  if (!value.is_string()) return Status::Ok();
-  std::string why;
-  if (!IsContainedRelativePath(value.get<std::string>(), &why)) {
-    return Status::Error(JoinPath(dataset.root, "scene.json") + ": ground_truth." + key + ": " +
-                         why);
-  }
-  *folder = value.get<std::string>();
-  return Status::Ok();
-}
-
 // The true pass of view v: an image of `folder` (named like the view's image, .exr), or a render
 // of `truth` when folder is empty.
 Status TruePass(const Dataset& dataset, int v, const std::string& folder, const RenderScene* scene,
@@ -100,7 +85,7 @@ struct Truth {
 
 Status LoadTruth(const Dataset& dataset, Truth* truth) {
   std::string material_path;
-  SFT_RETURN_IF_ERROR(PassFolder(dataset, "material", &material_path));
+  SFT_RETURN_IF_ERROR(GroundTruthPath(dataset, "material", &material_path));
   if (dataset.gt_mesh.empty() || material_path.empty()) return Status::Ok();
   SFT_RETURN_IF_ERROR(ReadMesh(JoinPath(dataset.root, dataset.gt_mesh), &truth->mesh));
   SFT_RETURN_IF_ERROR(LoadMaterial(JoinPath(dataset.root, material_path), truth->mesh,
@@ -235,8 +220,8 @@ Status ScoreViews(const RunToRender& run, const RenderScene& scene, const Truth&
                   const DatasetViews& views, const std::vector<int>& selected,
                   const RenderOptions& render, const HeldOutSetup* held_out, PassScores* scores) {
   std::string albedo_folder, roughness_folder;
-  SFT_RETURN_IF_ERROR(PassFolder(run.dataset, "albedo", &albedo_folder));
-  SFT_RETURN_IF_ERROR(PassFolder(run.dataset, "roughness", &roughness_folder));
+  SFT_RETURN_IF_ERROR(GroundTruthPath(run.dataset, "albedo", &albedo_folder));
+  SFT_RETURN_IF_ERROR(GroundTruthPath(run.dataset, "roughness", &roughness_folder));
   const bool can_render_truth = truth.scene != nullptr;
   RenderOptions albedo_pass = render;
   albedo_pass.pass = RenderPass::kAlbedo;

@@ -155,6 +155,11 @@ Status CheckViewsHaveLights(const Dataset& dataset);
 // (an image whose size differs from its camera's is an error naming both sizes).
 Status CheckDatasetFiles(const Dataset& dataset);
 
+// The file or folder that `ground_truth.<key>` names, relative to the dataset's root, or "" when
+// the key is absent or not a string; an error naming scene.json and the key when the path leaves
+// the dataset (absolute, or with a ".." component).
+Status GroundTruthPath(const Dataset& dataset, const std::string& key, std::string* relative);
+
 // Writes DIR/scene.json atomically from `dataset` (root is ignored; paths are written as stored).
 // Every extra (top level, camera, light, view, cam_from_world) is written back after the
 // documented keys of its object; documented keys win over same-named extras. Extras that are not

@@ -118,4 +118,17 @@ Status LoadProbe(const Dataset& dataset, int light_index, Image* rgb) {
   return Status::Ok();
 }
 
+Status GroundTruthPath(const Dataset& dataset, const std::string& key, std::string* relative) {
+  relative->clear();
+  if (!dataset.ground_truth.is_object() || !dataset.ground_truth.contains(key)) return Status::Ok();
+  const nlohmann::json& value = dataset.ground_truth[key];
+  if (!value.is_string()) return Status::Ok();
+  std::string why;
+  if (!IsContainedRelativePath(value.get<std::string>(), &why)) {
+    return Status::Error(JoinPath(dataset.root, kSceneFile) + ": ground_truth." + key + ": " + why);
+  }
+  *relative = value.get<std::string>();
+  return Status::Ok();
+}
+
 }  // namespace sft

@@ -151,15 +151,14 @@ Status LoadCellStart(const SweepContext& context, const SweepCell& cell, CellSta
   if (cell.material == "grey") {
     start->material.clear();
   } else if (cell.material == "ground_truth") {
-    const json& gt = context.dataset.ground_truth;
-    std::string why;
-    if (!gt.is_object() || !gt.contains("material") || !gt["material"].is_string() ||
-        !IsContainedRelativePath(gt["material"].get<std::string>(), &why)) {
+    std::string relative;
+    SFT_RETURN_IF_ERROR(GroundTruthPath(context.dataset, "material", &relative));
+    if (relative.empty()) {
       return Status::Error(
           "material \"ground_truth\": " + JoinPath(context.dataset.root, "scene.json") +
-          " has no ground_truth.material inside the dataset");
+          " has no ground_truth.material");
     }
-    start->material = JoinPath(context.dataset.root, gt["material"].get<std::string>());
+    start->material = JoinPath(context.dataset.root, relative);
   } else if (!cell.material.empty()) {
     start->material = cell.material;
   }

@@ -43,6 +43,28 @@ TEST(DatasetOutputPaths, MirrorUnderImagesAndNeverCollide) {
                                      "images/000_view005.exr", "images/b.exr"));
 }
 
+TEST(DatasetFiles, GroundTruthPathStaysInsideTheDataset) {
+  Dataset dataset;
+  dataset.root = "/data/set";
+  std::string path = "stale";
+  ASSERT_TRUE(GroundTruthPath(dataset, "material", &path).ok());  // no ground_truth at all.
+  EXPECT_EQ(path, "");
+  dataset.ground_truth = json::parse(
+      R"({"material": "gt/material.json", "albedo": 3, "roughness": "../elsewhere",
+          "mesh": "/abs/mesh.ply"})");
+  ASSERT_TRUE(GroundTruthPath(dataset, "material", &path).ok());
+  EXPECT_EQ(path, "gt/material.json");
+  ASSERT_TRUE(GroundTruthPath(dataset, "albedo", &path).ok());  // not a string: absent.
+  EXPECT_EQ(path, "");
+  ASSERT_TRUE(GroundTruthPath(dataset, "shading", &path).ok());
+  EXPECT_EQ(path, "");
+  const Status up = GroundTruthPath(dataset, "roughness", &path);
+  EXPECT_THAT(up.message(), HasSubstr("/data/set/scene.json: ground_truth.roughness: "));
+  EXPECT_EQ(path, "");
+  EXPECT_THAT(GroundTruthPath(dataset, "mesh", &path).message(),
+              HasSubstr("/data/set/scene.json: ground_truth.mesh: "));
+}
+
 TEST(DatasetFiles, ImageSizeDiffersFromCamera) {
   TempDir dir;
   WriteDataset(dir, MinimalScene());
