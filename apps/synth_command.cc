@@ -46,7 +46,13 @@ struct SynthOptions {
   bool normalize = true;      // centre the mesh and scale its bbox diagonal to 1.
   std::vector<double> light_offset = {0.15, 0.0, 0.0};  // point light in the camera frame.
   double light_intensity = 0.0;                         // W/sr, in (0, 1e30]; used when given.
-  bool light_intensity_given = false;   // --light-intensity was given (else automatic).
+  bool light_intensity_given = false;  // --light-intensity was given (else automatic).
+  // World-frame direction the sun's light travels (x,y,z, any length); empty = no sun. A sun
+  // replaces the point light (a directional light, docs/dataset.md).
+  std::vector<double> sun;
+  // Irradiance on a surface facing the sun, W/m², in (0, 1e30]; default 0.5·π (a white facing
+  // patch then has radiance 0.5, as under the default flash).
+  double sun_irradiance = 0.5 * M_PI;
   std::string envmap;                   // equirectangular EXR probe replacing the point light.
   double envmap_scale = 1.0;            // probe radiance scale, [0, 1e30].
   bool environment_background = false;  // camera rays that miss see the probe.
@@ -102,6 +108,16 @@ struct SynthOptions {
       return Fail(why, "--elevation: needs lo,hi degrees with -89 <= lo <= hi <= 89");
     }
     if (ground && !ground_options.Check(why)) return false;
+    if (!sun.empty()) {
+      if (sun.size() != 3 || !std::isfinite(sun[0]) || !std::isfinite(sun[1]) ||
+          !std::isfinite(sun[2]) || std::hypot(sun[0], sun[1], sun[2]) < 1e-12) {
+        return Fail(why, "--sun: needs 3 finite numbers x,y,z, not all 0");
+      }
+      if (!envmap.empty()) return Fail(why, "--sun: give either --sun or --envmap, not both");
+    }
+    if (!(sun_irradiance > 0 && sun_irradiance <= 1e30)) {
+      return Fail(why, "--sun-irradiance: must be in (0, 1e30] W/m², got " + Text(sun_irradiance));
+    }
     if (environment_background && envmap.empty()) {
       return Fail(why, "--background-environment: needs --envmap");
     }
@@ -158,8 +174,8 @@ Status LoadObject(const SynthOptions& opts, TriMesh* mesh, Material* material) {
   return LoadMaterial(opts.material, *mesh, material);
 }
 
-// One pinhole camera per zoom, and the light: the camera-attached point light, or the probe
-// (copied to PARTIAL/probes/ as EXR).
+// One pinhole camera per zoom, and the light: the camera-attached point light, a world-fixed
+// sun (directional light), or the probe (copied to PARTIAL/probes/ as EXR).
 Status AddCamerasAndLight(const SynthOptions& opts, double focal, double distance,
                           const std::string& partial, Dataset* dataset) {
   for (size_t z = 0; z < opts.zooms.size(); ++z) {
@@ -172,7 +188,13 @@ Status AddCamerasAndLight(const SynthOptions& opts, double focal, double distanc
     dataset->cameras.push_back(camera);
   }
   LightSpec light;
-  if (opts.envmap.empty()) {
+  if (!opts.sun.empty()) {
+    light.id = "sun";
+    light.type = LightType::kDirectional;
+    light.frame = LightFrame::kWorld;
+    light.direction = Eigen::Vector3d(opts.sun[0], opts.sun[1], opts.sun[2]).normalized();
+    light.irradiance = Eigen::Vector3d::Constant(opts.sun_irradiance);
+  } else if (opts.envmap.empty()) {
     light.id = "flash";
     light.type = LightType::kPoint;
     light.frame = LightFrame::kCamera;
@@ -363,6 +385,13 @@ CommandRunner SetupSynthCommand(CLI::App* app) {
   CLI::Option* light_intensity =
       app->add_option("--light-intensity", opts->light_intensity,
                       "Radiant intensity, W/sr (default: white facing patch at the centre = 0.5)");
+  app->add_option("--sun", opts->sun,
+                  "World-frame direction a sun's light travels, x,y,z (replaces the point light)")
+      ->delimiter(',')
+      ->expected(3);
+  app->add_option("--sun-irradiance", opts->sun_irradiance,
+                  "Sun irradiance on a facing surface, W/m^2 (default: white facing patch = 0.5)")
+      ->capture_default_str();
   app->add_option("--envmap", opts->envmap,
                   "Equirectangular EXR probe to light the object instead of the point light");
   app->add_option("--envmap-scale", opts->envmap_scale, "Probe radiance scale")

@@ -78,6 +78,10 @@ TEST(CliInputTest, SynthFlagsOutOfRangeNameTheFlag) {
       {"--zooms 1,nan", "--zooms: values must be in (0, 1000], got nan"},
       {"--zooms 1e300", "--zooms: values must be in (0, 1000], got 1e+300"},
       {"--envmap-scale inf", "--envmap-scale: must be in [0, 1e30], got inf"},
+      {"--sun 0,0,0", "--sun: needs 3 finite numbers x,y,z, not all 0"},
+      {"--sun 0,nan,1", "--sun: needs 3 finite numbers x,y,z, not all 0"},
+      {"--sun 0,0,-1 --envmap p.exr", "--sun: give either --sun or --envmap, not both"},
+      {"--sun 0,0,-1 --sun-irradiance 0", "--sun-irradiance: must be in (0, 1e30] W/m², got 0"},
       {"--spp 0", "spp: must be in [1, 1048576]"},
       {"--bounces 0", "bounces: must be in [1, 16]"},
   };
