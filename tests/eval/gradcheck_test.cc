@@ -18,6 +18,16 @@ namespace {
 
 using ::testing::HasSubstr;
 
+// The checks every one-view gradcheck run passes: within `tolerance`, with Jacobian entries, and
+// the adjoint projection equal to the rows' (1e-5).
+void ExpectOneViewPasses(const GradcheckResult& result, double tolerance) {
+  EXPECT_TRUE(result.passed) << result.kind << " " << result.relative_error;
+  EXPECT_LT(result.relative_error, tolerance) << result.kind;
+  ASSERT_EQ(result.views.size(), 1u);
+  EXPECT_GT(result.views[0].jacobian_entries, 0u) << result.kind;
+  EXPECT_LT(result.views[0].adjoint_mismatch, 1e-5) << result.kind;
+}
+
 class GradcheckTest : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -47,11 +57,7 @@ TEST_F(GradcheckTest, ImplementedKindsPass) {
     GradcheckResult result;
     const Status status = RunGradcheck(dataset_, mesh_, material_, options, &result);
     ASSERT_TRUE(status.ok()) << status.message();
-    EXPECT_TRUE(result.passed) << result.kind << " " << result.relative_error;
-    EXPECT_LT(result.relative_error, 2e-3) << result.kind;
-    ASSERT_EQ(result.views.size(), 1u);
-    EXPECT_GT(result.views[0].jacobian_entries, 0u);
-    EXPECT_LT(result.views[0].adjoint_mismatch, 1e-5);
+    ExpectOneViewPasses(result, 2e-3);
   }
 }
 
@@ -69,11 +75,7 @@ TEST_F(GradcheckTest, LightPositionsPass) {
   ASSERT_TRUE(status.ok()) << status.message();
   EXPECT_EQ(result.kind, "light_position");
   EXPECT_EQ(result.block, 8);
-  EXPECT_TRUE(result.passed) << result.relative_error;
-  EXPECT_LT(result.relative_error, 2e-3);
-  ASSERT_EQ(result.views.size(), 1u);
-  EXPECT_GT(result.views[0].jacobian_entries, 0u);
-  EXPECT_LT(result.views[0].adjoint_mismatch, 1e-5);
+  ExpectOneViewPasses(result, 2e-3);
 }
 
 // Directional-light directions (`--param light_direction`): the dataset's flash replaced by a
@@ -97,11 +99,7 @@ TEST_F(GradcheckTest, LightDirectionsPass) {
     const Status status = RunGradcheck(dataset_, mesh_, material_, options, &result);
     ASSERT_TRUE(status.ok()) << status.message();
     EXPECT_EQ(result.kind, ParameterKindName(kind));
-    EXPECT_TRUE(result.passed) << result.kind << " " << result.relative_error;
-    EXPECT_LT(result.relative_error, 2e-3) << result.kind;
-    ASSERT_EQ(result.views.size(), 1u);
-    EXPECT_GT(result.views[0].jacobian_entries, 0u) << result.kind;
-    EXPECT_LT(result.views[0].adjoint_mismatch, 1e-5) << result.kind;
+    ExpectOneViewPasses(result, 2e-3);
   }
 }
 
@@ -140,19 +138,17 @@ TEST_F(GradcheckTest, EnvironmentRotationsPass) {
   EXPECT_EQ(result.kind, "environment_rotation");
   EXPECT_EQ(result.block, 1);
   std::printf("environment_rotation: relative error %.2e\n", result.relative_error);
-  EXPECT_TRUE(result.passed) << result.relative_error;
-  EXPECT_LT(result.relative_error, 1e-2);
-  ASSERT_EQ(result.views.size(), 1u);
-  EXPECT_GT(result.views[0].jacobian_entries, 0u);
-  EXPECT_LT(result.views[0].adjoint_mismatch, 1e-5);
+  ExpectOneViewPasses(result, 1e-2);
 }
 
 // A camera-fixed probe (the map turns with each camera; its rotation parameters turn it in the
 // camera frame, δ_world = Rᵀ·θ). A smooth map (no bright patch): the finite differences of a
 // map with sharp features are dominated by lookups crossing bilinear kinks, an error that
 // shrinks in proportion to h (on the studio probe of data/cycles, view 5: 0.097 on 8×8 blocks at
-// h = 1e-4, 0.0085 at 1e-5) and says nothing about the frame. Measured 6e-3 at h = 1e-4, as the
-// world-fixed probe of the same map; tolerance 1e-2.
+// h = 1e-4, 0.0085 at 1e-5) and says nothing about the frame. On this smooth map both frames
+// agree to about 1e-3 (docs/design-notes.md, "Probe rotation"); tolerance 1e-2, as for the
+// world-fixed probe. The finite differences turn the map in the frame the dataset gives, so a
+// wrong camera factor in the rows fails here.
 TEST_F(GradcheckTest, CameraFixedEnvironmentRotationsPass) {
   LightSpec& light = dataset_.lights.at(0);
   light.type = LightType::kEnvironment;
@@ -180,8 +176,8 @@ TEST_F(GradcheckTest, CameraFixedEnvironmentRotationsPass) {
     ASSERT_TRUE(status.ok()) << status.message();
     std::printf("camera-fixed environment_rotation, view %d: relative error %.2e\n", view,
                 result.relative_error);
-    EXPECT_LT(result.relative_error, 1e-2) << view;
-    EXPECT_TRUE(result.passed);
+    SCOPED_TRACE(view);
+    ExpectOneViewPasses(result, 1e-2);
   }
 }
 
