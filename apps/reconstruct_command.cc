@@ -13,8 +13,8 @@
 #include "apps/commands.h"
 #include "src/core/file_util.h"
 #include "src/core/progress.h"
-#include "src/eval/mesh_metrics.h"
 #include "src/eval/reconstruct_report.h"
+#include "src/eval/reference_score.h"
 #include "src/export/export.h"
 #include "src/geometry/material.h"
 #include "src/geometry/mesh.h"
@@ -139,18 +139,6 @@ Status ResumedStages(const ReconstructCommandOptions& cli, const RunState& state
     if (!stage.Check(&why)) return Status::Error(stage.name + ": " + why);
   }
   return ExcludeHeldOutViews(state.held_out_views, static_cast<int>(dataset.views.size()), stages);
-}
-
-// F1 and Chamfer of the current mesh against --reference (50k samples per surface).
-Status ScoreAgainstReference(const TriMesh& reference, double tolerance, const TriMesh& mesh,
-                             nlohmann::json* out) {
-  MeshMetricsOptions options;
-  options.samples = 50000;
-  options.tolerance = tolerance;
-  MeshMetrics m;
-  SFT_RETURN_IF_ERROR(ComputeMeshMetrics(reference, mesh, options, &m, "--reference", "mesh"));
-  *out = {{"chamfer", m.chamfer}, {"f1", m.f1}, {"f1_tolerance", tolerance}};
-  return Status::Ok();
 }
 
 // --print-schedule: the stages with the views each fits, then the held-out views, if any.
@@ -297,7 +285,7 @@ Status RunReconstruct(const ReconstructCommandOptions& cli_in, const BeforeStart
   callbacks.on_event = [&](const std::string& line) { progress.Note(line); };
   if (!cli.reference.empty()) {
     callbacks.score = [&](const TriMesh& mesh, nlohmann::json* out) {
-      return ScoreAgainstReference(reference, cli.reference_tolerance, mesh, out);
+      return ScoreAgainstReference(reference, cli.reference_tolerance, mesh, "--reference", out);
     };
   }
   SFT_RETURN_IF_ERROR(schedule->Run(callbacks));

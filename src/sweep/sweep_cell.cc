@@ -1,11 +1,13 @@
 #include "src/sweep/sweep_cell.h"
 
+#include <algorithm>
 #include <chrono>
 #include <set>
 
 #include "src/core/file_util.h"
 #include "src/eval/mesh_metrics.h"
 #include "src/eval/reconstruction_eval.h"
+#include "src/eval/reference_score.h"
 #include "src/geometry/material.h"
 #include "src/io/scene_setup.h"
 #include "src/optim/schedule_config.h"
@@ -115,9 +117,25 @@ Status Reconstruct(const SweepContext& context, const CellStart& start,
     }
     return true;
   };
+  if (!context.grid->reference.empty()) {
+    hooks.score = [&](const TriMesh& mesh, json* out) {
+      const SweepEvalOptions& eval = context.grid->eval;
+      return ScoreAgainstReference(context.reference, eval.f1_tolerance, mesh, "reference", out,
+                                   std::min(eval.mesh_samples, kOuterScoreSamples));
+    };
+  }
   SFT_RETURN_IF_ERROR(schedule->Run(hooks));
   if (*interrupted) return Status::Ok();
   const ScheduleProgress& p = schedule->progress();
+  json trajectory = json::array();
+  for (const json& outer : schedule->outer_records()) {
+    json point = {{"stage", outer.value("stage", "")}, {"seconds", outer.value("seconds", 0.0)}};
+    for (const char* key : {"chamfer", "f1"}) {
+      if (outer.contains(key)) point[key] = outer[key];
+    }
+    trajectory.push_back(point);
+  }
+  (*line)["trajectory"] = trajectory;
   (*line)["seconds"] = p.seconds;
   (*line)["ended_by"] = budget_spent ? "time_budget" : "iterations";
   (*line)["outer_iterations"] = p.outer_done;

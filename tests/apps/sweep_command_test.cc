@@ -118,6 +118,18 @@ TEST_F(SweepCommandTest, InterruptedAndKilledSweepsContinue) {
   EXPECT_TRUE(ok["albedo"]["ssim_srgb"].is_number());
   EXPECT_EQ(ok["views"], 4);
   EXPECT_FALSE(ok["default"].get<bool>());
+  // With a reference, every outer iteration is scored, and so is the one the budget stopped:
+  // the trajectory and metrics.json agree.
+  const json& trajectory = ok["trajectory"];
+  ASSERT_EQ(trajectory.size(), ok["outer_iterations"].get<size_t>() + 1);
+  const json metrics =
+      json::parse(testing::ReadTestFile(tmp_.Join("out/cells/00_bounces2_spp4/metrics.json")));
+  for (size_t k = 0; k < trajectory.size(); ++k) {
+    EXPECT_GT(trajectory[k]["chamfer"].get<double>(), 0.0);
+    EXPECT_GT(trajectory[k]["f1"].get<double>(), 0.0);
+    EXPECT_EQ(trajectory[k]["chamfer"], metrics["outer"][k]["chamfer"]);
+    if (k > 0) EXPECT_GE(trajectory[k]["seconds"], trajectory[k - 1]["seconds"]);
+  }
   // spp 16 and bounces 2 are the configuration's own values: the default cell.
   EXPECT_TRUE(cells.at("02_bounces2_spp16")["default"].get<bool>());
   const json& error = cells.at("04_bouncesauto_spp8");
@@ -153,7 +165,9 @@ TEST_F(SweepCommandTest, ViewsAxisAndOuterIterations) {
   EXPECT_EQ(two["ended_by"], "iterations");
   EXPECT_EQ(two["outer_iterations"], 1);
   EXPECT_EQ(two["views"], 2);
-  EXPECT_TRUE(two["f1"].is_null());  // no reference mesh.
+  EXPECT_TRUE(two["f1"].is_null());  // no reference mesh: no per-outer scores either.
+  ASSERT_EQ(two["trajectory"].size(), 1u);
+  EXPECT_FALSE(two["trajectory"][0].contains("chamfer"));
   // Views 0 and 2 of 4 were fitted and scored.
   EXPECT_EQ(two["id"], "00_views2");
   const json state = json::parse(testing::ReadTestFile(tmp_.Join("o/cells/00_views2/state.json")));
