@@ -21,14 +21,27 @@ double NowSeconds() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
-// The base configuration with the grid's outer iterations (or the budget's 10000).
+// Outer iterations of a budgeted cell's last stage: more than any budget allows, so that the
+// budget is what ends the cell.
+constexpr int kBudgetOuterIterations = 10000;
+
+// The base configuration with the grid's outer iterations.
 Status BaseConfig(const SweepGrid& grid, ScheduleConfig* config) {
   SFT_RETURN_IF_ERROR(MergeScheduleConfig(grid.config, "config", config));
   if (grid.outer_iterations > 0) {
     return MergeScheduleConfig({{"outer_iterations", grid.outer_iterations}}, "grid", config);
   }
-  if (grid.time_budget > 0.0 && !config->flat.contains("outer_iterations")) {
-    return MergeScheduleConfig({{"outer_iterations", 10000}}, "grid", config);
+  return Status::Ok();
+}
+
+// The stages of `config`. With a budget and no flat outer_iterations, the last stage runs until
+// the budget ends it; the earlier stages keep their own counts (a list's coarse stages stay as
+// long as the list says, and the budget's remainder goes to its last stage).
+Status ResolveBudgetedStages(const SweepGrid& grid, const ScheduleConfig& config, bool carved,
+                             std::vector<StageOptions>* stages) {
+  SFT_RETURN_IF_ERROR(ResolveStages(config, carved, stages));
+  if (grid.time_budget > 0.0 && !config.flat.contains("outer_iterations")) {
+    stages->back().fit.outer_iterations = kBudgetOuterIterations;
   }
   return Status::Ok();
 }
@@ -194,7 +207,8 @@ Status LoadSweepContext(const SweepGrid& grid, SweepContext* context) {
   SFT_RETURN_IF_ERROR(BaseConfig(grid, &config));
   std::vector<StageOptions> stages;
   SFT_RETURN_IF_ERROR(
-      ResolveStages(config, context->start.kind == StartKind::kCarved, &stages).Prefixed("config"));
+      ResolveBudgetedStages(grid, config, context->start.kind == StartKind::kCarved, &stages)
+          .Prefixed("config"));
   context->default_stages =
       NormalizedStages(stages, static_cast<int>(context->dataset.views.size()));
   SFT_RETURN_IF_ERROR(LoadStartMesh(context->dataset, context->start, InitialMeshOptions(),
@@ -216,7 +230,7 @@ Status CellStages(const SweepContext& context, const SweepCell& cell,
   }
   // A cell with its own start mesh is never carved.
   const bool carved = cell.init.empty() && context.start.kind == StartKind::kCarved;
-  return ResolveStages(config, carved, stages);
+  return ResolveBudgetedStages(*context.grid, config, carved, stages);
 }
 
 bool IsDefaultStages(const SweepContext& context, const std::vector<StageOptions>& stages) {

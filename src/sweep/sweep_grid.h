@@ -72,8 +72,8 @@ struct SweepGrid {
   // Base reconstruct configuration (flat keys, "schedule", "stages"; docs/reconstruct.md).
   nlohmann::json config = nlohmann::json::object();
   // Wall-time budget of each cell's reconstruction, seconds, (0, 1e6]; 0 = none. With a budget
-  // and no outer_iterations (here or in the flat config) every stage gets 10000 outer iterations,
-  // so the budget ends the cell.
+  // and no outer_iterations (here or in the flat config) the last stage gets 10000 outer
+  // iterations, so the budget ends the cell; earlier stages keep their own.
   double time_budget = 0.0;
   int outer_iterations = 0;  // flat outer_iterations of every cell, [1, 10000]; 0 = the config's.
   SweepEvalOptions eval;

@@ -150,6 +150,29 @@ TEST_F(SweepCommandTest, InterruptedAndKilledSweepsContinue) {
   EXPECT_THAT(out, HasSubstr("\"time_budget\""));
 }
 
+// With a budget, a list's earlier stages keep their outer iterations and the last stage runs
+// until the budget ends it.
+TEST_F(SweepCommandTest, BudgetExtendsOnlyTheLastStage) {
+  const std::vector<std::string> lines = RunGrid(R"({
+    "dataset": "ds", "init": "init.ply", "reference": "ds/gt/mesh.ply", "time_budget": 2,
+    "config": {"spp": 2, "steps": 1, "stages": [
+      {"name": "first", "phases": "texture", "outer_iterations": 1},
+      {"name": "last", "phases": "texture", "outer_iterations": 1}]},
+    "eval": {"spp": 2, "bounces": 1, "mesh_samples": 2000}})",
+                                                 "o");
+  ASSERT_EQ(lines.size(), 1u);
+  const json cell = json::parse(lines[0]);
+  ASSERT_EQ(cell["status"], "ok") << lines[0];
+  EXPECT_EQ(cell["ended_by"], "time_budget");
+  const json state = json::parse(testing::ReadTestFile(tmp_.Join("o/cells/00/state.json")));
+  EXPECT_EQ(state["stages"][0]["outer_iterations"], 1);
+  EXPECT_EQ(state["stages"][1]["outer_iterations"], 10000);
+  const json& trajectory = cell["trajectory"];
+  ASSERT_GE(trajectory.size(), 3u);
+  EXPECT_EQ(trajectory[0]["stage"], "first");
+  for (size_t k = 1; k < trajectory.size(); ++k) EXPECT_EQ(trajectory[k]["stage"], "last");
+}
+
 // Views counts become evenly spaced view indices; more views than the dataset has is the cell's
 // error. Outer iterations instead of a budget end the cells.
 TEST_F(SweepCommandTest, ViewsAxisAndOuterIterations) {
