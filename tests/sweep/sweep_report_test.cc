@@ -48,7 +48,8 @@ TEST(SweepReportTest, WritesFrontsTableAndDefault) {
   const std::string html = testing::ReadTestFile(tmp.Join("report.html"));
   size_t charts = 0;
   for (size_t p = html.find("<svg"); p != std::string::npos; p = html.find("<svg", p + 1)) ++charts;
-  EXPECT_EQ(charts, 5u);
+  EXPECT_EQ(charts, 5u);  // no trajectories: no chart of them.
+  EXPECT_THAT(html, Not(HasSubstr("Accuracy within each cell")));
   for (const char* text :
        {"Chamfer against wall time", "F1 against wall time", "full PSNR against wall time",
         "albedo PSNR against wall time", "roughness PSNR against wall time", "Pareto front",
@@ -84,6 +85,34 @@ TEST(SweepReportTest, WithoutReferenceOrResultsSaysSo) {
   EXPECT_THAT(html, HasSubstr("Chamfer: no finished cell has it (the grid gives no reference"));
   EXPECT_THAT(html, HasSubstr("not among the finished cells"));
   EXPECT_EQ(html.find("<svg"), std::string::npos);
+}
+
+// Cells with per-outer scores get one line each in a chart of Chamfer within the cell; a cell
+// whose trajectory has no Chamfer (no reference) is left out of it.
+TEST(SweepReportTest, TrajectoriesChart) {
+  testing::TempDir tmp;
+  SweepGrid grid;
+  ASSERT_TRUE(ParseSweepGrid(json::parse(R"({"dataset": "ds", "reference": "gt.ply",
+                                              "axes": {"spp": [4, 16]}})"),
+                             "g", "/", &grid)
+                  .ok());
+  const std::vector<SweepCell> cells = EnumerateCells(grid);
+  json a = Line(cells[0].id, 10, 0.01, 0.5, 20), b = Line(cells[1].id, 12, 0.02, 0.4, 19);
+  a["trajectory"] = json::parse(R"([{"stage": "half", "seconds": 4, "chamfer": 0.03},
+                                    {"stage": "full_stage", "seconds": 9, "chamfer": 0.012}])");
+  b["trajectory"] = json::parse(R"([{"stage": "half", "seconds": 5}])");
+  ASSERT_TRUE(WriteSweepReport(tmp.path(), grid, cells, {a, b}).ok());
+  const std::string html = testing::ReadTestFile(tmp.Join("report.html"));
+  size_t charts = 0;
+  for (size_t p = html.find("<svg"); p != std::string::npos; p = html.find("<svg", p + 1)) ++charts;
+  EXPECT_EQ(charts, 6u);
+  EXPECT_THAT(html, HasSubstr("Accuracy within each cell"));
+  EXPECT_THAT(html, HasSubstr("full_stage: 0.012"));  // the tooltip of a's second point.
+  const size_t chart = html.find("Chamfer within each cell");
+  ASSERT_NE(chart, std::string::npos);
+  const std::string svg = html.substr(chart, html.find("</svg>", chart) - chart);
+  EXPECT_THAT(svg, HasSubstr(cells[0].id));
+  EXPECT_THAT(svg, Not(HasSubstr(cells[1].id)));
 }
 
 TEST(SweepReportTest, LineValues) {
