@@ -7,7 +7,7 @@
       random axis and shifted by --translation scene units in a random direction, both applied on
       the left (in the camera frame), as sft's pose corrections are.
   perturb_poses.py score DATASET PERTURBED [RUN]
-      The mean and largest rotation error (degrees) and mean translation error of PERTURBED's
+      The mean and largest rotation error (degrees) and mean camera-centre error of PERTURBED's
       poses against DATASET's, corrected by RUN/poses.json when given.
 
 Standard library only (no NumPy).
@@ -50,6 +50,13 @@ def left(pose, theta, tau):
     t = qrot(q, pose["translation"])
     return {"rotation": qmul(q, pose["rotation"]),
             "translation": [t[i] + tau[i] for i in range(3)]}
+
+
+def centre(pose):
+    """The camera centre −Rᵀt in the world."""
+    q = pose["rotation"]
+    c = qrot([q[0], -q[1], -q[2], -q[3]], pose["translation"])
+    return [-x for x in c]
 
 
 def random_unit(rng):
@@ -95,9 +102,9 @@ def score(args):
         if i == 0:
             continue
         rot.append(angle_deg(a["cam_from_world"]["rotation"], b["cam_from_world"]["rotation"]))
-        ta, tb = a["cam_from_world"]["translation"], b["cam_from_world"]["translation"]
-        trans.append(math.sqrt(sum((x - y) ** 2 for x, y in zip(ta, tb))))
-    print("rotation error: mean %.4f deg, max %.4f deg; translation error: mean %.5f" %
+        ca, cb = centre(a["cam_from_world"]), centre(b["cam_from_world"])
+        trans.append(math.sqrt(sum((x - y) ** 2 for x, y in zip(ca, cb))))
+    print("rotation error: mean %.4f deg, max %.4f deg; camera centre error: mean %.5f" %
           (sum(rot) / len(rot), max(rot), sum(trans) / len(trans)))
 
 

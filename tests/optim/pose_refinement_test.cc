@@ -21,6 +21,7 @@
 #include "src/geometry/mesh.h"
 #include "src/io/dataset.h"
 #include "src/io/scene_setup.h"
+#include "src/optim/fitted_environment.h"
 #include "src/optim/parameters.h"
 #include "src/optim/pose_corrections.h"
 #include "src/optim/reconstruct.h"
@@ -240,6 +241,7 @@ TEST(PoseFitTest, UnsupportedLightingIsRefused) {
   ASSERT_EQ(testing::ReadLightFit(dir.Join("ds"), &fit), "");
   fit.options.fit_poses = true;
   testing::RemoveLights(&fit.dataset);
+  ASSERT_TRUE(AddFittedEnvironment(probe, LightFrame::kWorld, &fit.dataset).ok());
   EXPECT_THAT(testing::RunLightFit(fit, {}, {}, &r),
               HasSubstr("fit_poses: the lighting is unknown"));
 }
