@@ -195,9 +195,8 @@ TEST_F(PoseDerivativesTest, FlashRowsMatchFiniteDifferences) {
 }
 
 // Open (docs/design-notes.md, "Camera pose refinement"): with a world-fixed point light the
-// block error is 0.69 (0.51 without shadows), and in this setup moving the light's y or z
-// changes no pixel while x does; not yet understood, so the test is disabled rather than
-// loosened.
+// block error is 0.69 (0.51 without shadows); not yet understood, so the test is disabled
+// rather than loosened.
 TEST_F(PoseDerivativesTest, DISABLED_WorldLightRowsMatchFiniteDifferences) {
   const Errors errors = Check(/*world_light=*/true);
   EXPECT_TRUE(errors.only_poses);
