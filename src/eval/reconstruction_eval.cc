@@ -202,7 +202,8 @@ Status LoadRunToRender(const std::string& dataset_dir, const std::string& recons
   // did not correct (held-out ones among them) keep the dataset's.
   std::vector<PoseDelta> poses;
   bool found = false;
-  SFT_RETURN_IF_ERROR(ReadPoses(JoinPath(reconstruction, kPosesFile), run->dataset, &poses, &found));
+  SFT_RETURN_IF_ERROR(
+      ReadPoses(JoinPath(reconstruction, kPosesFile), run->dataset, &poses, &found));
   for (size_t v = 0; v < poses.size(); ++v) {
     Rigid3d& pose = run->dataset.views[v].cam_from_world;
     pose = CorrectedCamFromWorld(pose, poses[v]);

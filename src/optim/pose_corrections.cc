@@ -163,14 +163,14 @@ std::string PosesJson(const std::vector<PoseDelta>& corrections,
     const PoseDelta& d = corrections[v];
     if (d.isZero(0.0)) continue;
     const Rigid3d pose = CorrectedCamFromWorld(cam_from_world[v], d);
-    json entry = {{"view", v},
-                  {"rotation", {d[0], d[1], d[2]}},
-                  {"translation", {d[3], d[4], d[5]}},
-                  {"cam_from_world",
-                   {{"rotation", {pose.rotation.w(), pose.rotation.x(), pose.rotation.y(),
-                                  pose.rotation.z()}},
-                    {"translation",
-                     {pose.translation.x(), pose.translation.y(), pose.translation.z()}}}}};
+    json entry = {
+        {"view", v},
+        {"rotation", {d[0], d[1], d[2]}},
+        {"translation", {d[3], d[4], d[5]}},
+        {"cam_from_world",
+         {{"rotation",
+           {pose.rotation.w(), pose.rotation.x(), pose.rotation.y(), pose.rotation.z()}},
+          {"translation", {pose.translation.x(), pose.translation.y(), pose.translation.z()}}}}};
     if (v < images.size()) entry["image"] = images[v];
     views.push_back(entry);
   }

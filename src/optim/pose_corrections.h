@@ -72,14 +72,14 @@ class PoseChain {
   // ∂x/∂δ (3 × 6) of a world-fixed point x, and of a world-fixed direction parameter v.
   Eigen::Matrix<double, 3, 6> PointJacobian(const Eigen::Vector3d& x) const;
 
-  int light_offset_ = 0;  // the layout's LightPositionOffset(): start of light_rows_.
+  int light_offset_ = 0;            // the layout's LightPositionOffset(): start of light_rows_.
   Eigen::Matrix3d world_from_cam_;  // R'ᵀ.
   Eigen::Matrix3d left_;            // J_l(ω).
   Eigen::Vector3d translation_;     // t' − τ.
   Eigen::Matrix3d rotation_;        // R'.
   std::vector<Eigen::Matrix<double, 1, 6>> vertex_rows_;  // 3 per vertex.
   std::vector<Eigen::Matrix<double, 1, 6>> light_rows_;   // from light_offset_ to the layout's end.
-  std::vector<bool> light_moves_;                          // whether light_rows_[k] is set.
+  std::vector<bool> light_moves_;                         // whether light_rows_[k] is set.
 };
 
 // `rows` (one view's, all renderer parameters) with six entries ∂I/∂δ per pixel appended at

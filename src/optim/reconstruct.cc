@@ -86,8 +86,8 @@ Status AddEnvironmentRotations(const Dataset& dataset, const ReconstructOptions&
                                SceneParameters* params) {
   bool world_probe = false;
   for (const LightSpec& light : dataset.lights) {
-    world_probe = world_probe ||
-                  (light.type == LightType::kEnvironment && light.frame == LightFrame::kWorld);
+    world_probe =
+        world_probe || (light.type == LightType::kEnvironment && light.frame == LightFrame::kWorld);
   }
   // A pose fit turns a world-fixed probe relative to the camera (pose_corrections.h).
   const bool needed = options.fit_environment_rotation || (options.fit_poses && world_probe);

@@ -191,8 +191,8 @@ Status WritePoses(const std::string& out, const Dataset& dataset,
   return WriteTextFile(JoinPath(out, kPosesFile), PosesJson(view_poses, poses, images, gauge_view));
 }
 
-Status ReadPoses(const std::string& path, const Dataset& dataset, std::vector<PoseDelta>* view_poses,
-                 bool* found) {
+Status ReadPoses(const std::string& path, const Dataset& dataset,
+                 std::vector<PoseDelta>* view_poses, bool* found) {
   view_poses->clear();
   *found = FileExists(path);
   if (!*found) return Status::Ok();

@@ -85,8 +85,8 @@ Status WritePoses(const std::string& out, const Dataset& dataset,
                   const std::vector<PoseDelta>& view_poses, int gauge_view);
 // Reads `path` (a poses.json) into one correction per dataset view; *found = false (and no
 // corrections) when the file does not exist. Errors name the file and the field.
-Status ReadPoses(const std::string& path, const Dataset& dataset, std::vector<PoseDelta>* view_poses,
-                 bool* found);
+Status ReadPoses(const std::string& path, const Dataset& dataset,
+                 std::vector<PoseDelta>* view_poses, bool* found);
 
 // metrics.csv and metrics.json. `records` are all iterations so far (resumed runs included),
 // `extra` is merged into metrics.json's top level.

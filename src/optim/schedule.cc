@@ -164,8 +164,8 @@ Status Schedule::Resume(const Dataset& dataset, const std::string& out,
   }
   s->current_.view_gains = view_gains;
   bool have_poses = false;
-  SFT_RETURN_IF_ERROR(ReadPoses(JoinPath(out, kPosesFile), dataset, &s->current_.view_poses,
-                                &have_poses));
+  SFT_RETURN_IF_ERROR(
+      ReadPoses(JoinPath(out, kPosesFile), dataset, &s->current_.view_poses, &have_poses));
   // The caller gave the fitted light the checkpoint's map (kFittedEnvironmentFile).
   if (FittedEnvironmentLight(dataset) >= 0) {
     s->current_.environment = dataset.lights[FittedEnvironmentLight(dataset)].pixels;

@@ -63,8 +63,7 @@ TEST(ReconstructPosesTest, PosesAreRecoveredWrittenEvaluatedAndResumed) {
   }
   ASSERT_TRUE(WriteSceneJson(dataset, tmp.Join("ds")).ok());
   const double before = MeanError(dataset, truth, "");
-  testing::WriteTestFile(tmp.Join("cfg.json"),
-                         R"({"fit_poses": true, "albedo_smoothness": 0.1})");
+  testing::WriteTestFile(tmp.Join("cfg.json"), R"({"fit_poses": true, "albedo_smoothness": 0.1})");
   ASSERT_EQ(RunSft("reconstruct --quiet --dataset " + tmp.Join("ds") + " --init " +
                        tmp.Join("ds/gt/mesh.ply") + " --config " + tmp.Join("cfg.json") +
                        " --spp 16 --bounces 1 --steps 5 --phases texture --outer 2 --out " +
@@ -89,7 +88,8 @@ TEST(ReconstructPosesTest, PosesAreRecoveredWrittenEvaluatedAndResumed) {
                      &text),
               0)
         << text;
-    return nlohmann::json::parse(testing::ReadTestFile(tmp.Join("eval.json")))["full"]["psnr_linear"]
+    return nlohmann::json::parse(
+               testing::ReadTestFile(tmp.Join("eval.json")))["full"]["psnr_linear"]
         .get<double>();
   };
   const double fitted_psnr = eval_psnr();
@@ -113,8 +113,7 @@ TEST(ReconstructPosesTest, PosesAreRecoveredWrittenEvaluatedAndResumed) {
   // --resume continues from the corrections (poses.json, restored) and rewrites them after one
   // more outer iteration: still within half the given error.
   ASSERT_EQ(std::rename(tmp.Join("poses.json").c_str(), tmp.Join("r/poses.json").c_str()), 0);
-  ASSERT_EQ(RunSft("reconstruct --quiet --resume " + tmp.Join("r") + " --outer 3", &out), 0)
-      << out;
+  ASSERT_EQ(RunSft("reconstruct --quiet --resume " + tmp.Join("r") + " --outer 3", &out), 0) << out;
   const double resumed = MeanError(dataset, truth, testing::ReadTestFile(tmp.Join("r/poses.json")));
   std::printf("after one more outer iteration: %.3f deg\n", resumed);
   EXPECT_LT(resumed, 0.5 * before);

@@ -40,12 +40,12 @@ class PoseDerivativesTest : public ::testing::Test {
   static void SetUpTestSuite() {
     dir_ = new testing::TempDir();
     std::string output;
-    const int code = testing::RunSft(
-        "synth --quiet --mesh " + testing::DataDir() + "/meshes/bunny_watertight_5k.obj --out " +
-            dir_->Join("ds") +
-            " --cameras 4 --zooms 1 --res 32 --spp 16 --bounces 1 --shading flat "
-            "--material '{\"albedo\": [0.6, 0.5, 0.4], \"roughness\": 0.5}'",
-        &output);
+    const int code =
+        testing::RunSft("synth --quiet --mesh " + testing::DataDir() +
+                            "/meshes/bunny_watertight_5k.obj --out " + dir_->Join("ds") +
+                            " --cameras 4 --zooms 1 --res 32 --spp 16 --bounces 1 --shading flat "
+                            "--material '{\"albedo\": [0.6, 0.5, 0.4], \"roughness\": 0.5}'",
+                        &output);
     ASSERT_EQ(code, 0) << output;
   }
   static void TearDownTestSuite() {
@@ -54,9 +54,9 @@ class PoseDerivativesTest : public ::testing::Test {
   }
 
   struct Errors {
-    double block = 0.0;  // relative L2 error of 8×8 block sums over the 6 components.
-    double sum = 0.0;    // the largest relative error of a component's weighted image sum.
-    double adjoint = 0.0;  // the largest relative gap between the adjoint and weighted rows.
+    double block = 0.0;      // relative L2 error of 8×8 block sums over the 6 components.
+    double sum = 0.0;        // the largest relative error of a component's weighted image sum.
+    double adjoint = 0.0;    // the largest relative gap between the adjoint and weighted rows.
     bool only_poses = true;  // the stored rows hold pose entries only.
   };
 
@@ -164,8 +164,7 @@ class PoseDerivativesTest : public ::testing::Test {
         }
       }
       const double sum_error = std::abs(sum_an - sum_fd) / std::max(std::abs(sum_fd), 1e-12);
-      const double adjoint_gap =
-          std::abs(gradient[first + k] - sum_an) / std::max(sum_abs, 1e-12);
+      const double adjoint_gap = std::abs(gradient[first + k] - sum_an) / std::max(sum_abs, 1e-12);
       std::printf(
           "%s light, δ_%d: block error %.3g, Σw·rows %.5g, Σw·fd %.5g (rel. error %.3g), adjoint "
           "gap %.2g\n",

@@ -16,9 +16,9 @@
 
 #include "src/core/file_util.h"
 #include "src/core/rng.h"
-#include "src/image/image_io.h"
 #include "src/geometry/material.h"
 #include "src/geometry/mesh.h"
+#include "src/image/image_io.h"
 #include "src/io/dataset.h"
 #include "src/io/scene_setup.h"
 #include "src/optim/fitted_environment.h"
@@ -109,9 +109,9 @@ TEST(PoseChainTest, ChainMatchesCentralDifferences) {
   delta0 << 0.02, -0.03, 0.015, 0.01, -0.02, 0.03;
   ViewSetup view = base;
   ApplyPoseCorrection(delta0, &view);
-  EXPECT_LT((view.cam_from_world * view.point_lights[0].position - Eigen::Vector3d(0.1, 0, 0))
-                .norm(),
-            1e-12)
+  EXPECT_LT(
+      (view.cam_from_world * view.point_lights[0].position - Eigen::Vector3d(0.1, 0, 0)).norm(),
+      1e-12)
       << "the flash rides with the camera";
   EXPECT_LT((view.point_lights[1].position - base.point_lights[1].position).norm(), 1e-15);
   EXPECT_LT((view.cam_from_world.rotation * view.directional_lights[1].direction -
@@ -215,9 +215,8 @@ TEST(PosesFileTest, RoundTripAndBadInput) {
               HasSubstr("format: expected \"sft-poses/1\""));
   EXPECT_THAT(error(R"({"format": "sft-poses/1", "views": [{"view": 7}]})"),
               HasSubstr("views[0].view: 7 is not a view of the 3-view dataset"));
-  EXPECT_THAT(
-      error(R"({"format": "sft-poses/1", "views": [{"view": 1, "rotation": [0, 0]}]})"),
-      HasSubstr("views[0].rotation: expected 3 finite numbers"));
+  EXPECT_THAT(error(R"({"format": "sft-poses/1", "views": [{"view": 1, "rotation": [0, 0]}]})"),
+              HasSubstr("views[0].rotation: expected 3 finite numbers"));
   EXPECT_THAT(error(R"({"format": "sft-poses/1", "views": [{"view": 1, "rotation": [0, 0, 0],
                         "translation": [0, "x", 0]}]})"),
               HasSubstr("views[0].translation: expected 3 finite numbers"));
