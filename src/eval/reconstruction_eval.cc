@@ -17,6 +17,7 @@
 #include "src/io/light_scales.h"
 #include "src/io/scene_setup.h"
 #include "src/optim/fitted_environment.h"
+#include "src/optim/run_outputs.h"
 #include "src/render/render.h"
 
 namespace sft {
@@ -196,6 +197,16 @@ Status LoadRunToRender(const std::string& dataset_dir, const std::string& recons
   const std::string lights = JoinPath(reconstruction, "lights.json");
   if (FileExists(lights)) {
     SFT_RETURN_IF_ERROR(ApplyLightsFile(lights, &run->dataset));
+  }
+  // Refined poses (fit_poses): the fitted views render at their corrected poses; views the run
+  // did not correct (held-out ones among them) keep the dataset's.
+  std::vector<PoseDelta> poses;
+  bool found = false;
+  SFT_RETURN_IF_ERROR(
+      ReadPoses(JoinPath(reconstruction, kPosesFile), run->dataset, &poses, &found));
+  for (size_t v = 0; v < poses.size(); ++v) {
+    Rigid3d& pose = run->dataset.views[v].cam_from_world;
+    pose = CorrectedCamFromWorld(pose, poses[v]);
   }
   return Status::Ok();
 }

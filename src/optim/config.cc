@@ -270,6 +270,7 @@ const std::map<std::string, Key>& Keys() {
       {"fit_light_directions", Bool([](O* o) -> bool& { return o->fit_light_directions; })},
       {"fit_environment_rotation", Bool([](O* o) -> bool& { return o->fit_environment_rotation; })},
       {"fit_exposure", Bool([](O* o) -> bool& { return o->fit_exposure; })},
+      {"fit_poses", Bool([](O* o) -> bool& { return o->fit_poses; })},
       {"exposure_prior",
        Real([](O* o) -> double& { return o->regularizers.exposure_prior; }, 0, 1e12)},
       {"fit_environment", Bool([](O* o) -> bool& { return o->fit_environment; })},

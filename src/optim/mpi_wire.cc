@@ -107,6 +107,7 @@ std::vector<std::vector<char> > StateParts(const RenderState& s) {
   settings.PutVector(s.light_positions);
   settings.PutVector(s.light_directions);
   settings.PutVector(s.environment_rotations);
+  settings.PutVector(s.pose_corrections);
   PutRenderOptions(s.render, &settings);
   PutRequest(s.request, &settings);
   settings.Put(s.layout);
@@ -144,6 +145,7 @@ void ApplyStatePart(int part, const std::vector<char>& bytes, RenderState* s) {
       s->light_positions = r.GetVector<Eigen::Vector3d>();
       s->light_directions = r.GetVector<Eigen::Vector3d>();
       s->environment_rotations = r.GetVector<Eigen::Vector3d>();
+      s->pose_corrections = r.GetVector<PoseDelta>();
       s->render = GetRenderOptions(&r);
       s->request = GetRequest(&r);
       s->layout = r.Get<ParameterLayout>();

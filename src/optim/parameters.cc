@@ -22,6 +22,11 @@ bool ParameterBounds::Check(std::string* why) const {
     *why = "environment_rotation_max: must be in (0, pi]";
     return false;
   }
+  if (!(pose_rotation_max > 0.0 && pose_rotation_max <= M_PI && pose_translation_max > 0.0 &&
+        std::isfinite(pose_translation_max))) {
+    *why = "pose_rotation_max/pose_translation_max: need 0 < rotation <= pi, 0 < translation";
+    return false;
+  }
   if (!(environment_max > 0.0 && std::isfinite(environment_max))) {
     *why = "environment_max: must be finite and > 0";
     return false;
@@ -144,6 +149,18 @@ std::vector<Eigen::Vector3d> SceneParameters::LightVectors(ParameterKind kind) c
   return vectors;
 }
 
+void SceneParameters::AddPoses(int num_pose_views) {
+  CHECK_GE(num_pose_views, 0);
+  CHECK_EQ(num_pose_views_, 0) << "poses added twice";
+  num_pose_views_ = num_pose_views;
+  values_.resize(values_.size() + 6 * num_pose_views, 0.0);
+}
+
+PoseDelta SceneParameters::Pose(int view) const {
+  if (view < 0 || view >= num_pose_views_) return PoseDelta::Zero();
+  return Eigen::Map<const PoseDelta>(&values_[PoseIndex(view, 0)]);
+}
+
 Image SceneParameters::EnvironmentTexels() const {
   if (!has_environment()) return Image();
   Image texels(environment_width_, environment_height_, 3);
@@ -195,11 +212,19 @@ std::vector<BlockSpan> SceneParameters::Blocks() const {
   for (int v = 0; v < num_gain_views_; ++v) {
     blocks.push_back({GainIndex(v, 0), 3, ParameterKind::kLight, /*exposure=*/true});
   }
+  for (int v = 0; v < num_pose_views_; ++v) {
+    blocks.push_back({PoseIndex(v, 0), 6, ParameterKind::kLight, /*exposure=*/false,
+                      /*pose=*/true});
+  }
   return blocks;
 }
 
 BlockSpan SceneParameters::BlockOf(int index) const {
   DCHECK(index >= 0 && index < size());
+  if (IsPose(index)) {
+    const int local = index - PoseOffset();
+    return {index - local % 6, 6, ParameterKind::kLight, /*exposure=*/false, /*pose=*/true};
+  }
   if (IsExposure(index)) {
     const int local = index - ExposureOffset();
     return {index - local % 3, 3, ParameterKind::kLight, /*exposure=*/true};
@@ -260,6 +285,7 @@ std::vector<double> SceneParameters::LightScales() const {
 }
 
 double SceneParameters::Lower(int index, const ParameterBounds& bounds) const {
+  if (IsPose(index)) return -Upper(index, bounds);
   if (IsExposure(index)) return bounds.gain_min;
   switch (layout_.KindOf(index)) {
     case ParameterKind::kVertex:
@@ -282,6 +308,9 @@ double SceneParameters::Lower(int index, const ParameterBounds& bounds) const {
 }
 
 double SceneParameters::Upper(int index, const ParameterBounds& bounds) const {
+  if (IsPose(index)) {
+    return (index - PoseOffset()) % 6 < 3 ? bounds.pose_rotation_max : bounds.pose_translation_max;
+  }
   if (IsExposure(index)) return bounds.gain_max;
   switch (layout_.KindOf(index)) {
     case ParameterKind::kVertex:

@@ -12,7 +12,8 @@
 // "Exposure and white balance"). Ceres parameter blocks point into this vector: one block per
 // vertex (3), per albedo texel (3), per roughness texel (1), the specular weight (1), each light
 // scale (1), each environment texel (3), each light position (3), each light direction (3), each
-// environment rotation (3) and each view's gains (3), so
+// environment rotation (3), each view's gains (3) and, with AddPoses, each view's pose correction
+// (6: src/optim/pose_corrections.h, after the gains), so
 // the mapping between Ceres
 // blocks and indices is the block's offset in the vector.
 #ifndef SFT_OPTIM_PARAMETERS_H_
@@ -24,6 +25,7 @@
 
 #include "src/core/image.h"
 #include "src/geometry/material.h"
+#include "src/optim/pose_corrections.h"
 #include "src/render/derivatives.h"
 
 namespace sft {
@@ -50,6 +52,12 @@ struct ParameterBounds {
   // stays in [−max, max], radians: a refinement of a given alignment by a few degrees, not a
   // search (0.1 rad ≈ 5.7°; docs/reconstruct.md, "Probe rotation").
   double environment_rotation_max = 0.1;
+  // Each rotation component of a view's pose correction (src/optim/pose_corrections.h) stays in
+  // [−pose_rotation_max, pose_rotation_max], radians (0.05 rad ≈ 2.9°: a refinement of poses good
+  // to about half a degree), and each translation component in ±pose_translation_max, scene units
+  // (the importers normalise the object to a bounding-box diagonal of 1: 5% of it).
+  double pose_rotation_max = 0.05;
+  double pose_translation_max = 0.05;
 
   bool Check(std::string* why) const;
 };
@@ -66,13 +74,14 @@ struct ActiveParameters {
   bool light_positions = false;  // point-light positions (when the parameters have them).
   bool light_directions = false;  // directional-light directions (when the parameters have them).
   bool environment_rotations = false;  // environment rotations (when the parameters have them).
+  bool poses = false;  // the per-view pose corrections (all views but the gauge view).
 
   // The renderer's kinds (exposure gains are applied by the render cache, not the renderer).
   ParameterSelection ToSelection() const;
   bool Includes(ParameterKind kind) const;
   bool Any() const {
     return vertices || albedo || roughness || specular || lights || exposure || environment ||
-           light_positions || light_directions || environment_rotations;
+           light_positions || light_directions || environment_rotations || poses;
   }
 };
 
@@ -87,6 +96,7 @@ struct BlockSpan {
   int size = 0;
   ParameterKind kind = ParameterKind::kVertex;  // meaningless when `exposure`.
   bool exposure = false;                        // one view's 3 exposure gains.
+  bool pose = false;                            // one view's 6 pose-correction numbers.
 };
 
 class SceneParameters {
@@ -107,7 +117,7 @@ class SceneParameters {
   int size() const { return static_cast<int>(values_.size()); }
   int ExposureOffset() const { return layout_.size(); }
   int num_gain_views() const { return num_gain_views_; }
-  bool IsExposure(int index) const { return index >= layout_.size(); }
+  bool IsExposure(int index) const { return index >= layout_.size() && index < PoseOffset(); }
   // Index of fitted view v's gain of channel c.
   int GainIndex(int view, int c) const { return ExposureOffset() + 3 * view + c; }
   // Fitted view v's gains (1, 1, 1 when the vector has none).
@@ -116,12 +126,26 @@ class SceneParameters {
   bool GainFitted(int view) const {
     return view != kExposureGaugeView && view >= 0 && view < num_gain_views_;
   }
+  // Pose corrections (src/optim/pose_corrections.h): 6 per fitted view after the gains, added by
+  // AddPoses (all zero: the dataset's poses).
+  void AddPoses(int num_pose_views);
+  int PoseOffset() const { return ExposureOffset() + 3 * num_gain_views_; }
+  int num_pose_views() const { return num_pose_views_; }
+  bool IsPose(int index) const { return index >= PoseOffset(); }
+  // Index of fitted view v's correction component k (0–2 rotation, 3–5 translation).
+  int PoseIndex(int view, int k) const { return PoseOffset() + 6 * view + k; }
+  // Fitted view v's correction (zero when the vector has none).
+  PoseDelta Pose(int view) const;
+  // Whether fitted view v's correction is a parameter of a pose fit (not the gauge view).
+  bool PoseFitted(int view) const {
+    return view != kPoseGaugeView && view >= 0 && view < num_pose_views_;
+  }
   std::vector<double>& values() { return values_; }
   const std::vector<double>& values() const { return values_; }
   double* data() { return values_.data(); }
 
   // Every block in order: vertices, albedo texels, roughness texels, specular, lights,
-  // environment texels, light positions, gains.
+  // environment texels, light positions, light directions, environment rotations, gains, poses.
   std::vector<BlockSpan> Blocks() const;
   // The block holding parameter `index`.
   BlockSpan BlockOf(int index) const;
@@ -171,7 +195,8 @@ class SceneParameters {
   int environment_height() const { return environment_height_; }
 
   // Lower/upper bound of parameter `index` (±infinity for vertices, light positions and
-  // directions; ±environment_rotation_max for environment rotations).
+  // directions; ±environment_rotation_max for environment rotations; ±pose_rotation_max and
+  // ±pose_translation_max for pose corrections).
   double Lower(int index, const ParameterBounds& bounds) const;
   double Upper(int index, const ParameterBounds& bounds) const;
   // Clamps every value into the bounds (projection onto the feasible set).
@@ -189,6 +214,7 @@ class SceneParameters {
 
   ParameterLayout layout_;
   int num_gain_views_ = 0;
+  int num_pose_views_ = 0;
   int environment_width_ = 0;
   int environment_height_ = 0;
   std::vector<double> values_;

@@ -29,6 +29,7 @@ ActiveParameters TexturePhase(const ReconstructOptions& options) {
   active.light_directions = options.fit_light_directions;
   active.environment_rotations = options.fit_environment_rotation;
   active.exposure = options.fit_exposure;
+  active.poses = options.fit_poses;
   active.environment = options.fit_environment;
   return active;
 }
@@ -49,7 +50,13 @@ Status AddLightGeometry(const Dataset& dataset, const ReconstructOptions& option
   const size_t num_lights = dataset.lights.size();
   for (const bool direction : {false, true}) {
     const std::vector<Eigen::Vector3d>& given = direction ? directions : positions;
-    const bool fit = direction ? options.fit_light_directions : options.fit_light_positions;
+    bool fit = direction ? options.fit_light_directions : options.fit_light_positions;
+    // A pose fit contracts the rows of world-fixed lights (pose_corrections.h): they must be
+    // parameters, held when not fitted.
+    const LightType type = direction ? LightType::kDirectional : LightType::kPoint;
+    for (const LightSpec& light : dataset.lights) {
+      fit = fit || (options.fit_poses && light.type == type && light.frame == LightFrame::kWorld);
+    }
     if (!fit && given.empty()) continue;
     if (!given.empty() && given.size() != num_lights) {
       return Status::Error(std::string(direction ? "light directions: " : "light positions: ") +
@@ -77,11 +84,24 @@ Status AddLightGeometry(const Dataset& dataset, const ReconstructOptions& option
 Status AddEnvironmentRotations(const Dataset& dataset, const ReconstructOptions& options,
                                const std::vector<Eigen::Vector3d>& rotations,
                                SceneParameters* params) {
-  if (!options.fit_environment_rotation && rotations.empty()) return Status::Ok();
+  bool world_probe = false;
+  for (const LightSpec& light : dataset.lights) {
+    world_probe =
+        world_probe || (light.type == LightType::kEnvironment && light.frame == LightFrame::kWorld);
+  }
+  // A pose fit turns a world-fixed probe relative to the camera (pose_corrections.h).
+  const bool needed = options.fit_environment_rotation || (options.fit_poses && world_probe);
+  if (!needed && rotations.empty()) return Status::Ok();
   const size_t num_lights = dataset.lights.size();
   if (!rotations.empty() && rotations.size() != num_lights) {
     return Status::Error("environment rotations: " + std::to_string(rotations.size()) +
                          " given, the dataset has " + std::to_string(num_lights) + " lights");
+  }
+  if (FittedEnvironmentLight(dataset) >= 0 && !options.fit_environment_rotation &&
+      options.fit_poses) {
+    return Status::Error(
+        "fit_poses: the lighting is unknown (a fitted environment); refining poses under a "
+        "fitted environment is not supported yet");
   }
   if (FittedEnvironmentLight(dataset) >= 0) {
     return Status::Error(
@@ -96,6 +116,33 @@ Status AddEnvironmentRotations(const Dataset& dataset, const ReconstructOptions&
   params->AddEnvironmentRotations(
       rotations.empty() ? std::vector<Eigen::Vector3d>(num_lights, Eigen::Vector3d::Zero())
                         : rotations);
+  return Status::Ok();
+}
+
+// Pose corrections are parameters whenever an earlier fit corrected a pose (`poses` not all zero)
+// or this fit refines them. A camera-fixed probe would turn with every pose change: refused.
+Status AddPoses(const Dataset& dataset, const ReconstructOptions& options,
+                const std::vector<int>& views, const std::vector<PoseDelta>& poses,
+                SceneParameters* params) {
+  bool any = options.fit_poses;
+  for (int v : views) any = any || !poses[v].isZero(0.0);
+  if (!any) return Status::Ok();
+  for (const LightSpec& light : dataset.lights) {
+    if (light.type == LightType::kEnvironment && light.frame == LightFrame::kCamera) {
+      return Status::Error("fit_poses: light '" + light.id +
+                           "' is a camera-fixed environment; refining poses under it is not "
+                           "supported");
+    }
+  }
+  if (FittedEnvironmentLight(dataset) >= 0) {
+    return Status::Error(
+        "fit_poses: the lighting is unknown (a fitted environment); refining poses under a "
+        "fitted environment is not supported yet");
+  }
+  params->AddPoses(static_cast<int>(views.size()));
+  for (size_t k = 0; k < views.size(); ++k) {
+    for (int i = 0; i < 6; ++i) params->values()[params->PoseIndex(k, i)] = poses[views[k]][i];
+  }
   return Status::Ok();
 }
 
@@ -182,7 +229,8 @@ Status Reconstruction::Create(const Dataset& dataset, const TriMesh& mesh, const
                               const Image& environment,
                               const std::vector<Eigen::Vector3d>& light_positions,
                               const std::vector<Eigen::Vector3d>& light_directions,
-                              const std::vector<Eigen::Vector3d>& environment_rotations) {
+                              const std::vector<Eigen::Vector3d>& environment_rotations,
+                              const std::vector<PoseDelta>& view_poses) {
   std::string why;
   if (!options.Check(&why)) return Status::Error(why);
   std::unique_ptr<Reconstruction> r(new Reconstruction());
@@ -233,6 +281,13 @@ Status Reconstruction::Create(const Dataset& dataset, const TriMesh& mesh, const
       AddLightGeometry(dataset, options, light_positions, light_directions, &r->params_));
   SFT_RETURN_IF_ERROR(
       AddEnvironmentRotations(dataset, options, environment_rotations, &r->params_));
+  if (!view_poses.empty() && view_poses.size() != num_dataset_views) {
+    return Status::Error("pose corrections: " + std::to_string(view_poses.size()) +
+                         " views given, the dataset has " + std::to_string(num_dataset_views));
+  }
+  r->view_poses_ = view_poses;
+  if (r->view_poses_.empty()) r->view_poses_.assign(num_dataset_views, PoseDelta::Zero());
+  SFT_RETURN_IF_ERROR(AddPoses(dataset, options, views, r->view_poses_, &r->params_));
   SFT_RETURN_IF_ERROR(RenderCache::Create(dataset, &r->views_, views, r->faces_, material,
                                           &r->params_, r->options_.cache, &r->cache_));
   r->start_time_ = NowSeconds();
@@ -383,6 +438,13 @@ std::vector<Eigen::Vector3d> Reconstruction::ViewGains() const {
   const std::vector<int>& views = cache_->view_indices();
   for (int k = 0; k < params_.num_gain_views(); ++k) gains[views[k]] = params_.Gains(k);
   return gains;
+}
+
+std::vector<PoseDelta> Reconstruction::ViewPoses() const {
+  std::vector<PoseDelta> poses = view_poses_;
+  const std::vector<int>& views = cache_->view_indices();
+  for (int k = 0; k < params_.num_pose_views(); ++k) poses[views[k]] = params_.Pose(k);
+  return poses;
 }
 
 Image Reconstruction::RenderNormals(int v) {

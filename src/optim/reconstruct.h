@@ -53,6 +53,11 @@ struct ReconstructOptions {
   // The texture phase also fits per-view exposure gains (3 per fitted view, the first fitted view
   // the fixed gauge; src/optim/parameters.h, kExposureGaugeView).
   bool fit_exposure = false;
+  // The texture phase also refines each fitted view's camera pose: 6 numbers per view (rotation
+  // vector and translation in the camera frame, src/optim/pose_corrections.h), the first fitted
+  // view the fixed gauge, bounded by ParameterBounds::pose_rotation_max and pose_translation_max
+  // (docs/reconstruct.md, "Camera poses").
+  bool fit_poses = false;
   // The texture phase also fits the fitted environment's texels (unknown lighting,
   // src/optim/fitted_environment.h); without a fitted environment it changes nothing. Off by
   // default: `sft reconstruct` fits the map in an automatic first stage with the material held
@@ -95,7 +100,8 @@ class Reconstruction {
  public:
   // `mesh` and `material` are the initial state (copied). `light_scales` may be empty (all 1).
   // `view_gains` are the exposure gains per dataset view (empty = all 1; otherwise one per
-  // dataset view): the fitted views' gains start from them.
+  // dataset view): the fitted views' gains start from them. `view_poses` likewise the pose
+  // corrections per dataset view (empty = all zero).
   static Status Create(const Dataset& dataset, const TriMesh& mesh, const Material& material,
                        const std::vector<double>& light_scales, const ReconstructOptions& options,
                        std::unique_ptr<Reconstruction>* out,
@@ -103,7 +109,8 @@ class Reconstruction {
                        const Image& environment = Image(),
                        const std::vector<Eigen::Vector3d>& light_positions = {},
                        const std::vector<Eigen::Vector3d>& light_directions = {},
-                       const std::vector<Eigen::Vector3d>& environment_rotations = {});
+                       const std::vector<Eigen::Vector3d>& environment_rotations = {},
+                       const std::vector<PoseDelta>& view_poses = {});
 
   // Runs the effect planner for outer iteration `outer` (its renders use the chosen plan from
   // now on). The ceiling is the configured effects and budgets; `image_signal_scale` and
@@ -135,6 +142,9 @@ class Reconstruction {
   // The exposure gains per dataset view: the fitted views' current ones, the others' as given to
   // Create (1 when none were given).
   std::vector<Eigen::Vector3d> ViewGains() const;
+  // The pose corrections per dataset view: the fitted views' current ones, the others' as given
+  // to Create (zero when none were given).
+  std::vector<PoseDelta> ViewPoses() const;
   // Renders every fitted view at the current state (seed `seed`) and returns level-0 images.
   std::vector<Image> RenderViews(uint64_t seed);
   // The normal pass of fitted view `v` at the current state (RGB: world-space geometric normals
@@ -164,6 +174,7 @@ class Reconstruction {
   AdamState adam_;
   std::vector<PhaseRecord> phase_records_;
   std::vector<Eigen::Vector3d> view_gains_;  // per dataset view, as given to Create.
+  std::vector<PoseDelta> view_poses_;        // per dataset view, as given to Create.
   double start_time_ = 0.0;
 };
 

@@ -241,12 +241,22 @@ ViewSetup RenderCache::ScaledView(int v) const {
                       params_->LightPositions(), params_->LightDirections());
   UseFittedEnvironment(params_->layout(), fitted_environment_, view_indices_[v], &view);
   rotated_environments_.Use(view_indices_[v], &view);
+  if (params_->num_pose_views() > 0) ApplyPoseCorrection(params_->Pose(v), &view);
   return view;
+}
+
+bool RenderCache::FitsPose(int v) const { return active_.poses && params_->PoseFitted(v); }
+
+PoseChain RenderCache::ChainOf(int v) const {
+  return PoseChain(params_->layout(), ScaledView(v), params_->Pose(v), scene_positions_,
+                   params_->LightDirections());
 }
 
 DerivativeRequest RenderCache::ActiveRequest() const {
   DerivativeRequest request = options_.edges;
   request.params = active_.ToSelection();
+  // Pose rows are contracted from the rows of everything that moves with the scene.
+  if (active_.poses && params_->num_pose_views() > 1) AddPoseChainSelection(&request.params);
   request.jacobian_rows = false;
   request.adjoint_weights = nullptr;
   return request;
@@ -264,6 +274,9 @@ RenderState RenderCache::CurrentState(const RenderOptions& render,
   state.light_positions = params_->LightPositions();
   state.light_directions = params_->LightDirections();
   state.environment_rotations = params_->EnvironmentRotations();
+  for (int v = 0; v < params_->num_pose_views(); ++v) {
+    state.pose_corrections.push_back(params_->Pose(v));
+  }
   state.render = render;
   state.request = request;
   state.layout = params_->layout();
@@ -382,6 +395,14 @@ void RenderCache::StoreRender(int v, const Image& image, const JacobianRows* row
     if (fit_gains || gain != Eigen::Vector3d::Ones()) {
       level_rows =
           GainedRows(level_rows, ungained, gain, fit_gains ? params_->GainIndex(v, 0) : -1);
+    }
+    if (active_.poses && params_->num_pose_views() > 1) {
+      // The rows of kinds the phase does not fit were only rendered for the pose chain.
+      const auto keep = [&](int param) {
+        return param >= layout.size() || active_.Includes(layout.KindOf(param));
+      };
+      const PoseChain chain = FitsPose(v) ? ChainOf(v) : PoseChain();
+      level_rows = PoseRows(level_rows, chain, params_->PoseIndex(v, 0), keep);
     }
   }
   for (int l = 0; l < num_levels(v); ++l) {
@@ -588,6 +609,14 @@ bool RenderCache::AddGradientResult(int v, const Image& weights, const ViewResul
     if (parts == nullptr) continue;
     for (int t = 0; t < kNumDerivativeTerms; ++t) {
       parts->parts[t][i] += unscaled(result.gradient_parts.parts[t][i]);
+    }
+  }
+  if (FitsPose(v)) {
+    const PoseDelta g = ChainOf(v).Contract(result.gradient);
+    for (int k = 0; k < 6; ++k) {
+      finite = finite && std::isfinite(g[k]);
+      (*gradient)[params_->PoseIndex(v, k)] += g[k];
+      if (parts != nullptr) parts->part(DerivativeTerm::kRest)[params_->PoseIndex(v, k)] += g[k];
     }
   }
   if (active_.exposure && params_->GainFitted(v)) {

@@ -18,6 +18,12 @@
 // g and adds Σ_p w_pc I_pc to the gains' gradient. The gains are exact (linear); I_c is the Monte
 // Carlo render of the same pass.
 //
+// Pose corrections: when the parameters hold them (SceneParameters::AddPoses), view v renders at
+// its corrected pose, and when the phase fits poses (ActiveParameters::poses) and v is not the
+// gauge view, each pixel gains the six entries ∂(g ⊙ I)/∂δ_v, contracted from the rows of the
+// vertices and world-fixed lights, which are rendered for that even when the phase does not fit
+// them (and then dropped); the adjoint pass contracts the gradient the same way.
+//
 // Every render but RenderPassImage's is a ViewJob (view_jobs.h) run by the ViewRunner installed
 // when the cache was created (CurrentViewRunner): in this process, or spread over MPI ranks
 // (mpi_views.h). Results come back in view order, so the stored renders, rows and gradient sums
@@ -214,6 +220,10 @@ class RenderCache : public ceres::EvaluationCallback {
                       const RenderOptions& render, const DerivativeRequest& request, uint64_t seed,
                       std::vector<double>* gradient, GradientParts* parts = nullptr);
   DerivativeRequest ActiveRequest() const;
+  // Whether the phase fits view v's pose correction, and the chain of its rows
+  // (src/optim/pose_corrections.h) at the current parameters.
+  bool FitsPose(int v) const;
+  PoseChain ChainOf(int v) const;
   // Adds view v's adjoint result (of `weights`, ungained) to *gradient: light entries divided by
   // their scales, the exposure gains' part from the result's image. False when not finite.
   // With `parts`, adds the result's gradient parts there alike (the gains' part to kRest).

@@ -180,6 +180,27 @@ Status WriteExposure(const std::string& out, const Dataset& dataset,
   return WriteTextFile(JoinPath(out, "exposure.json"), j.dump(1) + "\n");
 }
 
+Status WritePoses(const std::string& out, const Dataset& dataset,
+                  const std::vector<PoseDelta>& view_poses, int gauge_view) {
+  std::vector<Rigid3d> poses;
+  std::vector<std::string> images;
+  for (const ViewSpec& view : dataset.views) {
+    poses.push_back(view.cam_from_world);
+    images.push_back(view.image);
+  }
+  return WriteTextFile(JoinPath(out, kPosesFile), PosesJson(view_poses, poses, images, gauge_view));
+}
+
+Status ReadPoses(const std::string& path, const Dataset& dataset,
+                 std::vector<PoseDelta>* view_poses, bool* found) {
+  view_poses->clear();
+  *found = FileExists(path);
+  if (!*found) return Status::Ok();
+  std::string text;
+  SFT_RETURN_IF_ERROR(ReadTextFile(path, &text));
+  return ParsePosesJson(text, static_cast<int>(dataset.views.size()), view_poses).Prefixed(path);
+}
+
 Status WriteMetrics(const std::string& out, const std::vector<IterationRecord>& records,
                     const std::vector<PhaseRecord>& phases, const json& extra) {
   std::string csv = "outer,stage,phase,iteration,cost,seconds,accepted,mean_psnr";

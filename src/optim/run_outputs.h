@@ -17,7 +17,9 @@
 //                               counted against it;
 //   stages/NN_NAME_normals.png  the normals of the first fitted view after each stage;
 //   exposure.json               when a stage fits exposure: the gains per dataset view (format
-//                               sft-exposure/1, WriteExposure).
+//                               sft-exposure/1, WriteExposure);
+//   poses.json                  when a stage fits poses: the corrected views' pose corrections
+//                               and poses (format sft-poses/1, WritePoses).
 // A checkpoint is written after every outer iteration and when the run is interrupted.
 #ifndef SFT_OPTIM_RUN_OUTPUTS_H_
 #define SFT_OPTIM_RUN_OUTPUTS_H_
@@ -74,6 +76,17 @@ Status ReadRunSnapshot(const std::string& out, const Dataset& dataset, TriMesh* 
 // when unknown). Views that were not fitted keep 1.
 Status WriteExposure(const std::string& out, const Dataset& dataset,
                      const std::vector<Eigen::Vector3d>& view_gains, int gauge_view);
+
+// poses.json (src/optim/pose_corrections.h, PosesJson): the pose corrections per dataset view
+// (zero: not corrected, not listed) relative to the dataset's cam_from_world, and the corrected
+// poses; G the gauge view (-1 when unknown).
+constexpr char kPosesFile[] = "poses.json";
+Status WritePoses(const std::string& out, const Dataset& dataset,
+                  const std::vector<PoseDelta>& view_poses, int gauge_view);
+// Reads `path` (a poses.json) into one correction per dataset view; *found = false (and no
+// corrections) when the file does not exist. Errors name the file and the field.
+Status ReadPoses(const std::string& path, const Dataset& dataset,
+                 std::vector<PoseDelta>* view_poses, bool* found);
 
 // metrics.csv and metrics.json. `records` are all iterations so far (resumed runs included),
 // `extra` is merged into metrics.json's top level.

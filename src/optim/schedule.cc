@@ -163,6 +163,9 @@ Status Schedule::Resume(const Dataset& dataset, const std::string& out,
                          " views, the dataset has " + std::to_string(dataset.views.size()));
   }
   s->current_.view_gains = view_gains;
+  bool have_poses = false;
+  SFT_RETURN_IF_ERROR(
+      ReadPoses(JoinPath(out, kPosesFile), dataset, &s->current_.view_poses, &have_poses));
   // The caller gave the fitted light the checkpoint's map (kFittedEnvironmentFile).
   if (FittedEnvironmentLight(dataset) >= 0) {
     s->current_.environment = dataset.lights[FittedEnvironmentLight(dataset)].pixels;
@@ -205,7 +208,7 @@ Status Schedule::CreateReconstruction() {
   SFT_RETURN_IF_ERROR(Reconstruction::Create(
       *dataset_, current_.mesh, current_.material, current_.light_scales, stage.fit,
       &reconstruction_, current_.view_gains, current_.environment, current_.light_positions,
-      current_.light_directions, current_.environment_rotations));
+      current_.light_directions, current_.environment_rotations, current_.view_poses));
   reconstruction_->elapsed_offset = Elapsed();
   reconstruction_stage_ = progress_.stage;
   phases_seen_ = 0;
@@ -247,6 +250,7 @@ void Schedule::SyncCurrent() {
   std::vector<Eigen::Vector3d> rotations = reconstruction_->EnvironmentRotations();
   if (!rotations.empty()) current_.environment_rotations = std::move(rotations);
   current_.view_gains = reconstruction_->ViewGains();
+  current_.view_poses = reconstruction_->ViewPoses();
   Image environment = reconstruction_->EnvironmentTexels();
   if (!environment.empty()) current_.environment = std::move(environment);
 }
@@ -596,6 +600,14 @@ Status Schedule::Checkpoint() {
     state.view_gains = current_.view_gains;
     const int gauge = reconstruction_ ? reconstruction_->view_indices()[kExposureGaugeView] : -1;
     SFT_RETURN_IF_ERROR(WriteExposure(out_, *dataset_, current_.view_gains, gauge));
+  }
+  // Poses likewise, in poses.json (which --resume reads back).
+  bool poses = false;
+  for (const StageOptions& s : stages_) poses = poses || s.fit.fit_poses;
+  for (const PoseDelta& d : current_.view_poses) poses = poses || !d.isZero(0.0);
+  if (poses && !current_.view_poses.empty()) {
+    const int gauge = reconstruction_ ? reconstruction_->view_indices()[kPoseGaugeView] : -1;
+    SFT_RETURN_IF_ERROR(WritePoses(out_, *dataset_, current_.view_poses, gauge));
   }
   state.run_info = run_info_;
   for (const StageOptions& s : stages_) state.stages.push_back(StageJson(s));

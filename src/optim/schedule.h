@@ -86,6 +86,8 @@ struct ScheduleStart {
   std::vector<Eigen::Vector3d> environment_rotations;
   // Exposure gains per dataset view (src/optim/parameters.h); empty = all 1.
   std::vector<Eigen::Vector3d> view_gains;
+  // Pose corrections per dataset view (src/optim/pose_corrections.h); empty = all zero.
+  std::vector<PoseDelta> view_poses;
   // The fitted environment's texels (unknown lighting, src/optim/fitted_environment.h); empty =
   // the dataset's fitted light's own (or no fitted environment).
   Image environment;

@@ -191,6 +191,12 @@ AdjointObjective::AdjointObjective(RenderCache* cache, SceneParameters* params,
       for (int c = 0; c < 3; ++c) active_.push_back(params->GainIndex(v, c));
     }
   }
+  if (cache->active().poses) {
+    for (int v = 0; v < params->num_pose_views(); ++v) {
+      if (!params->PoseFitted(v)) continue;
+      for (int k = 0; k < 6; ++k) active_.push_back(params->PoseIndex(v, k));
+    }
+  }
 }
 
 std::vector<double> AdjointObjective::Current() const {

@@ -53,6 +53,7 @@ void StateRenderer::Render(const RenderState& state, const ViewJob& job, ViewRes
                       state.light_scales, state.light_positions, state.light_directions);
   UseFittedEnvironment(state.layout, fitted_environment_, state.view_indices[job.view], &view);
   rotated_environments_.Use(state.view_indices[job.view], &view);
+  if (!state.pose_corrections.empty()) ApplyPoseCorrection(state.pose_corrections[job.view], &view);
   RenderViewJob(*scene_, state.material, view, state.render, state.request, state.layout, job,
                 result);
 }

@@ -21,6 +21,7 @@
 #include "src/core/image.h"
 #include "src/geometry/material.h"
 #include "src/io/scene_setup.h"
+#include "src/optim/pose_corrections.h"
 #include "src/render/derivatives.h"
 #include "src/render/render.h"
 #include "src/render/scene.h"
@@ -72,6 +73,9 @@ struct RenderState {
   // environment's frame); empty = the dataset's alignment (SceneParameters::
   // EnvironmentRotations).
   std::vector<Eigen::Vector3d> environment_rotations;
+  // Pose corrections per render-cache view (src/optim/pose_corrections.h: each view renders at
+  // exp(δ)·cam_from_world); empty = the dataset's poses.
+  std::vector<PoseDelta> pose_corrections;
   RenderOptions render;       // spp, bounces, effects, threads, shading.
   DerivativeRequest request;  // derivative kinds and edge budgets (no weights).
   // The index space of rows and gradients (SceneParameters::layout): vertices, texels, lights
