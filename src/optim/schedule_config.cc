@@ -20,26 +20,26 @@ using json = nlohmann::json;
 const char kRefineSchedule[] = R"([{"name": "refine"}])";
 // large_steps: from a given mesh, material stages (LM: albedo, roughness, specular weight)
 // alternating with geometry stages (Adam on the large-steps parameterisation, a new seed and 8
-// views per step, the specular lobe off and silhouette edges on in the step) at a step size that
-// halves, half scale first. Measured on the glossy dragon and the README bunny
-// (docs/design-notes.md, "Large steps for Adam").
+// views per step, the specular lobe off and silhouette edges on in the step, one pyramid level) at
+// a step size that halves, half scale first. Measured on the glossy dragon and the README bunny
+// (docs/design-notes.md, "Large steps for Adam", "The convergence aids one by one").
 const char kLargeStepsSchedule[] = R"([
   {"name": "material", "phases": "texture", "image_scale": 0.5, "pyramid_levels": 3,
    "outer_iterations": 1, "steps": 5},
   {"name": "shape_half", "phases": "geometry", "solver": "adam", "image_scale": 0.5,
-   "pyramid_levels": 3, "outer_iterations": 2, "steps": 25, "adam_lr_vertices": 0.002},
+   "pyramid_levels": 1, "outer_iterations": 2, "steps": 25, "adam_lr_vertices": 0.002},
   {"name": "material_half", "phases": "texture", "image_scale": 0.5, "pyramid_levels": 3,
    "outer_iterations": 1, "steps": 5},
   {"name": "shape_full", "phases": "geometry", "solver": "adam", "image_scale": 1,
-   "pyramid_levels": 3, "outer_iterations": 2, "steps": 25, "adam_lr_vertices": 0.001},
+   "pyramid_levels": 1, "outer_iterations": 2, "steps": 25, "adam_lr_vertices": 0.001},
   {"name": "material_full", "phases": "texture", "image_scale": 1, "pyramid_levels": 3,
    "outer_iterations": 1, "steps": 5},
   {"name": "shape_full2", "phases": "geometry", "solver": "adam", "image_scale": 1,
-   "pyramid_levels": 3, "outer_iterations": 2, "steps": 25, "adam_lr_vertices": 0.0005},
+   "pyramid_levels": 1, "outer_iterations": 2, "steps": 25, "adam_lr_vertices": 0.0005},
   {"name": "material_full2", "phases": "texture", "image_scale": 1, "pyramid_levels": 3,
    "outer_iterations": 1, "steps": 5},
   {"name": "shape_full3", "phases": "geometry", "solver": "adam", "image_scale": 1,
-   "pyramid_levels": 3, "outer_iterations": 2, "steps": 25, "adam_lr_vertices": 0.00025},
+   "pyramid_levels": 1, "outer_iterations": 2, "steps": 25, "adam_lr_vertices": 0.00025},
   {"name": "material_final", "phases": "texture", "solver": "adam", "image_scale": 1,
    "pyramid_levels": 3, "outer_iterations": 1, "steps": 120, "independent_gradient": true,
    "adam_views_per_step": 16, "restart_roughness": 0.5, "restart_specular": 0.2}
