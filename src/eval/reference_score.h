@@ -15,7 +15,8 @@ namespace sft {
 // Surface samples per mesh of a per-outer score by default: cheaper than `sft eval`'s 1M (a few
 // hundred ms on a 50k-face mesh). It reads high when there are fewer samples than faces: a
 // sample's distance is taken to the faces its nearest samples lie on, which can miss the nearest
-// face (docs/design-notes.md, "Per-outer Chamfer reads high").
+// face (docs/design-notes.md, "The warp acceptance: three knobs", item "Per-outer Chamfer reads
+// high").
 constexpr int kOuterScoreSamples = 50000;
 
 // Sets *out to {"chamfer", "f1", "f1_tolerance"} of `mesh` against `reference` with `samples`
