@@ -171,6 +171,7 @@ const std::map<std::string, Key>& Keys() {
            },
            [](const O& o) { return std::string(ImageLossName(o.cache.image_loss)); })},
       {"independent_gradient", Bool([](O* o) -> bool& { return o->cache.independent_gradient; })},
+      {"gradient_specular", Bool([](O* o) -> bool& { return o->cache.gradient_specular; })},
       {"mask_dilation", Int([](O* o) -> int& { return o->cache.mask_dilation; }, 0, 64)},
       {"primary_edge_ratio",
        Real([](O* o) -> double& { return o->cache.edges.primary_edge_ratio; }, 0, 16)},

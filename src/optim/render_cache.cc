@@ -554,7 +554,9 @@ bool RenderCache::AddAdjointGradients(const std::vector<int>& views,
                                       std::vector<double>* gradient) {
   std::vector<Image> weights(views.size());
   for (size_t k = 0; k < views.size(); ++k) weights[k] = AdjointWeights(views[k]);
-  return RunAdjointJobs(views, weights, options_.render, ActiveRequest(),
+  RenderOptions render = options_.render;
+  render.effects.specular = render.effects.specular && options_.gradient_specular;
+  return RunAdjointJobs(views, weights, render, ActiveRequest(),
                         AdjointSeed(seed_, options_.independent_gradient), gradient);
 }
 
@@ -570,6 +572,7 @@ bool RenderCache::AddAdjointGradientsWith(const std::vector<int>& views,
   RenderOptions render = options_.render;
   DerivativeRequest request = ActiveRequest();
   plan.ApplyTo(&render, &request);
+  render.effects.specular = render.effects.specular && options_.gradient_specular;
   request.gradient_parts = parts != nullptr;
   return RunAdjointJobs(views, weights, render, request, seed, gradient, parts);
 }

@@ -85,6 +85,14 @@ struct RenderCacheOptions {
   // Independent paths make the gradient an unbiased estimate of the noise-free loss's. Used by
   // the first-order solvers (the adjoint pass); LM's rows come from the residual's own pass.
   bool independent_gradient = false;
+  // The glossy lobe in the adjoint (gradient) pass. false: the first-order solvers step along the
+  // gradient of the image without the lobe, weighted by the residual of the image with it (when
+  // the plan renders it). The lobe's vertex derivative is the noisiest part of the step on glossy
+  // objects (docs/design-notes.md, "Why the glossy dragon's geometry does not move"), while a
+  // residual without the lobe leaves highlights the geometry then tries to explain: with the lobe
+  // in the residual, a shape whose full render matches the photographs stays a stationary point
+  // of the step. A biased direction elsewhere (not the loss's gradient); no effect on LM's rows.
+  bool gradient_specular = true;
 
   bool Check(std::string* why) const;
 };
