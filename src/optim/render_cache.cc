@@ -554,9 +554,7 @@ bool RenderCache::AddAdjointGradients(const std::vector<int>& views,
                                       std::vector<double>* gradient) {
   std::vector<Image> weights(views.size());
   for (size_t k = 0; k < views.size(); ++k) weights[k] = AdjointWeights(views[k]);
-  RenderOptions render = options_.render;
-  render.effects.specular = render.effects.specular && options_.gradient_specular;
-  return RunAdjointJobs(views, weights, render, ActiveRequest(),
+  return RunAdjointJobs(views, weights, options_.render, ActiveRequest(),
                         AdjointSeed(seed_, options_.independent_gradient), gradient);
 }
 
@@ -572,7 +570,6 @@ bool RenderCache::AddAdjointGradientsWith(const std::vector<int>& views,
   RenderOptions render = options_.render;
   DerivativeRequest request = ActiveRequest();
   plan.ApplyTo(&render, &request);
-  render.effects.specular = render.effects.specular && options_.gradient_specular;
   request.gradient_parts = parts != nullptr;
   return RunAdjointJobs(views, weights, render, request, seed, gradient, parts);
 }
@@ -582,6 +579,8 @@ bool RenderCache::RunAdjointJobs(const std::vector<int>& views, const std::vecto
                                  uint64_t seed, std::vector<double>* gradient,
                                  GradientParts* parts) {
   CHECK_EQ(views.size(), weights.size());
+  RenderOptions adjoint = render;  // gradient_specular: the lobe out of the adjoint pass only.
+  adjoint.effects.specular = render.effects.specular && options_.gradient_specular;
   std::vector<ViewJob> jobs(views.size());
   for (size_t k = 0; k < views.size(); ++k) {
     jobs[k].view = views[k];
@@ -590,7 +589,7 @@ bool RenderCache::RunAdjointJobs(const std::vector<int>& views, const std::vecto
     jobs[k].weights = GainedWeights(weights[k], params_->Gains(views[k]));
   }
   bool finite = true;
-  RunJobs(jobs, render, request, [&](size_t k, ViewResult* result) {
+  RunJobs(jobs, adjoint, request, [&](size_t k, ViewResult* result) {
     finite = AddGradientResult(views[k], weights[k], *result, gradient, parts) && finite;
   });
   return finite;

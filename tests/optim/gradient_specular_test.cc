@@ -23,7 +23,7 @@ namespace {
 
 struct StepStats {
   double mean_squared_norm = 0.0;  // ‖mean gradient over seeds‖².
-  double noise = 0.0;              // Σ over entries of the mean's variance (its expected ‖·‖²).
+  double noise = 0.0;  // Σ over entries of the mean's variance (its expected ‖·‖²).
   double specular_gradient = 0.0;  // the specular weight's entry, summed over seeds.
 };
 
@@ -83,11 +83,12 @@ StepStats VertexStep(const Dataset& dataset, const TriMesh& mesh, const Material
 TEST(GradientSpecularTest, TheTruthStaysStationaryWithTheLobeInTheResidualOnly) {
   testing::TempDir dir;
   // A glossy icosphere under the camera flash, smooth-shaded; the target has 1024 spp.
-  ASSERT_EQ(testing::SynthIcosphere(
-                dir.Join("ds"),
-                "--cameras 3 --zooms 1 --res 24 --spp 1024 --bounces 1 --shading smooth "
-                "--material '{\"albedo\": [0.4, 0.4, 0.4], \"roughness\": 0.3, \"specular\": 0.5}'"),
-            "");
+  ASSERT_EQ(
+      testing::SynthIcosphere(
+          dir.Join("ds"),
+          "--cameras 3 --zooms 1 --res 24 --spp 1024 --bounces 1 --shading smooth "
+          "--material '{\"albedo\": [0.4, 0.4, 0.4], \"roughness\": 0.3, \"specular\": 0.5}'"),
+      "");
   Dataset dataset;
   TriMesh mesh;
   Material truth;
@@ -96,7 +97,8 @@ TEST(GradientSpecularTest, TheTruthStaysStationaryWithTheLobeInTheResidualOnly) 
   ASSERT_TRUE(LoadMaterial(dir.Join("ds/gt/material.json"), mesh, &truth).ok());
   const int kSeeds = 16;
   const StepStats pinned = VertexStep(dataset, mesh, truth, /*specular=*/false, true, kSeeds);
-  const StepStats residual_only = VertexStep(dataset, mesh, truth, /*specular=*/true, false, kSeeds);
+  const StepStats residual_only =
+      VertexStep(dataset, mesh, truth, /*specular=*/true, false, kSeeds);
   // The lobe off in both passes: a mean step far above its noise (the missing highlights).
   EXPECT_GT(pinned.mean_squared_norm, 10.0 * pinned.noise)
       << "mean² " << pinned.mean_squared_norm << " noise " << pinned.noise;
