@@ -7,6 +7,7 @@
 #include "src/eval/line_chart.h"
 #include "src/eval/reconstruction_eval.h"
 #include "src/eval/report.h"
+#include "src/eval/studio_lights.h"
 
 namespace sft {
 namespace {
@@ -14,6 +15,7 @@ namespace {
 constexpr int kMaxViewRows = 4;
 constexpr int kMaxHeldOutRows = 2;
 constexpr int kHeldOutSpp = 32;  // the held-out rows' renders (sft eval --held-out's scores: 64).
+constexpr int kMaxRelitRows = 2;
 
 double MeanPsnr(const IterationRecord& r) {
   double sum = 0.0;
@@ -151,6 +153,58 @@ Status AddHeldOutRows(const std::string& out, const Dataset& dataset, HtmlReport
   return Status::Ok();
 }
 
+// Up to kMaxRelitRows views of the result under the studio lights (src/eval/studio_lights.h),
+// beside the render under the run's own lighting: the held-out views when there are any, else
+// fitted views spread over the list. The relit images are shown unscaled (their radiance reads as
+// albedo); the fitted-lighting render at its target's exposure.
+Status AddRelitRows(const std::string& out, const Dataset& dataset,
+                    const std::vector<int>& fitted_views, HtmlReport* html) {
+  std::vector<int> views;
+  HeldOutSetup setup;
+  if (ReadHeldOutSetup(out, static_cast<int>(dataset.views.size()), &setup).ok()) {
+    views = setup.views;
+  }
+  if (views.empty()) {
+    for (int k = 0; k < kMaxRelitRows && k < static_cast<int>(fitted_views.size()); ++k) {
+      views.push_back(fitted_views[k * fitted_views.size() / kMaxRelitRows]);
+    }
+  }
+  views.resize(std::min<size_t>(views.size(), kMaxRelitRows));
+  if (views.empty()) return Status::Ok();
+  ReconstructionEvalOptions options;
+  options.spp = kHeldOutSpp;
+  std::vector<std::vector<Image>> renders(1);
+  SFT_RETURN_IF_ERROR(RenderRunViews(dataset.root, out, views, options, &renders[0]));
+  const std::vector<RelightCondition> conditions = StudioConditions();
+  for (const RelightCondition& c : conditions) {
+    renders.emplace_back();
+    SFT_RETURN_IF_ERROR(RenderRunViews(dataset.root, out, views, options, &renders.back(), &c));
+  }
+  html->AddHeading("Relit (lights the fit never saw)");
+  html->AddParagraph(
+      "key: a light from the camera's upper right with a 20% white fill; ambient: a uniform white "
+      "sky, where a diffuse surface shows its albedo darkened by occlusion. Both at exposure 1, "
+      "so their values read as albedo.");
+  for (size_t k = 0; k < views.size(); ++k) {
+    Image target;
+    SFT_RETURN_IF_ERROR(LoadViewImage(dataset, views[k], &target));
+    const std::string base = "report_files/relit_" + std::to_string(views[k]) + "_";
+    ImageRow row;
+    row.label = "view " + std::to_string(views[k]);
+    SFT_RETURN_IF_ERROR(html->WriteImage(base + "capture.png",
+                                         ScaledRgb(renders[0][k], ExposureScale(target, nullptr))));
+    row.images.push_back({base + "capture.png", "the run's lighting", nullptr});
+    for (size_t c = 0; c < conditions.size(); ++c) {
+      const std::string file = base + conditions[c].name + ".png";
+      SFT_RETURN_IF_ERROR(html->WriteImage(file, ScaledRgb(renders[c + 1][k], 1.0)));
+      row.images.push_back({file, conditions[c].name, nullptr});
+    }
+    row.notes = {{"spp", std::to_string(kHeldOutSpp)}};
+    SFT_RETURN_IF_ERROR(html->AddImageRow(row));
+  }
+  return Status::Ok();
+}
+
 }  // namespace
 
 Status WriteReconstructReport(const std::string& out, const Dataset& dataset,
@@ -228,6 +282,7 @@ Status WriteReconstructReport(const std::string& out, const Dataset& dataset,
     SFT_RETURN_IF_ERROR(html.AddImageRow(row));
   }
   SFT_RETURN_IF_ERROR(AddHeldOutRows(out, dataset, &html));
+  SFT_RETURN_IF_ERROR(AddRelitRows(out, dataset, reconstruction->view_indices(), &html));
   return html.Write("report.html");
 }
 

@@ -373,11 +373,12 @@ Status EvaluateReconstruction(const std::string& dataset_dir, const std::string&
 
 Status RenderRunViews(const std::string& dataset_dir, const std::string& reconstruction,
                       const std::vector<int>& views, const ReconstructionEvalOptions& options,
-                      std::vector<Image>* renders) {
+                      std::vector<Image>* renders, const RelightCondition* lighting) {
   std::string why;
   if (!options.Check(&why)) return Status::Error("--" + why);
   RunToRender run;
   SFT_RETURN_IF_ERROR(LoadRunToRender(dataset_dir, reconstruction, options, &run));
+  if (lighting != nullptr) run.dataset = RelitDataset(run.dataset, *lighting);
   DatasetViews dataset_views;
   SFT_RETURN_IF_ERROR(MakeDatasetViews(run.dataset, &dataset_views));
   const RenderScene scene(run.mesh);

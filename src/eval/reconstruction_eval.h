@@ -21,6 +21,7 @@
 
 #include "src/core/image.h"
 #include "src/core/status.h"
+#include "src/eval/relight_eval.h"
 
 namespace sft {
 
@@ -58,11 +59,12 @@ Status EvaluateReconstruction(const std::string& dataset_dir, const std::string&
 
 // Renders `views` (dataset view indices) of the run in `reconstruction` as EvaluateReconstruction
 // does (its mesh and material or the overrides, the fitted lighting and light scales, options'
-// spp, bounces and seed), as linear RGB (e.g. the held-out rows of report.html). Errors: as
-// EvaluateReconstruction's loading, and a view outside the dataset.
+// spp, bounces and seed), as linear RGB (e.g. the held-out rows of report.html). With `lighting`,
+// under its lights instead of the run's (RelitDataset: black background, no fitted light scales).
+// Errors: as EvaluateReconstruction's loading, and a view outside the dataset.
 Status RenderRunViews(const std::string& dataset_dir, const std::string& reconstruction,
                       const std::vector<int>& views, const ReconstructionEvalOptions& options,
-                      std::vector<Image>* renders);
+                      std::vector<Image>* renders, const RelightCondition* lighting = nullptr);
 
 }  // namespace sft
 

@@ -79,8 +79,9 @@ std::string ConditionFolder(size_t k, const std::string& name) {
   return prefix + safe;
 }
 
-// The dataset lit by condition c: its lights replaced, black background.
-Dataset Relit(const Dataset& dataset, const RelightCondition& c) {
+}  // namespace
+
+Dataset RelitDataset(const Dataset& dataset, const RelightCondition& c) {
   Dataset relit = dataset;
   relit.lights = c.lights;
   relit.background = Background::kBlack;
@@ -94,10 +95,12 @@ Dataset Relit(const Dataset& dataset, const RelightCondition& c) {
   return relit;
 }
 
+namespace {
+
 // Renders and scores condition k, writing the renders under inputs.out when set.
 Status ScoreCondition(const RelightInputs& in, const RelightCondition& c, size_t k,
                       const std::vector<std::string>& out_paths, json* result) {
-  const Dataset relit = Relit(*in.dataset, c);
+  const Dataset relit = RelitDataset(*in.dataset, c);
   DatasetViews views;
   SFT_RETURN_IF_ERROR(MakeDatasetViews(relit, &views).Prefixed("--relight " + c.source));
   const std::string folder =

@@ -46,6 +46,10 @@ Status MakeRelightConditions(const std::vector<std::string>& specs, const Datase
                              const Eigen::Vector3d& centre,
                              std::vector<RelightCondition>* conditions);
 
+// `dataset` lit by condition c: its lights replaced by c's (each view by its view_lights, or all
+// of them), on a black background.
+Dataset RelitDataset(const Dataset& dataset, const RelightCondition& c);
+
 // What is rendered and compared.
 struct RelightInputs {
   const Dataset* dataset = nullptr;    // views, cameras, masks; its lights are not used.

@@ -64,6 +64,11 @@ TEST(ReconstructHoldoutTest, HeldOutViewsAreKeptOutAndScored) {
   EXPECT_THAT(page, HasSubstr("view 0 (held out)"));
   EXPECT_THAT(page, HasSubstr("view 2 (held out)"));
   EXPECT_THAT(page, HasSubstr("PSNR after its own gain"));
+  // ...and the held-out views relit by the studio lights (src/eval/studio_lights.h).
+  EXPECT_THAT(page, HasSubstr("Relit (lights the fit never saw)"));
+  for (const char* file : {"relit_0_capture.png", "relit_0_key.png", "relit_2_ambient.png"}) {
+    EXPECT_TRUE(std::filesystem::exists(run + "/report_files/" + file)) << file;
+  }
   const nlohmann::json state = ReadJson(run + "/state.json");
   EXPECT_EQ(state["held_out_views"], nlohmann::json({0, 2}));
   EXPECT_EQ(state["holdout"], 2);
