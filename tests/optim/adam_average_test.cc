@@ -14,6 +14,7 @@
 #include "src/optim/problem.h"
 #include "src/optim/render_cache.h"
 #include "src/optim/solvers.h"
+#include "tests/testing/render_cache_fixture.h"
 #include "tests/testing/synth_dataset.h"
 #include "tests/testing/temp_dir.h"
 
@@ -43,23 +44,16 @@ TEST(AdamAverageTest, EndsAtTheTailMeanWhichIsCloserToTheTruth) {
   ASSERT_TRUE(ReadDataset(dir.Join("ds"), &dataset).ok());
   ASSERT_TRUE(ReadMesh(dir.Join("ds/gt/mesh.ply"), &mesh).ok());
   ASSERT_TRUE(LoadMaterial(dir.Join("ds/gt/material.json"), mesh, &truth).ok());
-  DatasetViews views;
-  ASSERT_TRUE(MakeDatasetViews(dataset, &views).ok());
-  std::vector<Eigen::Vector3d> positions;
-  std::vector<Eigen::Vector3i> faces;
-  MeshToArrays(mesh, &positions, &faces);
-  SceneParameters params(positions, truth, static_cast<int>(dataset.lights.size()));
-  const std::vector<double> truth_values = params.values();
   RenderCacheOptions cache_options;
   cache_options.render.spp = 4;  // a noisy gradient, so the last iterate wanders.
   cache_options.render.bounces = 1;
   cache_options.pyramid_levels = 1;
   cache_options.independent_gradient = true;
-  std::vector<int> all(dataset.views.size());
-  for (size_t v = 0; v < all.size(); ++v) all[v] = static_cast<int>(v);
-  std::unique_ptr<RenderCache> cache;
-  ASSERT_TRUE(
-      RenderCache::Create(dataset, &views, all, faces, truth, &params, cache_options, &cache).ok());
+  testing::CacheFixture f;
+  ASSERT_EQ(testing::MakeCacheFixture(dataset, mesh, truth, cache_options, &f), "");
+  SceneParameters& params = *f.params;
+  RenderCache* cache = f.cache.get();
+  const std::vector<double> truth_values = params.values();
   ActiveParameters active;
   active.albedo = true;
   active.roughness = true;
@@ -87,7 +81,7 @@ TEST(AdamAverageTest, EndsAtTheTailMeanWhichIsCloserToTheTruth) {
   };
   AdamState state;
   SolverRunStats stats;
-  ASSERT_TRUE(RunAdam(solver, problem, cache.get(), &params, hooks, {}, &state, &stats).ok());
+  ASSERT_TRUE(RunAdam(solver, problem, cache, &params, hooks, {}, &state, &stats).ok());
   ASSERT_EQ(iterates.size(), 60u);
   // One closing evaluation of all views, at the end point.
   ASSERT_EQ(full_costs.size(), 1u);

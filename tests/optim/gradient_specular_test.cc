@@ -15,6 +15,7 @@
 #include "src/io/dataset.h"
 #include "src/optim/parameters.h"
 #include "src/optim/render_cache.h"
+#include "tests/testing/render_cache_fixture.h"
 #include "tests/testing/synth_dataset.h"
 #include "tests/testing/temp_dir.h"
 
@@ -30,12 +31,6 @@ struct StepStats {
 // The vertex gradient's mean over `seeds` seeds at the true shape and material.
 StepStats VertexStep(const Dataset& dataset, const TriMesh& mesh, const Material& truth,
                      bool specular, bool gradient_specular, int seeds) {
-  DatasetViews views;
-  EXPECT_TRUE(MakeDatasetViews(dataset, &views).ok());
-  std::vector<Eigen::Vector3d> positions;
-  std::vector<Eigen::Vector3i> faces;
-  MeshToArrays(mesh, &positions, &faces);
-  SceneParameters params(positions, truth, static_cast<int>(dataset.lights.size()));
   RenderCacheOptions options;
   options.render.spp = 4;
   options.render.bounces = 1;
@@ -44,29 +39,24 @@ StepStats VertexStep(const Dataset& dataset, const TriMesh& mesh, const Material
   options.pyramid_levels = 1;
   options.independent_gradient = true;  // no variance term: only the residual's mean matters.
   options.gradient_specular = gradient_specular;
-  std::vector<int> all(dataset.views.size());
-  for (size_t v = 0; v < all.size(); ++v) all[v] = static_cast<int>(v);
-  std::unique_ptr<RenderCache> cache;
-  EXPECT_TRUE(
-      RenderCache::Create(dataset, &views, all, faces, truth, &params, options, &cache).ok());
+  testing::CacheFixture f;
+  EXPECT_EQ(testing::MakeCacheFixture(dataset, mesh, truth, options, &f), "");
+  RenderCache* cache = f.cache.get();
   ActiveParameters active;
   active.vertices = true;
   active.albedo = false;
   active.roughness = false;
   active.specular = true;  // its entry shows whether the adjoint pass rendered the lobe.
   cache->SetActive(active);
-  const int n = 3 * static_cast<int>(positions.size());
+  const int n = 3 * static_cast<int>(f.positions.size());
   std::vector<std::vector<double>> samples;
   double specular_gradient = 0.0;
   for (int s = 0; s < seeds; ++s) {
     cache->SetSeed(500 + s);
     cache->Render(/*rows=*/false);
-    std::vector<double> gradient(params.layout().size(), 0.0);
-    for (int v = 0; v < cache->num_views(); ++v) {
-      EXPECT_TRUE(cache->AddAdjointGradient(v, cache->AdjointWeights(v), &gradient));
-    }
+    const std::vector<double> gradient = testing::AdjointGradient(cache, *f.params);
     samples.emplace_back(gradient.begin(), gradient.begin() + n);
-    specular_gradient += std::abs(gradient[params.layout().SpecularIndex()]);
+    specular_gradient += std::abs(gradient[f.params->layout().SpecularIndex()]);
   }
   StepStats stats;
   stats.specular_gradient = specular_gradient;

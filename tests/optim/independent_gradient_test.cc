@@ -14,6 +14,7 @@
 #include "src/io/dataset.h"
 #include "src/optim/parameters.h"
 #include "src/optim/render_cache.h"
+#include "tests/testing/render_cache_fixture.h"
 #include "tests/testing/synth_dataset.h"
 #include "tests/testing/temp_dir.h"
 
@@ -28,37 +29,25 @@ struct GradientStats {
 // The specular weight's adjoint gradient over `seeds` seeds at the true material.
 GradientStats SpecularGradient(const Dataset& dataset, const TriMesh& mesh, const Material& truth,
                                bool independent, int seeds) {
-  DatasetViews views;
-  EXPECT_TRUE(MakeDatasetViews(dataset, &views).ok());
-  std::vector<Eigen::Vector3d> positions;
-  std::vector<Eigen::Vector3i> faces;
-  MeshToArrays(mesh, &positions, &faces);
-  SceneParameters params(positions, truth, static_cast<int>(dataset.lights.size()));
   RenderCacheOptions options;
   options.render.spp = 1;  // few samples: a large variance, so its gradient is clear.
   options.render.bounces = 1;
   options.pyramid_levels = 1;
   options.independent_gradient = independent;
-  std::vector<int> all(dataset.views.size());
-  for (size_t v = 0; v < all.size(); ++v) all[v] = static_cast<int>(v);
-  std::unique_ptr<RenderCache> cache;
-  EXPECT_TRUE(
-      RenderCache::Create(dataset, &views, all, faces, truth, &params, options, &cache).ok());
+  testing::CacheFixture f;
+  EXPECT_EQ(testing::MakeCacheFixture(dataset, mesh, truth, options, &f), "");
+  RenderCache* cache = f.cache.get();
   ActiveParameters active;
   active.albedo = false;
   active.roughness = false;
   active.specular = true;
   cache->SetActive(active);
-  const int index = params.layout().SpecularIndex();
+  const int index = f.params->layout().SpecularIndex();
   std::vector<double> samples;
   for (int s = 0; s < seeds; ++s) {
     cache->SetSeed(1000 + s);
     cache->Render(/*rows=*/false);
-    std::vector<double> gradient(params.layout().size(), 0.0);
-    for (int v = 0; v < cache->num_views(); ++v) {
-      EXPECT_TRUE(cache->AddAdjointGradient(v, cache->AdjointWeights(v), &gradient));
-    }
-    samples.push_back(gradient[index]);
+    samples.push_back(testing::AdjointGradient(cache, *f.params)[index]);
   }
   GradientStats stats;
   for (double g : samples) stats.mean += g / seeds;
