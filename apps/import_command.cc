@@ -19,6 +19,12 @@ void PrintMasksAndProbe(const char* command, const ColmapImportReport& report) {
     std::fprintf(stderr, "%s: support plane: %d sparse points on or beyond it left out\n", command,
                  n.plane.off_object);
   }
+  if (report.probe_ground_requested) {
+    std::fprintf(stderr, "%s: %s\n", command,
+                 report.probe_ground
+                     ? "probe ground: the support plane hides the probe below its horizon"
+                     : "probe ground: no support plane found, the probe is not hidden");
+  }
   if (report.auto_masks > 0) {
     std::fprintf(stderr, "%s: %d automatic masks (GrabCut) in masks/\n", command,
                  report.auto_masks);
@@ -80,6 +86,9 @@ void AddSupportPlaneFlags(CLI::App* app, SupportPlaneOptions* plane) {
                   "Support plane band half-width, as a fraction of the median viewing distance, "
                   "(0, 0.2]")
       ->capture_default_str();
+  app->add_flag("--probe-ground", plane->hides_probe,
+                "With --probe: the support plane, when found, hides the probe below its horizon "
+                "(a floor the probe does not show, e.g. a studio or sky panorama taken elsewhere)");
 }
 
 void SetupImportVideo(CLI::App* video, VideoImportOptions* opts) {

@@ -319,6 +319,11 @@ Status ImportInto(const ColmapImportOptions& opts, const std::string& root,
   }
 
   SFT_RETURN_IF_ERROR(AddProbeLight(opts, root, &dataset));
+  // --probe-ground: the support plane's normal (a direction: the normalisation has no rotation).
+  const bool probe_ground = opts.normalization.plane.hides_probe && !opts.probe.empty();
+  if (probe_ground && norm.plane.found) dataset.lights[0].ground_normal = norm.plane.normal;
+  report->probe_ground_requested = probe_ground;
+  report->probe_ground = probe_ground && norm.plane.found;
 
   std::string encoding;
   for (const std::string& e : encodings) encoding += (encoding.empty() ? "" : "; ") + e;
@@ -327,6 +332,7 @@ Status ImportInto(const ColmapImportOptions& opts, const std::string& root,
                                   {"points_total", norm.points_total},
                                   {"points_used", norm.points_used}};
   if (norm.plane.found) normalization["support_plane_points"] = norm.plane.off_object;
+  if (probe_ground) normalization["probe_ground"] = norm.plane.found;
   dataset.extra["import"] = {{"from", "colmap"},
                              {"model", opts.model},
                              {"model_format", report->format},

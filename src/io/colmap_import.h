@@ -54,7 +54,11 @@ struct ColmapImportReport {
   int auto_masks = 0;        // masks made by --masks auto.
   bool probe_aligned = false;
   ProbeAlignmentResult alignment;  // when probe_aligned.
-  double seconds = 0;              // wall time.
+  // --probe-ground (SupportPlaneOptions::hides_probe): whether it was asked for with a probe, and
+  // whether a support plane was found to hide the probe's lower part.
+  bool probe_ground_requested = false;
+  bool probe_ground = false;
+  double seconds = 0;  // wall time.
 };
 
 Status ImportColmap(const ColmapImportOptions& options, ColmapImportReport* report);

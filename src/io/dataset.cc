@@ -62,7 +62,8 @@ constexpr Keys kSimilarityKeys = {"scale", "rotation", "translation"};
 constexpr Keys kCameraKeys = {"id", "model", "width", "height", "params"};
 constexpr Keys kPointLightKeys = {"id", "type", "frame", "position", "intensity"};
 constexpr Keys kDirectionalLightKeys = {"id", "type", "frame", "direction", "irradiance"};
-constexpr Keys kEnvironmentLightKeys = {"id", "type", "frame", "image", "world_from_env", "scale"};
+constexpr Keys kEnvironmentLightKeys = {"id",    "type",         "frame", "image", "world_from_env",
+                                        "scale", "ground_normal"};
 constexpr Keys kViewKeys = {"image", "mask", "camera", "lights", "cam_from_world"};
 constexpr Keys kPoseKeys = {"rotation", "translation"};
 
@@ -375,6 +376,20 @@ class SceneParser {
     if (const json* scale = Find(entry, "scale")) {
       SFT_RETURN_IF_ERROR(Number(*scale, Field(path, "scale"), &light->scale));
       if (light->scale < 0) return Error(Field(path, "scale"), "must be non-negative");
+    }
+    if (const json* ground = Find(entry, "ground_normal")) {
+      const std::string ground_path = Field(path, "ground_normal");
+      SFT_RETURN_IF_ERROR(Vector3(*ground, ground_path, &light->ground_normal));
+      const double norm = light->ground_normal.norm();
+      if (!(norm > 1e-12) || !std::isfinite(norm)) {
+        return Error(ground_path, "must have a non-zero finite length");
+      }
+      if (light->frame != LightFrame::kWorld) {
+        return Error(ground_path, "only a world-fixed environment can have a ground");
+      }
+      if (std::abs(norm - 1.0) > 4 * std::numeric_limits<double>::epsilon()) {
+        light->ground_normal /= norm;
+      }
     }
     return Status::Ok();
   }

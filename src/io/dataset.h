@@ -64,6 +64,10 @@ struct LightSpec {
   std::string image;  // relative to the dataset root: an equirectangular linear EXR.
   Eigen::Matrix3d world_from_env = Eigen::Matrix3d::Identity();
   double scale = 1.0;  // radiance = scale * texel value.
+  // A ground plane the probe does not show (a world-frame environment only): when non-zero, the
+  // unit world direction of "up"; directions d with d·ground_normal < 0 carry no radiance, as if an
+  // infinite black floor lay under the object (docs/dataset.md). Zero = no ground.
+  Eigen::Vector3d ground_normal = Eigen::Vector3d::Zero();
   // An environment map held in memory instead of `image` (RGB, linear): the fitted environment of
   // unknown lighting (src/optim/fitted_environment.h). Never read from or written to scene.json.
   Image pixels;

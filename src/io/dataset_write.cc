@@ -66,6 +66,10 @@ ojson LightsJson(const Dataset& dataset) {
       }
       entry["world_from_env"] = std::move(matrix);
       entry["scale"] = light.scale;
+      if (!light.ground_normal.isZero()) {
+        entry["ground_normal"] = {light.ground_normal.x(), light.ground_normal.y(),
+                                  light.ground_normal.z()};
+      }
     }
     AppendExtra(light.extra, &entry);
     lights.push_back(std::move(entry));

@@ -1,5 +1,7 @@
 #include "src/io/scene_setup.h"
 
+#include <cmath>
+
 #include "src/core/memory.h"
 
 namespace sft {
@@ -36,6 +38,27 @@ Eigen::Matrix3d ViewWorldFromEnv(const LightSpec& light, const Rigid3d& cam_from
   if (light.frame != LightFrame::kCamera) return light.world_from_env;
   return cam_from_world.rotation.conjugate().toRotationMatrix() * light.world_from_env;
 }
+
+namespace {
+
+// Sets to zero the texels of the world-fixed probe `rgb` whose centre direction d (in the world:
+// world_from_env times the equirectangular direction of the texel's centre, src/render/
+// environment.h) has d·ground_normal < 0: an infinite black floor under the object that the probe
+// does not show. Texels across the horizon blend with their zeroed neighbours over one texel.
+void BlackenBelowGround(const LightSpec& light, Image* rgb) {
+  for (int y = 0; y < rgb->height; ++y) {
+    const double theta = M_PI * (y + 0.5) / rgb->height;
+    for (int x = 0; x < rgb->width; ++x) {
+      const double phi = 2.0 * M_PI * (0.5 - (x + 0.5) / rgb->width);
+      const Eigen::Vector3d env(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi),
+                                std::cos(theta));
+      if ((light.world_from_env * env).dot(light.ground_normal) >= 0.0) continue;
+      for (int c = 0; c < rgb->channels; ++c) rgb->at(x, y, c) = 0.0f;
+    }
+  }
+}
+
+}  // namespace
 
 Status MakeDatasetViews(const Dataset& dataset, DatasetViews* out) {
   SFT_RETURN_IF_ERROR(CheckViewsFitInMemory(dataset));
@@ -83,6 +106,7 @@ Status MakeDatasetViews(const Dataset& dataset, DatasetViews* out) {
       }
       if (!loaded[l]) {
         SFT_RETURN_IF_ERROR(LoadProbe(dataset, l, &probes[l]));
+        if (!light.ground_normal.isZero()) BlackenBelowGround(light, &probes[l]);
         loaded[l] = true;
       }
       if (light.frame == LightFrame::kCamera) {

@@ -31,6 +31,11 @@ struct SupportPlaneOptions {
   double camera_fraction = 0.9;  // fewest cameras on its positive side, fraction, (0.5, 1].
   int iterations = 1000;         // RANSAC trials, [1, 1e6].
   uint64_t seed = 1;             // RANSAC random seed.
+  // With a probe: the plane, when found, is a black floor under the object that the probe does
+  // not show (the probe's LightSpec::ground_normal = the plane's normal): for a probe taken away
+  // from the object's support, e.g. a studio or sky panorama. Off for a probe taken where the
+  // object stands, whose lower half already shows the support.
+  bool hides_probe = false;
 
   bool Check(std::string* why) const;
 };

@@ -8,15 +8,15 @@
 //     mesh and material carried into the imported frame (the albedo pass of both, over the
 //     automatic masks, at 480²);
 //   - the fitted probe scale (O/lights.json) against the truth's 1.
-// The stage list is kVideoConfig, the one docs/reconstruct.md gives for a 480² video. Long (about
-// an hour on 2 cores), so labelled `long` by its name. With SFT_VIDEO_ROAD_DIR set, a truth, a
-// video, an import and a reconstruction (recon/mesh.ply) found there are reused.
+// The stage list is data/example/video_480.json (docs/reconstruct.md, "Videos and other large
+// captures"). Long (the reconstruction alone takes minutes on 2 cores), so labelled `long` by its
+// name. With SFT_VIDEO_ROAD_DIR set, a truth, a video, an import and a reconstruction
+// (recon/mesh.ply) found there are reused.
 #include <gtest/gtest.h>
 
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <memory>
 #include <nlohmann/json.hpp>
 
@@ -29,31 +29,6 @@ namespace sft {
 namespace {
 namespace fs = std::filesystem;
 using json = nlohmann::json;
-
-// The stage list for the 480² video (docs/reconstruct.md, "A video at 480²"): the `hull` list's
-// stage keys at scales 1/8 → 1/4 → 1/2, adaptive remeshing at 2-pixel edges before the 1/4 and
-// 1/2 stages, the probe's scale fitted throughout, a final material stage at texel resolution
-// "auto".
-constexpr char kVideoConfig[] = R"({"stages": [
-  {"name": "material_eighth", "phases": "texture", "image_scale": 0.125, "pyramid_levels": 2,
-   "outer_iterations": 1, "steps": 5},
-  {"name": "shape_eighth", "phases": "geometry", "solver": "adam", "image_scale": 0.125,
-   "pyramid_levels": 2, "outer_iterations": 2, "steps": 25, "adam_lr_vertices": 0.004,
-   "pin": {"specular": false, "primary_edges": true}},
-  {"name": "material_quarter", "phases": "texture", "image_scale": 0.25, "pyramid_levels": 3,
-   "outer_iterations": 1, "steps": 4, "remesh": "adaptive", "remesh_edge_pixels": 2},
-  {"name": "shape_quarter", "phases": "geometry", "solver": "adam", "image_scale": 0.25,
-   "pyramid_levels": 3, "outer_iterations": 2, "steps": 25, "adam_lr_vertices": 0.002,
-   "pin": {"specular": false, "primary_edges": true}},
-  {"name": "material_half", "phases": "texture", "image_scale": 0.5, "pyramid_levels": 3,
-   "outer_iterations": 1, "steps": 4, "remesh": "adaptive", "remesh_edge_pixels": 2},
-  {"name": "shape_half", "phases": "geometry", "solver": "adam", "image_scale": 0.5,
-   "pyramid_levels": 3, "outer_iterations": 2, "steps": 25, "adam_lr_vertices": 0.001,
-   "pin": {"specular": false, "primary_edges": true}},
-  {"name": "material_final", "phases": "texture", "image_scale": 0.5, "pyramid_levels": 3,
-   "outer_iterations": 2, "steps": 6, "texel_resolution": "auto"}],
- "image_loss": "relative", "fit_specular": false, "fit_lights": true,
- "adam_large_steps": 25, "adam_uniform": true, "adam_resample": true, "adam_views_per_step": 8})";
 
 double Seconds(std::chrono::steady_clock::time_point since) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
@@ -113,11 +88,11 @@ TEST(VideoReconstructLongTest, SyntheticVideoReconstructedAndScoredInTheTruthsFr
 
   const auto t = std::chrono::steady_clock::now();
   if (!fs::exists(dir + "/recon/mesh.ply")) {
-    testing::WriteTestFile(dir + "/video.json", kVideoConfig);
-    ASSERT_EQ(testing::RunSft("reconstruct --quiet --dataset " + dir + "/imported --out " + dir +
-                                  "/recon --config " + dir + "/video.json",
-                              &out),
-              0)
+    ASSERT_EQ(
+        testing::RunSft("reconstruct --quiet --dataset " + dir + "/imported --out " + dir +
+                            "/recon --config " + testing::DataDir() + "/example/video_480.json",
+                        &out),
+        0)
         << out;
   }
   const double reconstruct_seconds = Seconds(t);

@@ -1,6 +1,7 @@
 // Environment lights fixed in the world or in each view's camera (src/io/scene_setup.h,
 // ViewWorldFromEnv and MakeDatasetViews; docs/dataset.md, "frame"): the frame round-trips through
-// scene.json, and a camera-fixed map is turned with each view's camera.
+// scene.json, and a camera-fixed map is turned with each view's camera. A world-fixed map's
+// `ground_normal` hides it below the ground's horizon, in the world whatever the map's rotation.
 #include "src/io/scene_setup.h"
 
 #include <gtest/gtest.h>
@@ -110,6 +111,98 @@ TEST(SceneSetupTest, CameraFixedEnvironmentShinesFromTheSameCameraDirectionInEve
   const Eigen::Vector3d right1 =
       dataset.views[1].cam_from_world.rotation.conjugate() * Eigen::Vector3d::UnitX();
   EXPECT_LT(right0.dot(right1), 0.5);
+}
+
+// MinimalScene's probe lighting both views, world-fixed, turned by `world_from_env`, with a ground
+// whose up is world +z.
+json GroundScene(const Eigen::Matrix3d& world_from_env) {
+  json scene = testing::MinimalScene();
+  json matrix = json::array();
+  for (int r = 0; r < 3; ++r) {
+    matrix.push_back({world_from_env(r, 0), world_from_env(r, 1), world_from_env(r, 2)});
+  }
+  scene["lights"][1]["world_from_env"] = matrix;
+  scene["lights"][1]["ground_normal"] = {0, 0, 2};  // normalized on read.
+  scene["views"][0]["lights"] = {"probe"};
+  scene["views"][1]["lights"] = {"probe"};
+  return scene;
+}
+
+// Known answer: a uniform map of radiance 1 over an infinite black floor is 1 above the horizon
+// and 0 below it (beyond the one texel across the horizon that blends both), for a map turned
+// about any axis: the ground is in the world, not in the map.
+TEST(SceneSetupTest, GroundHidesAWorldFixedMapBelowItsHorizon) {
+  const Eigen::Matrix3d turns[] = {
+      Eigen::Matrix3d::Identity(),
+      Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitX()).toRotationMatrix(),
+      Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, -2, 0.5).normalized()).toRotationMatrix()};
+  for (const Eigen::Matrix3d& world_from_env : turns) {
+    testing::TempDir dir;
+    testing::WriteDataset(dir, GroundScene(world_from_env));
+    ASSERT_TRUE(WriteExr(dir.Join("probes/env.exr"), Image(64, 32, 3, 1.0f)).ok());
+    Dataset dataset;
+    ASSERT_TRUE(ReadDataset(dir.path(), &dataset).ok());
+    EXPECT_TRUE(dataset.lights[1].ground_normal.isApprox(Eigen::Vector3d::UnitZ()));
+    DatasetViews views;
+    ASSERT_TRUE(MakeDatasetViews(dataset, &views).ok());
+    const EnvironmentMap& map = *views.views[0].environment;
+    EXPECT_EQ(&map, views.views[1].environment);  // one shared world-fixed map.
+    // A texel spans 180°/32 = 5.6° in elevation: 15° clears the blended band.
+    for (double azimuth = 0; azimuth < 2 * M_PI; azimuth += 0.5) {
+      for (double elevation : {-80.0, -40.0, -15.0, 15.0, 40.0, 80.0}) {
+        const double e = elevation * M_PI / 180;
+        const Eigen::Vector3d dir(std::cos(e) * std::cos(azimuth), std::cos(e) * std::sin(azimuth),
+                                  std::sin(e));
+        EXPECT_NEAR(map.Radiance(dir).x(), elevation > 0 ? 1.0 : 0.0, 1e-6)
+            << "elevation " << elevation << " azimuth " << azimuth;
+      }
+    }
+    // Importance sampling draws only from above the ground.
+    for (int k = 0; k < 200; ++k) {
+      Eigen::Vector3d dir, radiance;
+      double pdf = 0;
+      ASSERT_TRUE(map.Sample((k + 0.5) / 200, std::fmod(0.618 * k, 1.0), &dir, &radiance, &pdf));
+      EXPECT_GT(dir.z(), -0.1) << k;
+    }
+  }
+}
+
+TEST(SceneSetupTest, GroundNormalRoundTripsAndIsRefusedWhereItCannotHold) {
+  testing::TempDir dir;
+  testing::WriteDataset(dir, GroundScene(Eigen::Matrix3d::Identity()));
+  Dataset dataset;
+  ASSERT_TRUE(ReadDataset(dir.path(), &dataset).ok());
+  testing::TempDir copy;
+  ASSERT_TRUE(WriteSceneJson(dataset, copy.path()).ok());
+  const json written = json::parse(testing::ReadTestFile(copy.Join("scene.json")));
+  EXPECT_EQ(written["lights"][1]["ground_normal"], json({0.0, 0.0, 1.0}));
+  // Without the key nothing is written (files before it read and write the same).
+  dataset.lights[1].ground_normal.setZero();
+  testing::TempDir plain;
+  ASSERT_TRUE(WriteSceneJson(dataset, plain.path()).ok());
+  EXPECT_FALSE(json::parse(testing::ReadTestFile(plain.Join("scene.json")))["lights"][1].contains(
+      "ground_normal"));
+  // Bad values: one error naming the field.
+  for (const json& bad : {json({0, 0, 0}), json({0, 1}), json("up")}) {
+    json scene = GroundScene(Eigen::Matrix3d::Identity());
+    scene["lights"][1]["ground_normal"] = bad;
+    testing::TempDir d;
+    testing::WriteDataset(d, scene);
+    Dataset ignored;
+    const Status status = ReadDataset(d.path(), &ignored);
+    ASSERT_FALSE(status.ok()) << bad.dump();
+    EXPECT_NE(status.message().find("lights[1].ground_normal"), std::string::npos)
+        << status.message();
+  }
+  json camera = GroundScene(Eigen::Matrix3d::Identity());
+  camera["lights"][1]["frame"] = "camera";
+  testing::TempDir d;
+  testing::WriteDataset(d, camera);
+  Dataset ignored;
+  const Status status = ReadDataset(d.path(), &ignored);
+  ASSERT_FALSE(status.ok());
+  EXPECT_NE(status.message().find("only a world-fixed environment"), std::string::npos)
+      << status.message();
 }
 
 }  // namespace
