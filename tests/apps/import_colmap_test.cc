@@ -113,6 +113,27 @@ TEST(ImportColmapTest, TextWithoutMasksWithProbe) {
   ImportAndCheck("txt", false, testing::DataDir() + "/cycles/sphere_env_studio/probes/studio.exr");
 }
 
+// --probe-ground on a model without a support plane (the fixture's points surround the object):
+// one summary line says so, the import records it, and the probe is not hidden. (A found plane
+// is checked against the truth's floor in tests/apps/video_reconstruct_long_test.cc.)
+TEST(ImportColmapTest, ProbeGroundWithoutASupportPlaneLeavesTheProbeWhole) {
+  testing::TempDir tmp;
+  std::string output;
+  ASSERT_EQ(RunSft("import colmap --model " + Fixture() + "/sparse_txt --images " + Fixture() +
+                       "/images --probe " + testing::DataDir() +
+                       "/cycles/sphere_env_studio/probes/studio.exr --probe-ground --out " +
+                       tmp.Join("ds"),
+                   &output),
+            0)
+      << output;
+  EXPECT_THAT(output, HasSubstr("probe ground: no support plane found, the probe is not hidden"));
+  Dataset dataset;
+  ASSERT_TRUE(ReadDataset(tmp.Join("ds"), &dataset).ok());
+  ASSERT_EQ(dataset.lights.size(), 1u);
+  EXPECT_TRUE(dataset.lights[0].ground_normal.isZero());
+  EXPECT_EQ(dataset.extra["import"]["normalization"]["probe_ground"], false);
+}
+
 TEST(ImportColmapTest, UnknownLightingIsReadableButNotRenderable) {
   testing::TempDir tmp;
   std::string output;

@@ -1,8 +1,9 @@
 // Issue 22's acceptance "synthetic video + probe": the video road (tests/testing/video_road.h:
 // textured spot on a ground plane under the studio probe → video → `sft import video --probe
-// --masks auto`) reconstructed end to end with `sft reconstruct` from the imported dataset's own
-// start (the hull `sft import` carves), then scored after the similarity that maps the imported
-// world onto the truth's (fitted on the camera centres):
+// --probe-ground --masks auto`: the studio panorama does not show the ground the spot stands on)
+// reconstructed end to end with `sft reconstruct` from the imported dataset's own start (the hull
+// `sft import` carves), then scored after the similarity that maps the imported world onto the
+// truth's (fitted on the camera centres):
 //   - F1@0.01 and Chamfer of the mesh in the truth's frame against the true mesh;
 //   - albedo PSNR from `sft eval` on a copy of the imported dataset whose ground_truth is the true
 //     mesh and material carried into the imported frame (the albedo pass of both, over the
@@ -14,7 +15,9 @@
 // (recon/mesh.ply) found there are reused.
 #include <gtest/gtest.h>
 
+#include <Eigen/Core>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -74,8 +77,8 @@ TEST(VideoReconstructLongTest, SyntheticVideoReconstructedAndScoredInTheTruthsFr
   if (!fs::exists(dir + "/imported/scene.json")) {
     ASSERT_EQ(testing::RunSft("import video --quiet --overwrite --video " + dir + "/orbit.avi" +
                                   " --frames " + std::to_string(testing::kVideoSelected) +
-                                  " --masks auto --probe " + testing::StudioProbe() + " --out " +
-                                  dir + "/imported",
+                                  " --masks auto --probe " + testing::StudioProbe() +
+                                  " --probe-ground --out " + dir + "/imported",
                               &out),
               0)
         << out;
@@ -85,6 +88,10 @@ TEST(VideoReconstructLongTest, SyntheticVideoReconstructedAndScoredInTheTruthsFr
   testing::PoseFit fit;
   testing::FitPoses(imported, truth, &fit);
   if (HasFatalFailure()) return;
+  // --probe-ground: the support plane found under the spot is the truth's floor (its up is +z).
+  ASSERT_EQ(imported.lights.size(), 1u);
+  const Eigen::Vector3d up = fit.align * imported.lights[0].ground_normal;
+  EXPECT_GT(up.z(), std::cos(2.0 * M_PI / 180)) << up.transpose();
 
   const auto t = std::chrono::steady_clock::now();
   if (!fs::exists(dir + "/recon/mesh.ply")) {

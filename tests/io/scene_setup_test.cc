@@ -122,6 +122,7 @@ json GroundScene(const Eigen::Matrix3d& world_from_env) {
     matrix.push_back({world_from_env(r, 0), world_from_env(r, 1), world_from_env(r, 2)});
   }
   scene["lights"][1]["world_from_env"] = matrix;
+  scene["lights"][1]["scale"] = 1.0;
   scene["lights"][1]["ground_normal"] = {0, 0, 2};  // normalized on read.
   scene["views"][0]["lights"] = {"probe"};
   scene["views"][1]["lights"] = {"probe"};
