@@ -1,9 +1,9 @@
 // Issue 22's acceptance "synthetic video + probe": the video road (tests/testing/video_road.h:
 // textured spot on a ground plane under the studio probe → video → `sft import video --probe
 // --probe-ground --masks auto`: the studio panorama does not show the ground the spot stands on)
-// reconstructed end to end with `sft reconstruct` from the imported dataset's own start (the hull
-// `sft import` carves), then scored after the similarity that maps the imported world onto the
-// truth's (fitted on the camera centres):
+// reconstructed end to end with `sft reconstruct` from the hull it carves (the import names no
+// initial mesh; the start is O/initial_mesh.ply), then scored after the similarity that maps the
+// imported world onto the truth's (fitted on the camera centres):
 //   - F1@0.01 and Chamfer of the mesh in the truth's frame against the true mesh;
 //   - albedo PSNR from `sft eval` on a copy of the imported dataset whose ground_truth is the true
 //     mesh and material carried into the imported frame (the albedo pass of both, over the
@@ -104,7 +104,7 @@ TEST(VideoReconstructLongTest, SyntheticVideoReconstructedAndScoredInTheTruthsFr
   }
   const double reconstruct_seconds = Seconds(t);
   MeshMetrics start, end;
-  testing::MetricsInTruthFrame(dir, dir + "/imported/init/mesh.ply", fit, &start);
+  testing::MetricsInTruthFrame(dir, dir + "/recon/initial_mesh.ply", fit, &start);
   testing::MetricsInTruthFrame(dir, dir + "/recon/mesh.ply", fit, &end);
   if (HasFatalFailure()) return;
 
@@ -130,7 +130,11 @@ TEST(VideoReconstructLongTest, SyntheticVideoReconstructedAndScoredInTheTruthsFr
       "scale %.3f (truth 1)\n",
       reconstruct_seconds, start.f1, end.f1, end.precision, end.recall, start.chamfer, end.chamfer,
       albedo_linear, albedo_srgb, full_linear, probe_scale);
+  // Measured (docs/design-notes.md, "The synthetic video end to end"): F1@0.01 0.618 -> 0.656,
+  // albedo 12.5 dB linear, probe scale 1.15; the issue's 0.9 and 28 dB are not met. Without
+  // --probe-ground the scale was 0.69 (the panorama's floor lit the spot from below).
   EXPECT_GT(end.f1, start.f1);
+  EXPECT_NEAR(probe_scale, 1.0, 0.3);
 }
 
 }  // namespace
