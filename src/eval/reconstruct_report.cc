@@ -17,6 +17,14 @@ constexpr int kMaxHeldOutRows = 2;
 constexpr int kHeldOutSpp = 32;  // the held-out rows' renders (sft eval --held-out's scores: 64).
 constexpr int kMaxRelitRows = 2;
 
+// Renders of the result under the run's own lighting, shared between the report's rows so that
+// a view is rendered once: views, their renders and their targets' ExposureScale (no mask).
+struct CaptureRenders {
+  std::vector<int> views;
+  std::vector<Image> renders;
+  std::vector<double> scales;
+};
+
 double MeanPsnr(const IterationRecord& r) {
   double sum = 0.0;
   for (double p : r.view_psnr) sum += p;
@@ -109,8 +117,9 @@ void AddEffectPlans(const nlohmann::json& outer, HtmlReport* html) {
 // Up to kMaxHeldOutRows held-out views (sft reconstruct --holdout): target | render × the median
 // fitted gain | difference, rendered as `sft eval --held-out --spp kHeldOutSpp` renders them,
 // with that view's linear PSNR before and after its own gain. Nothing when the run held out no
-// views.
-Status AddHeldOutRows(const std::string& out, const Dataset& dataset, HtmlReport* html) {
+// views. *shown: the views and their renders.
+Status AddHeldOutRows(const std::string& out, const Dataset& dataset, HtmlReport* html,
+                      CaptureRenders* shown) {
   HeldOutSetup setup;
   if (!ReadHeldOutSetup(out, static_cast<int>(dataset.views.size()), &setup).ok()) {
     return Status::Ok();  // no held-out views (or no readable state): no rows.
@@ -131,6 +140,9 @@ Status AddHeldOutRows(const std::string& out, const Dataset& dataset, HtmlReport
     HeldOutScores scores;
     SFT_RETURN_IF_ERROR(scores.Add(v, renders[k], target, mask, setup.gain));
     const nlohmann::json score = scores.ToJson()["per_view"][0];
+    shown->views.push_back(v);
+    shown->renders.push_back(renders[k]);
+    shown->scales.push_back(ExposureScale(target, nullptr));
     const Image ours = ScaleChannels(renders[k], setup.gain);
     const double scale = ExposureScale(target, mask.empty() ? nullptr : &mask);
     const std::string base = "report_files/held_out_" + std::to_string(v) + "_";
@@ -154,31 +166,38 @@ Status AddHeldOutRows(const std::string& out, const Dataset& dataset, HtmlReport
 }
 
 // Up to kMaxRelitRows views of the result under the studio lights (src/eval/studio_lights.h),
-// beside the render under the run's own lighting: the held-out views when there are any, else
-// fitted views spread over the list. The relit images are shown unscaled (their radiance reads as
-// albedo); the fitted-lighting render at its target's exposure.
+// beside the render under the run's own lighting: the held-out views when there are any (their
+// renders `held_out` reused), else fitted views spread over the list. The relit images are shown
+// unscaled (their radiance reads as albedo); the run's lighting at its target's exposure.
 Status AddRelitRows(const std::string& out, const Dataset& dataset,
-                    const std::vector<int>& fitted_views, HtmlReport* html) {
-  std::vector<int> views;
-  HeldOutSetup setup;
-  if (ReadHeldOutSetup(out, static_cast<int>(dataset.views.size()), &setup).ok()) {
-    views = setup.views;
-  }
-  if (views.empty()) {
+                    const std::vector<int>& fitted_views, const CaptureRenders& held_out,
+                    HtmlReport* html) {
+  CaptureRenders capture = held_out;
+  const std::vector<RelightCondition> conditions = StudioConditions();
+  std::vector<const RelightCondition*> lightings;
+  if (capture.views.empty()) {
     for (int k = 0; k < kMaxRelitRows && k < static_cast<int>(fitted_views.size()); ++k) {
-      views.push_back(fitted_views[k * fitted_views.size() / kMaxRelitRows]);
+      capture.views.push_back(fitted_views[k * fitted_views.size() / kMaxRelitRows]);
     }
+    lightings.push_back(nullptr);  // the run's own lighting too.
   }
-  views.resize(std::min<size_t>(views.size(), kMaxRelitRows));
+  const std::vector<int> views(
+      capture.views.begin(),
+      capture.views.begin() + std::min<size_t>(capture.views.size(), kMaxRelitRows));
   if (views.empty()) return Status::Ok();
+  for (const RelightCondition& c : conditions) lightings.push_back(&c);
   ReconstructionEvalOptions options;
   options.spp = kHeldOutSpp;
-  std::vector<std::vector<Image>> renders(1);
-  SFT_RETURN_IF_ERROR(RenderRunViews(dataset.root, out, views, options, &renders[0]));
-  const std::vector<RelightCondition> conditions = StudioConditions();
-  for (const RelightCondition& c : conditions) {
-    renders.emplace_back();
-    SFT_RETURN_IF_ERROR(RenderRunViews(dataset.root, out, views, options, &renders.back(), &c));
+  std::vector<std::vector<Image>> renders;
+  SFT_RETURN_IF_ERROR(RenderRunViewsUnder(dataset.root, out, views, options, lightings, &renders));
+  if (lightings[0] == nullptr) {
+    capture.renders = std::move(renders[0]);
+    renders.erase(renders.begin());
+    for (int v : views) {
+      Image target;
+      SFT_RETURN_IF_ERROR(LoadViewImage(dataset, v, &target));
+      capture.scales.push_back(ExposureScale(target, nullptr));
+    }
   }
   html->AddHeading("Relit (lights the fit never saw)");
   html->AddParagraph(
@@ -186,17 +205,15 @@ Status AddRelitRows(const std::string& out, const Dataset& dataset,
       "sky, where a diffuse surface shows its albedo darkened by occlusion. Both at exposure 1, "
       "so their values read as albedo.");
   for (size_t k = 0; k < views.size(); ++k) {
-    Image target;
-    SFT_RETURN_IF_ERROR(LoadViewImage(dataset, views[k], &target));
     const std::string base = "report_files/relit_" + std::to_string(views[k]) + "_";
     ImageRow row;
     row.label = "view " + std::to_string(views[k]);
-    SFT_RETURN_IF_ERROR(html->WriteImage(base + "capture.png",
-                                         ScaledRgb(renders[0][k], ExposureScale(target, nullptr))));
+    SFT_RETURN_IF_ERROR(
+        html->WriteImage(base + "capture.png", ScaledRgb(capture.renders[k], capture.scales[k])));
     row.images.push_back({base + "capture.png", "the run's lighting", nullptr});
     for (size_t c = 0; c < conditions.size(); ++c) {
       const std::string file = base + conditions[c].name + ".png";
-      SFT_RETURN_IF_ERROR(html->WriteImage(file, ScaledRgb(renders[c + 1][k], 1.0)));
+      SFT_RETURN_IF_ERROR(html->WriteImage(file, ScaledRgb(renders[c][k], 1.0)));
       row.images.push_back({file, conditions[c].name, nullptr});
     }
     row.notes = {{"spp", std::to_string(kHeldOutSpp)}};
@@ -281,8 +298,9 @@ Status WriteReconstructReport(const std::string& out, const Dataset& dataset,
     }
     SFT_RETURN_IF_ERROR(html.AddImageRow(row));
   }
-  SFT_RETURN_IF_ERROR(AddHeldOutRows(out, dataset, &html));
-  SFT_RETURN_IF_ERROR(AddRelitRows(out, dataset, reconstruction->view_indices(), &html));
+  CaptureRenders held_out;
+  SFT_RETURN_IF_ERROR(AddHeldOutRows(out, dataset, &html, &held_out));
+  SFT_RETURN_IF_ERROR(AddRelitRows(out, dataset, reconstruction->view_indices(), held_out, &html));
   return html.Write("report.html");
 }
 

@@ -373,24 +373,40 @@ Status EvaluateReconstruction(const std::string& dataset_dir, const std::string&
 
 Status RenderRunViews(const std::string& dataset_dir, const std::string& reconstruction,
                       const std::vector<int>& views, const ReconstructionEvalOptions& options,
-                      std::vector<Image>* renders, const RelightCondition* lighting) {
+                      std::vector<Image>* renders) {
+  std::vector<std::vector<Image>> under;
+  SFT_RETURN_IF_ERROR(
+      RenderRunViewsUnder(dataset_dir, reconstruction, views, options, {nullptr}, &under));
+  *renders = std::move(under[0]);
+  return Status::Ok();
+}
+
+Status RenderRunViewsUnder(const std::string& dataset_dir, const std::string& reconstruction,
+                           const std::vector<int>& views, const ReconstructionEvalOptions& options,
+                           const std::vector<const RelightCondition*>& lightings,
+                           std::vector<std::vector<Image>>* renders) {
   std::string why;
   if (!options.Check(&why)) return Status::Error("--" + why);
   RunToRender run;
   SFT_RETURN_IF_ERROR(LoadRunToRender(dataset_dir, reconstruction, options, &run));
-  if (lighting != nullptr) run.dataset = RelitDataset(run.dataset, *lighting);
-  DatasetViews dataset_views;
-  SFT_RETURN_IF_ERROR(MakeDatasetViews(run.dataset, &dataset_views));
-  const RenderScene scene(run.mesh);
-  const RenderOptions render = EvalRenderOptions(options, run.dataset);
-  renders->clear();
   for (int v : views) {
-    if (v < 0 || v >= static_cast<int>(dataset_views.views.size())) {
+    if (v < 0 || v >= static_cast<int>(run.dataset.views.size())) {
       return Status::Error("view " + std::to_string(v) + ": not in " + dataset_dir);
     }
-    Image image;
-    RenderView(scene, run.material, dataset_views.views[v], render, &image);
-    renders->push_back(ToRgb(image));
+  }
+  const RenderScene scene(run.mesh);
+  const RenderOptions render = EvalRenderOptions(options, run.dataset);
+  renders->assign(lightings.size(), {});
+  for (size_t i = 0; i < lightings.size(); ++i) {
+    const Dataset lit =
+        lightings[i] == nullptr ? run.dataset : RelitDataset(run.dataset, *lightings[i]);
+    DatasetViews dataset_views;
+    SFT_RETURN_IF_ERROR(MakeDatasetViews(lit, &dataset_views));
+    for (int v : views) {
+      Image image;
+      RenderView(scene, run.material, dataset_views.views[v], render, &image);
+      (*renders)[i].push_back(ToRgb(image));
+    }
   }
   return Status::Ok();
 }

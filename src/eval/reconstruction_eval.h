@@ -59,12 +59,19 @@ Status EvaluateReconstruction(const std::string& dataset_dir, const std::string&
 
 // Renders `views` (dataset view indices) of the run in `reconstruction` as EvaluateReconstruction
 // does (its mesh and material or the overrides, the fitted lighting and light scales, options'
-// spp, bounces and seed), as linear RGB (e.g. the held-out rows of report.html). With `lighting`,
-// under its lights instead of the run's (RelitDataset: black background, no fitted light scales).
-// Errors: as EvaluateReconstruction's loading, and a view outside the dataset.
+// spp, bounces and seed), as linear RGB (e.g. the held-out rows of report.html). Errors: as
+// EvaluateReconstruction's loading, and a view outside the dataset.
 Status RenderRunViews(const std::string& dataset_dir, const std::string& reconstruction,
                       const std::vector<int>& views, const ReconstructionEvalOptions& options,
-                      std::vector<Image>* renders, const RelightCondition* lighting = nullptr);
+                      std::vector<Image>* renders);
+
+// The same under each of `lightings`, the run loaded once: (*renders)[i] under lightings[i]'s
+// lights instead of the run's (RelitDataset: black background, no fitted light scales), or under
+// the run's own lighting where lightings[i] is null.
+Status RenderRunViewsUnder(const std::string& dataset_dir, const std::string& reconstruction,
+                           const std::vector<int>& views, const ReconstructionEvalOptions& options,
+                           const std::vector<const RelightCondition*>& lightings,
+                           std::vector<std::vector<Image>>* renders);
 
 }  // namespace sft
 
