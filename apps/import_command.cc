@@ -91,6 +91,16 @@ void AddSupportPlaneFlags(CLI::App* app, SupportPlaneOptions* plane) {
                 "(a floor the probe does not show, e.g. a studio or sky panorama taken elsewhere)");
 }
 
+// --background-distance (src/io/auto_masks.h), for both imports.
+void AddAutoMaskFlags(CLI::App* app, AutoMaskOptions* masks) {
+  app->add_option("--background-distance", masks->background_distance,
+                  "With --masks auto: a pixel whose colour differs from what the other views see "
+                  "of the background behind it (the support plane, or far away) by less than "
+                  "this (display values, [0, 1]) is background; 0 = GrabCut seeded by the sparse "
+                  "points alone")
+      ->capture_default_str();
+}
+
 void SetupImportVideo(CLI::App* video, VideoImportOptions* opts) {
   video->add_option("--video", opts->video, "Input video (any format OpenCV decodes)")->required();
   video->add_option("--out", opts->out, "Output dataset folder")->required();
@@ -117,6 +127,7 @@ void SetupImportVideo(CLI::App* video, VideoImportOptions* opts) {
       ->capture_default_str();
   video->add_option("--colmap", opts->colmap, "COLMAP executable")->capture_default_str();
   AddSupportPlaneFlags(video, &opts->normalization.plane);
+  AddAutoMaskFlags(video, &opts->auto_masks);
   video->add_flag("--overwrite", opts->overwrite, "Replace an existing output folder");
   video->add_flag("--quiet", opts->quiet, "No progress or summary line");
 }
@@ -154,6 +165,7 @@ CommandRunner SetupImportCommand(CLI::App* app) {
                    "Without masks: robust bounding-box percentile per axis, [0, 50)")
       ->capture_default_str();
   AddSupportPlaneFlags(colmap, &opts->normalization.plane);
+  AddAutoMaskFlags(colmap, &opts->auto_masks);
   colmap->add_flag("!--no-dense", opts->import_dense,
                    "Ignore fused.ply / meshed-*.ply beside the model");
   colmap->add_flag("--overwrite", opts->overwrite, "Replace an existing output folder");

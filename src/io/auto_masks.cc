@@ -76,6 +76,25 @@ cv::Mat SeedLabels(const std::vector<cv::Point>& seeds, cv::Size size,
   return labels;
 }
 
+// Background consistency on the labels (see the header): `distance` at its working resolution,
+// looked up at each pixel's nearest working pixel; NaN (no comparison) changes nothing.
+void ApplyBackgroundDistance(const Image& distance, const AutoMaskOptions& opts, cv::Mat* labels) {
+  const int w = labels->cols, h = labels->rows;
+  const double object = std::max(opts.object_distance, opts.background_distance);
+  for (int y = 0; y < h; ++y) {
+    const int dy = std::min(distance.height - 1, y * distance.height / h);
+    for (int x = 0; x < w; ++x) {
+      const float d = distance.at(std::min(distance.width - 1, x * distance.width / w), dy);
+      uint8_t& label = labels->at<uint8_t>(y, x);
+      if (d < opts.background_distance) {
+        label = cv::GC_BGD;
+      } else if (d > object && label == cv::GC_PR_BGD) {
+        label = cv::GC_PR_FGD;
+      }
+    }
+  }
+}
+
 // Foreground of the GrabCut labels: the component holding most seeds, holes filled.
 cv::Mat KeepSeededComponent(const cv::Mat& labels, const std::vector<cv::Point>& seeds) {
   cv::Mat fg = (labels == cv::GC_FGD) | (labels == cv::GC_PR_FGD);
@@ -95,7 +114,7 @@ cv::Mat KeepSeededComponent(const cv::Mat& labels, const std::vector<cv::Point>&
 }
 
 Status Segment(const Dataset& dataset, int index, const std::vector<Eigen::Vector3d>& sparse,
-               const AutoMaskOptions& opts, Image* mask) {
+               const AutoMaskOptions& opts, const Image* background_distance, Image* mask) {
   const ViewSpec& view = dataset.views[index];
   const Camera& camera = dataset.cameras[view.camera];
   std::vector<cv::Point> seeds;
@@ -116,6 +135,12 @@ Status Segment(const Dataset& dataset, int index, const std::vector<Eigen::Vecto
   SFT_RETURN_IF_ERROR(LoadViewImage(dataset, index, &rgb));
   const cv::Mat bgr = ToneMap8(rgb);
   cv::Mat labels = SeedLabels(seeds, bgr.size(), opts);
+  if (background_distance != nullptr && !background_distance->empty()) {
+    ApplyBackgroundDistance(*background_distance, opts, &labels);
+    for (const cv::Point& p : seeds) {
+      cv::circle(labels, p, opts.seed_disc_px, cv::Scalar(cv::GC_FGD), cv::FILLED);
+    }
+  }
   cv::Mat bgd_model, fgd_model;
   cv::grabCut(bgr, labels, cv::Rect(), bgd_model, fgd_model, opts.iterations,
               cv::GC_INIT_WITH_MASK);
@@ -145,29 +170,44 @@ bool AutoMaskOptions::Check(std::string* why) const {
   if (border_px < 0 || border_px > 1000) return Fail(why, "border_px: must be in [0, 1000]");
   if (iterations < 1 || iterations > 50) return Fail(why, "iterations: must be in [1, 50]");
   if (min_seeds < 3) return Fail(why, "min_seeds: must be >= 3");
-  return true;
+  if (!(background_distance >= 0 && background_distance <= 1)) {
+    return Fail(why, "background_distance: must be in [0, 1]");
+  }
+  if (!(object_distance >= 0 && object_distance <= 1)) {
+    return Fail(why, "object_distance: must be in [0, 1]");
+  }
+  return consistency.Check(why);
 }
 
 Status AutoMask(const Dataset& dataset, int index, const std::vector<Eigen::Vector3d>& sparse,
-                const AutoMaskOptions& options, Image* mask) {
+                const AutoMaskOptions& options, const Image* background_distance, Image* mask) {
   std::string why;
   if (!options.Check(&why)) return Status::Error("automatic masks: " + why);
   if (index < 0 || index >= static_cast<int>(dataset.views.size())) {
     return Status::Error("automatic masks: no view " + std::to_string(index));
   }
   try {
-    return Segment(dataset, index, sparse, options, mask);
+    return Segment(dataset, index, sparse, options, background_distance, mask);
   } catch (const std::exception& e) {
     return Status::Error(dataset.views[index].image + ": automatic mask: OpenCV: " + e.what());
   }
 }
 
 Status WriteAutoMasks(Dataset* dataset, const std::vector<Eigen::Vector3d>& sparse,
-                      const AutoMaskOptions& options) {
+                      const SupportPlane* plane, const AutoMaskOptions& options) {
+  std::string why;
+  if (!options.Check(&why)) return Status::Error("automatic masks: " + why);
+  std::vector<Image> distances;
+  if (options.background_distance > 0 && dataset->views.size() >= 2) {
+    BackgroundConsistencyOptions consistency = options.consistency;
+    consistency.quiet = consistency.quiet || options.quiet;
+    SFT_RETURN_IF_ERROR(BackgroundDistances(*dataset, plane, consistency, &distances));
+  }
   Progress progress("auto masks", static_cast<int64_t>(dataset->views.size()), !options.quiet);
   for (size_t i = 0; i < dataset->views.size(); ++i) {
     Image mask;
-    SFT_RETURN_IF_ERROR(AutoMask(*dataset, static_cast<int>(i), sparse, options, &mask));
+    SFT_RETURN_IF_ERROR(AutoMask(*dataset, static_cast<int>(i), sparse, options,
+                                 distances.empty() ? nullptr : &distances[i], &mask));
     const std::string path = MaskPath(dataset->views[i].image);
     SFT_RETURN_IF_ERROR(
         MakeDirectories(fs::path(JoinPath(dataset->root, path)).parent_path().string()));

@@ -221,12 +221,12 @@ Status ImportViews(const ColmapImportOptions& opts, const ColmapModel& model,
 // --masks auto and the probe's alignment, on the written dataset (both need the normalised
 // poses); rewrites scene.json when either ran.
 Status AutoMasksAndProbe(const ColmapImportOptions& opts,
-                         const std::vector<Eigen::Vector3d>& sparse, Dataset* dataset,
-                         ColmapImportReport* report) {
+                         const std::vector<Eigen::Vector3d>& sparse, const SupportPlane& plane,
+                         Dataset* dataset, ColmapImportReport* report) {
   if (opts.masks == "auto") {
     AutoMaskOptions mask_options = opts.auto_masks;
     mask_options.quiet = mask_options.quiet || opts.quiet;
-    SFT_RETURN_IF_ERROR(WriteAutoMasks(dataset, sparse, mask_options));
+    SFT_RETURN_IF_ERROR(WriteAutoMasks(dataset, sparse, &plane, mask_options));
     report->auto_masks = static_cast<int>(dataset->views.size());
   }
   if (!opts.probe.empty() && opts.align_probe) {
@@ -342,7 +342,11 @@ Status ImportInto(const ColmapImportOptions& opts, const std::string& root,
   SFT_RETURN_IF_ERROR(WriteSceneJson(dataset, root));
   Dataset check;
   SFT_RETURN_IF_ERROR(ReadDataset(root, &check));
-  return AutoMasksAndProbe(opts, seeds, &check, report);
+  // The support plane in the normalised world (n·p_source + offset with p_source = d·p + c).
+  SupportPlane world_plane = norm.plane;
+  world_plane.offset = (norm.plane.normal.dot(norm.centre) + norm.plane.offset) / norm.diagonal;
+  world_plane.band = norm.plane.band / norm.diagonal;
+  return AutoMasksAndProbe(opts, seeds, world_plane, &check, report);
 }
 
 }  // namespace

@@ -124,6 +124,7 @@ Status ImportModel(const VideoImportOptions& opts, const std::string& work,
   import.probe = opts.probe;
   import.out = opts.out;
   import.normalization = opts.normalization;
+  import.auto_masks = opts.auto_masks;
   import.import_dense = false;
   import.overwrite = opts.overwrite;
   import.quiet = opts.quiet;

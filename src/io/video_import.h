@@ -29,6 +29,7 @@ struct VideoImportOptions {
   std::string camera_model = "SIMPLE_RADIAL";  // shared COLMAP camera model sft supports.
   std::string colmap = "colmap";               // COLMAP executable.
   NormalizationOptions normalization;          // as `sft import colmap`.
+  AutoMaskOptions auto_masks;                  // how --masks auto segments (as `import colmap`).
   bool overwrite = false;                      // replace an existing, non-empty output folder.
   bool quiet = false;                          // no progress or summary line.
 

@@ -18,7 +18,6 @@
 #include <memory>
 
 #include "src/eval/mesh_metrics.h"
-#include "src/io/auto_masks.h"
 #include "src/io/dataset.h"
 #include "tests/testing/temp_dir.h"
 #include "tests/testing/video_road.h"
@@ -44,22 +43,6 @@ double ProbeErrorDeg(const Dataset& imported, const Dataset& truth, const testin
   const Eigen::AngleAxisd error(fit.align * estimated->world_from_env *
                                 actual->world_from_env.transpose());
   return error.angle() * 180 / M_PI;
-}
-
-// IoU of each imported view's automatic mask against synth's mask of the same frame.
-void MaskIoUs(const Dataset& imported, const Dataset& truth, const testing::PoseFit& fit,
-              double* mean, double* min) {
-  double sum = 0;
-  *min = 1;
-  for (size_t i = 0; i < imported.views.size(); ++i) {
-    Image automatic, actual;
-    ASSERT_TRUE(LoadViewMask(imported, static_cast<int>(i), &automatic).ok());
-    ASSERT_TRUE(LoadViewMask(truth, fit.frame[i], &actual).ok());
-    const double iou = MaskIoU(automatic, actual);
-    sum += iou;
-    *min = std::min(*min, iou);
-  }
-  *mean = sum / std::max<size_t>(1, imported.views.size());
 }
 
 TEST(VideoImportLongTest, SyntheticVideoWithProbeAndAutoMasksToDatasetAndHull) {
@@ -102,7 +85,7 @@ TEST(VideoImportLongTest, SyntheticVideoWithProbeAndAutoMasksToDatasetAndHull) {
   if (HasFatalFailure()) return;
   const double probe_error = ProbeErrorDeg(imported, truth, fit);
   double iou_mean = 0, iou_min = 0;
-  MaskIoUs(imported, truth, fit, &iou_mean, &iou_min);
+  testing::MaskIoUs(imported, truth, fit, &iou_mean, &iou_min);
   if (HasFatalFailure()) return;
 
   t = std::chrono::steady_clock::now();

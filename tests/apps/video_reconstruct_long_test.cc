@@ -92,6 +92,10 @@ TEST(VideoReconstructLongTest, SyntheticVideoReconstructedAndScoredInTheTruthsFr
   ASSERT_EQ(imported.lights.size(), 1u);
   const Eigen::Vector3d up = fit.align * imported.lights[0].ground_normal;
   EXPECT_GT(up.z(), std::cos(2.0 * M_PI / 180)) << up.transpose();
+  double iou_mean = 0, iou_min = 0;
+  testing::MaskIoUs(imported, truth, fit, &iou_mean, &iou_min);
+  if (HasFatalFailure()) return;
+  std::printf("automatic masks against the truth's: IoU mean %.4f, min %.4f\n", iou_mean, iou_min);
 
   const auto t = std::chrono::steady_clock::now();
   if (!fs::exists(dir + "/recon/mesh.ply")) {

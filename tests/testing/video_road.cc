@@ -11,6 +11,7 @@
 #include <opencv2/videoio.hpp>
 
 #include "src/image/image_io.h"
+#include "src/io/auto_masks.h"
 #include "tests/testing/temp_dir.h"
 
 namespace sft {
@@ -134,6 +135,21 @@ void MetricsInTruthFrame(const std::string& dir, const std::string& path, const 
   MeshMetricsOptions metric_options;
   metric_options.samples = 200000;
   ASSERT_TRUE(ComputeMeshMetrics(gt, mapped, metric_options, metrics).ok());
+}
+
+void MaskIoUs(const Dataset& imported, const Dataset& truth, const PoseFit& fit, double* mean,
+              double* min) {
+  double sum = 0;
+  *min = 1;
+  for (size_t i = 0; i < imported.views.size(); ++i) {
+    Image automatic, actual;
+    ASSERT_TRUE(LoadViewMask(imported, static_cast<int>(i), &automatic).ok());
+    ASSERT_TRUE(LoadViewMask(truth, fit.frame[i], &actual).ok());
+    const double iou = MaskIoU(automatic, actual);
+    sum += iou;
+    *min = std::min(*min, iou);
+  }
+  *mean = sum / std::max<size_t>(1, imported.views.size());
 }
 
 }  // namespace testing

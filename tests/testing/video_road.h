@@ -63,6 +63,11 @@ TriMesh MapMesh(const TriMesh& mesh,
 void MetricsInTruthFrame(const std::string& dir, const std::string& path, const PoseFit& fit,
                          MeshMetrics* metrics);
 
+// IoU of each imported view's mask against the truth's mask of the same frame: the mean and the
+// smallest. Fatal failures when a mask does not load.
+void MaskIoUs(const Dataset& imported, const Dataset& truth, const PoseFit& fit, double* mean,
+              double* min);
+
 }  // namespace testing
 }  // namespace sft
 
