@@ -176,6 +176,7 @@ bool AutoMaskOptions::Check(std::string* why) const {
   if (!(object_distance >= 0 && object_distance <= 1)) {
     return Fail(why, "object_distance: must be in [0, 1]");
   }
+  if (passes < 1 || passes > 4) return Fail(why, "passes: must be in [1, 4]");
   return consistency.Check(why);
 }
 
@@ -197,25 +198,33 @@ Status WriteAutoMasks(Dataset* dataset, const std::vector<Eigen::Vector3d>& spar
                       const SupportPlane* plane, const AutoMaskOptions& options) {
   std::string why;
   if (!options.Check(&why)) return Status::Error("automatic masks: " + why);
-  std::vector<Image> distances;
-  if (options.background_distance > 0 && dataset->views.size() >= 2) {
-    BackgroundConsistencyOptions consistency = options.consistency;
-    consistency.quiet = consistency.quiet || options.quiet;
-    SFT_RETURN_IF_ERROR(BackgroundDistances(*dataset, plane, consistency, &distances));
+  const size_t n = dataset->views.size();
+  const bool consistent = options.background_distance > 0 && n >= 2;
+  BackgroundConsistencyOptions consistency = options.consistency;
+  consistency.quiet = consistency.quiet || options.quiet;
+  std::vector<Image> masks(n), distances;
+  for (int pass = 0; pass < (consistent ? options.passes : 1); ++pass) {
+    if (consistent) {
+      SFT_RETURN_IF_ERROR(BackgroundDistances(*dataset, plane, pass == 0 ? nullptr : &masks,
+                                              consistency, &distances));
+    }
+    Progress progress("auto masks", static_cast<int64_t>(n), !options.quiet);
+    std::vector<Image> next(n);
+    for (size_t i = 0; i < n; ++i) {
+      SFT_RETURN_IF_ERROR(AutoMask(*dataset, static_cast<int>(i), sparse, options,
+                                   distances.empty() ? nullptr : &distances[i], &next[i]));
+      progress.Advance();
+    }
+    progress.Finish();
+    masks.swap(next);
   }
-  Progress progress("auto masks", static_cast<int64_t>(dataset->views.size()), !options.quiet);
-  for (size_t i = 0; i < dataset->views.size(); ++i) {
-    Image mask;
-    SFT_RETURN_IF_ERROR(AutoMask(*dataset, static_cast<int>(i), sparse, options,
-                                 distances.empty() ? nullptr : &distances[i], &mask));
+  for (size_t i = 0; i < n; ++i) {
     const std::string path = MaskPath(dataset->views[i].image);
     SFT_RETURN_IF_ERROR(
         MakeDirectories(fs::path(JoinPath(dataset->root, path)).parent_path().string()));
-    SFT_RETURN_IF_ERROR(WritePng(JoinPath(dataset->root, path), mask, false));
+    SFT_RETURN_IF_ERROR(WritePng(JoinPath(dataset->root, path), masks[i], false));
     dataset->views[i].mask = path;
-    progress.Advance();
   }
-  progress.Finish();
   return Status::Ok();
 }
 

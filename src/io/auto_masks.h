@@ -51,6 +51,10 @@ struct AutoMaskOptions {
   double background_distance = 0.06;         // [0, 1].
   double object_distance = 0.15;             // [0, 1].
   BackgroundConsistencyOptions consistency;  // how the distances are computed.
+  // Segmentations with consistency, [1, 4]: each after the first computes the distances again
+  // with the previous masks as visibility (a background sample that another view's mask covers
+  // is left out; src/io/background_consistency.h).
+  int passes = 3;
 
   bool Check(std::string* why) const;
 };

@@ -27,6 +27,8 @@ struct WorkView {
   Rigid3d cam_from_world;
   double max_radius2 = std::numeric_limits<double>::infinity();  // of normalized coordinates.
   std::vector<uint8_t> rgb;
+  // 1 where an earlier mask says the view sees the object (row-major); empty = no mask.
+  std::vector<uint8_t> object;
 };
 
 // The linear image of view `index` box-filtered to `camera`'s size (cv::INTER_AREA).
@@ -67,6 +69,10 @@ bool Sample(const WorkView& view, const Eigen::Vector2d& px, std::array<float, 3
   const double u = px.x() - 0.5, v = px.y() - 0.5;
   const int w = view.camera.width, h = view.camera.height;
   if (!(u >= 0 && v >= 0 && u <= w - 1 && v <= h - 1)) return false;
+  if (!view.object.empty() &&
+      view.object[static_cast<int>(px.y()) * w + static_cast<int>(px.x())] != 0) {
+    return false;  // the object hides the background point from this view.
+  }
   const int x0 = std::min(static_cast<int>(u), std::max(w - 2, 0));
   const int y0 = std::min(static_cast<int>(v), std::max(h - 2, 0));
   const int x1 = std::min(x0 + 1, w - 1), y1 = std::min(y0 + 1, h - 1);
@@ -238,7 +244,40 @@ int BackgroundLog2Factor(int width, int height, int max_side) {
   return k;
 }
 
+namespace {
+
+// `mask` (1 channel, > 0.5 = object, any resolution) at `view`'s working resolution: a working
+// pixel is object when any mask pixel it covers is (nearest lookups at its corners and centre).
+std::vector<uint8_t> WorkMask(const Image& mask, const Camera& camera) {
+  std::vector<uint8_t> object(static_cast<size_t>(camera.width) * camera.height, 0);
+  const double sx = static_cast<double>(mask.width) / camera.width;
+  const double sy = static_cast<double>(mask.height) / camera.height;
+  for (int y = 0; y < camera.height; ++y) {
+    for (int x = 0; x < camera.width; ++x) {
+      bool any = false;
+      for (double fy : {0.0, 0.5, 0.999}) {
+        for (double fx : {0.0, 0.5, 0.999}) {
+          const int mx = std::min(mask.width - 1, static_cast<int>((x + fx) * sx));
+          const int my = std::min(mask.height - 1, static_cast<int>((y + fy) * sy));
+          any = any || mask.at(mx, my) > 0.5f;
+        }
+      }
+      object[static_cast<size_t>(y) * camera.width + x] = any;
+    }
+  }
+  return object;
+}
+
+}  // namespace
+
 Status BackgroundDistances(const Dataset& dataset, const SupportPlane* plane,
+                           const BackgroundConsistencyOptions& options,
+                           std::vector<Image>* distances) {
+  return BackgroundDistances(dataset, plane, nullptr, options, distances);
+}
+
+Status BackgroundDistances(const Dataset& dataset, const SupportPlane* plane,
+                           const std::vector<Image>* masks,
                            const BackgroundConsistencyOptions& options,
                            std::vector<Image>* distances) {
   std::string why;
@@ -248,6 +287,12 @@ Status BackgroundDistances(const Dataset& dataset, const SupportPlane* plane,
   std::vector<WorkView> views;
   try {
     SFT_RETURN_IF_ERROR(LoadWorkViews(dataset, options, &views));
+    if (masks != nullptr && masks->size() != views.size()) {
+      return Status::Error("background consistency: one mask per view needed");
+    }
+    for (size_t i = 0; masks != nullptr && i < views.size(); ++i) {
+      if (!(*masks)[i].empty()) views[i].object = WorkMask((*masks)[i], views[i].camera);
+    }
   } catch (const std::exception& e) {
     return Status::Error("background consistency: OpenCV: " + std::string(e.what()));
   }

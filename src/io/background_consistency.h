@@ -54,6 +54,15 @@ Status BackgroundDistances(const Dataset& dataset, const SupportPlane* plane,
                            const BackgroundConsistencyOptions& options,
                            std::vector<Image>* distances);
 
+// The same with visibility from earlier masks, one per view (any resolution, > 0.5 = object; an
+// empty image = none): a sample that falls on another view's object is left out, because the
+// object hides the background point from that view. This keeps the floor right beside an object,
+// which the object hides from about half of the views, consistent.
+Status BackgroundDistances(const Dataset& dataset, const SupportPlane* plane,
+                           const std::vector<Image>* masks,
+                           const BackgroundConsistencyOptions& options,
+                           std::vector<Image>* distances);
+
 }  // namespace sft
 
 #endif  // SFT_IO_BACKGROUND_CONSISTENCY_H_

@@ -139,6 +139,38 @@ TEST_F(GroundSceneTest, WithoutThePlaneTheGroundIsNotConsistent) {
   EXPECT_LT(f_without.background_below, f_with.background_below - 0.3);
 }
 
+// With the true masks as visibility, the samples of views that see the object in front of a
+// ground point are left out, so the ground right beside the object is consistent too.
+TEST_F(GroundSceneTest, VisibilityFromMasksKeepsTheGroundBesideTheObject) {
+  Dataset dataset;
+  ASSERT_TRUE(ReadDataset(dir_->Join("ds"), &dataset).ok());
+  const SupportPlane plane = Ground(dataset);
+  std::vector<Image> masks(dataset.views.size());
+  for (size_t i = 0; i < masks.size(); ++i) {
+    ASSERT_TRUE(ReadMask(JoinPath(dataset.root, dataset.views[i].mask), &masks[i]).ok());
+  }
+  BackgroundConsistencyOptions options;
+  options.quiet = true;
+  std::vector<Image> without, with;
+  ASSERT_TRUE(BackgroundDistances(dataset, &plane, options, &without).ok());
+  ASSERT_TRUE(BackgroundDistances(dataset, &plane, &masks, options, &with).ok());
+  double sum_without = 0, sum_with = 0;
+  for (int view : {0, 5, 9}) {
+    const Fractions a = Classify(without[view], masks[view], 0.06);
+    const Fractions b = Classify(with[view], masks[view], 0.06);
+    std::printf(
+        "view %d: background below 0.06: %.4f without visibility, %.4f with; object "
+        "%.4f, %.4f\n",
+        view, a.background_below, b.background_below, a.object_below, b.object_below);
+    sum_without += a.background_below;
+    sum_with += b.background_below;
+    EXPECT_LT(b.object_below, 0.02) << view;
+  }
+  EXPECT_GT(sum_with, sum_without);
+  std::vector<Image> wrong(1);
+  EXPECT_FALSE(BackgroundDistances(dataset, &plane, &wrong, options, &with).ok());
+}
+
 TEST(BackgroundConsistencyTest, RefusesOneViewAndBadOptions) {
   Dataset dataset;
   dataset.views.resize(1);
