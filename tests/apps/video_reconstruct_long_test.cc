@@ -96,7 +96,7 @@ TEST(VideoReconstructLongTest, SyntheticVideoReconstructedAndScoredInTheTruthsFr
   testing::MaskIoUs(imported, truth, fit, &iou_mean, &iou_min);
   if (HasFatalFailure()) return;
   std::printf("automatic masks against the truth's: IoU mean %.4f, min %.4f\n", iou_mean, iou_min);
-  EXPECT_GT(iou_mean, 0.88);  // measured 0.920 (background consistency).
+  EXPECT_GT(iou_mean, 0.9);  // measured 0.940 (background consistency, 3 passes).
 
   const auto t = std::chrono::steady_clock::now();
   if (!fs::exists(dir + "/recon/mesh.ply")) {
@@ -136,7 +136,7 @@ TEST(VideoReconstructLongTest, SyntheticVideoReconstructedAndScoredInTheTruthsFr
       reconstruct_seconds, start.f1, end.f1, end.precision, end.recall, start.chamfer, end.chamfer,
       albedo_linear, albedo_srgb, full_linear, probe_scale);
   // Measured (docs/design-notes.md, "Background consistency for the automatic masks"): F1@0.01
-  // 0.807 -> 0.816, albedo 15.0 dB linear, probe scale 1.13; the 0.9 and 28 dB are not
+  // 0.858 -> 0.863, albedo 15.6 dB linear, probe scale 1.14; the 0.9 and 28 dB are not
   // met. Without --probe-ground the scale was 0.69 (the panorama's floor lit the spot from below).
   EXPECT_GT(end.f1, start.f1);
   EXPECT_NEAR(probe_scale, 1.0, 0.3);
