@@ -47,9 +47,28 @@ cv::Mat ToneMap8(const Image& rgb) {
   return out;
 }
 
-// GrabCut labels from the seeds (see the header).
-cv::Mat SeedLabels(const std::vector<cv::Point>& seeds, cv::Size size,
-                   const AutoMaskOptions& opts) {
+// Background consistency on the labels (see the header): `distance` at its working resolution,
+// looked up at each pixel's nearest working pixel; NaN (no comparison) changes nothing.
+void ApplyBackgroundDistance(const Image& distance, const AutoMaskOptions& opts, cv::Mat* labels) {
+  const int w = labels->cols, h = labels->rows;
+  const double object = std::max(opts.object_distance, opts.background_distance);
+  for (int y = 0; y < h; ++y) {
+    const int dy = std::min(distance.height - 1, y * distance.height / h);
+    for (int x = 0; x < w; ++x) {
+      const float d = distance.at(std::min(distance.width - 1, x * distance.width / w), dy);
+      uint8_t& label = labels->at<uint8_t>(y, x);
+      if (d < opts.background_distance) {
+        label = cv::GC_BGD;
+      } else if (d > object && label == cv::GC_PR_BGD) {
+        label = cv::GC_PR_FGD;
+      }
+    }
+  }
+}
+
+// GrabCut labels from the seeds and, when given, the background distances (see the header).
+cv::Mat SeedLabels(const std::vector<cv::Point>& seeds, cv::Size size, const AutoMaskOptions& opts,
+                   const Image* background_distance) {
   cv::Mat labels(size, CV_8U, cv::Scalar(cv::GC_BGD));
   std::vector<cv::Point> hull;
   cv::convexHull(seeds, hull);
@@ -70,29 +89,13 @@ cv::Mat SeedLabels(const std::vector<cv::Point>& seeds, cv::Size size,
     labels.colRange(0, std::min(b, size.width)).setTo(cv::GC_BGD);
     labels.colRange(std::max(0, size.width - b), size.width).setTo(cv::GC_BGD);
   }
+  if (background_distance != nullptr && !background_distance->empty()) {
+    ApplyBackgroundDistance(*background_distance, opts, &labels);
+  }
   for (const cv::Point& p : seeds) {
     cv::circle(labels, p, opts.seed_disc_px, cv::Scalar(cv::GC_FGD), cv::FILLED);
   }
   return labels;
-}
-
-// Background consistency on the labels (see the header): `distance` at its working resolution,
-// looked up at each pixel's nearest working pixel; NaN (no comparison) changes nothing.
-void ApplyBackgroundDistance(const Image& distance, const AutoMaskOptions& opts, cv::Mat* labels) {
-  const int w = labels->cols, h = labels->rows;
-  const double object = std::max(opts.object_distance, opts.background_distance);
-  for (int y = 0; y < h; ++y) {
-    const int dy = std::min(distance.height - 1, y * distance.height / h);
-    for (int x = 0; x < w; ++x) {
-      const float d = distance.at(std::min(distance.width - 1, x * distance.width / w), dy);
-      uint8_t& label = labels->at<uint8_t>(y, x);
-      if (d < opts.background_distance) {
-        label = cv::GC_BGD;
-      } else if (d > object && label == cv::GC_PR_BGD) {
-        label = cv::GC_PR_FGD;
-      }
-    }
-  }
 }
 
 // Foreground of the GrabCut labels: the component holding most seeds, holes filled.
@@ -134,13 +137,7 @@ Status Segment(const Dataset& dataset, int index, const std::vector<Eigen::Vecto
   Image rgb;
   SFT_RETURN_IF_ERROR(LoadViewImage(dataset, index, &rgb));
   const cv::Mat bgr = ToneMap8(rgb);
-  cv::Mat labels = SeedLabels(seeds, bgr.size(), opts);
-  if (background_distance != nullptr && !background_distance->empty()) {
-    ApplyBackgroundDistance(*background_distance, opts, &labels);
-    for (const cv::Point& p : seeds) {
-      cv::circle(labels, p, opts.seed_disc_px, cv::Scalar(cv::GC_FGD), cv::FILLED);
-    }
-  }
+  cv::Mat labels = SeedLabels(seeds, bgr.size(), opts, background_distance);
   cv::Mat bgd_model, fgd_model;
   cv::grabCut(bgr, labels, cv::Rect(), bgd_model, fgd_model, opts.iterations,
               cv::GC_INIT_WITH_MASK);
