@@ -1,5 +1,5 @@
 // sft align-probe: finds the rotation of a dataset's environment light (a 360° probe) from the
-// frames' background (src/io/probe_alignment.h) and writes a copy of the dataset with it stored as
+// frames' background (src/capture/probe_alignment.h) and writes a copy of the dataset with it stored as
 // the light's world_from_env. `sft import colmap --probe` runs the same alignment itself; this
 // command is for datasets imported with --no-align-probe or made elsewhere. Decisions in
 // docs/import.md "Probe alignment".
@@ -10,7 +10,7 @@
 #include "apps/commands.h"
 #include "src/core/file_util.h"
 #include "src/io/dataset.h"
-#include "src/io/probe_alignment.h"
+#include "src/capture/probe_alignment.h"
 
 namespace sft {
 namespace {

@@ -1,13 +1,13 @@
 // sft import: brings captures into the sft-dataset/1 format. `sft import colmap` converts a COLMAP
-// sparse model and its images (src/io/colmap_import.h); `sft import video` selects frames of a
-// video and runs COLMAP on them first (src/io/video_import.h); `nerf`, `idr` and `middlebury` are
+// sparse model and its images (src/capture/colmap_import.h); `sft import video` selects frames of a
+// video and runs COLMAP on them first (src/capture/video_import.h); `nerf`, `idr` and `middlebury` are
 // in import_calibrated_command.cc. Decisions in docs/import.md.
 #include <cstdio>
 #include <memory>
 
 #include "apps/commands.h"
-#include "src/io/colmap_import.h"
-#include "src/io/video_import.h"
+#include "src/capture/colmap_import.h"
+#include "src/capture/video_import.h"
 
 namespace sft {
 namespace {
@@ -77,7 +77,7 @@ int RunImportVideo(const VideoImportOptions& opts) {
   return 0;
 }
 
-// --no-support-plane and --plane-distance (src/io/support_plane.h), for both imports.
+// --no-support-plane and --plane-distance (src/capture/support_plane.h), for both imports.
 void AddSupportPlaneFlags(CLI::App* app, SupportPlaneOptions* plane) {
   app->add_flag("!--no-support-plane", plane->enabled,
                 "Without masks: keep the points of a dominant plane (table top, floor) as "
@@ -91,7 +91,7 @@ void AddSupportPlaneFlags(CLI::App* app, SupportPlaneOptions* plane) {
                 "(a floor the probe does not show, e.g. a studio or sky panorama taken elsewhere)");
 }
 
-// --background-distance (src/io/auto_masks.h), for both imports.
+// --background-distance (src/capture/auto_masks.h), for both imports.
 void AddAutoMaskFlags(CLI::App* app, AutoMaskOptions* masks) {
   app->add_option("--background-distance", masks->background_distance,
                   "With --masks auto: a pixel whose colour differs from what the other views see "

@@ -8,7 +8,7 @@
 
 #include "src/core/progress.h"
 #include "src/io/dataset.h"
-#include "src/io/import_files.h"
+#include "src/capture/import_files.h"
 
 namespace sft {
 namespace {

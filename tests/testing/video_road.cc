@@ -11,7 +11,7 @@
 #include <opencv2/videoio.hpp>
 
 #include "src/image/image_io.h"
-#include "src/io/auto_masks.h"
+#include "src/capture/auto_masks.h"
 #include "tests/testing/temp_dir.h"
 
 namespace sft {

@@ -1,4 +1,4 @@
-#include "src/io/import_files.h"
+#include "src/capture/import_files.h"
 
 #include <cctype>
 #include <filesystem>

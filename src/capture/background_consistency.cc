@@ -1,4 +1,4 @@
-#include "src/io/background_consistency.h"
+#include "src/capture/background_consistency.h"
 
 #include <tbb/parallel_for.h>
 

@@ -1,7 +1,7 @@
 // `sft import video` without running COLMAP: the COLMAP stage plan (matcher choice, command
 // lines), the --min-registered rule, and the CLI's error when a (stand-in) COLMAP registers too
 // few frames.
-#include "src/io/video_import.h"
+#include "src/capture/video_import.h"
 
 #include <gtest/gtest.h>
 

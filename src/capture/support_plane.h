@@ -14,8 +14,8 @@
 // Limits: an object that is itself mostly one plane (a book, a painting) with few points around
 // it can be taken for the support; a support with too little texture has too few points to be
 // found (then nothing changes).
-#ifndef SFT_IO_SUPPORT_PLANE_H_
-#define SFT_IO_SUPPORT_PLANE_H_
+#ifndef SFT_CAPTURE_SUPPORT_PLANE_H_
+#define SFT_CAPTURE_SUPPORT_PLANE_H_
 
 #include <Eigen/Core>
 #include <cstdint>
@@ -61,4 +61,4 @@ SupportPlane FindSupportPlane(const std::vector<Eigen::Vector3d>& points,
 
 }  // namespace sft
 
-#endif  // SFT_IO_SUPPORT_PLANE_H_
+#endif  // SFT_CAPTURE_SUPPORT_PLANE_H_

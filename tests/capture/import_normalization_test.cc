@@ -1,6 +1,6 @@
 // The normalisation's object finding on the stored fixture (data/colmap/spot), whose points are
 // coloured by origin: spot's vertices rgb 200, background points on a sphere of radius 4 rgb 90.
-#include "src/io/import_normalization.h"
+#include "src/capture/import_normalization.h"
 
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-#include "src/io/probe_alignment.h"
+#include "src/capture/probe_alignment.h"
 
 #include <Eigen/Geometry>
 #include <Eigen/SVD>

@@ -11,7 +11,7 @@
 // `iterations` times on the view's image tone-mapped to 8-bit sRGB, and the connected component
 // holding most seeds is kept, holes filled.
 //
-// Background consistency (src/io/background_consistency.h), when the views can be compared: a
+// Background consistency (src/capture/background_consistency.h), when the views can be compared: a
 // pixel whose colour matches what the other views see of the background behind it (on the support
 // plane, or far away) is definite background; one in the ring around the seeds' hull whose colour
 // does not match is probable foreground. So the feet of an object, whose sparse points the support
@@ -21,8 +21,8 @@
 // Limits: seeds that fall on background (a sparse point in the box that belongs to the table or
 // the wall) become definite foreground; parts of the object with no sparse points and colours like
 // the background are lost; an object larger than ring_fraction beyond its points' hull is cut.
-#ifndef SFT_IO_AUTO_MASKS_H_
-#define SFT_IO_AUTO_MASKS_H_
+#ifndef SFT_CAPTURE_AUTO_MASKS_H_
+#define SFT_CAPTURE_AUTO_MASKS_H_
 
 #include <Eigen/Core>
 #include <string>
@@ -30,9 +30,9 @@
 
 #include "src/core/image.h"
 #include "src/core/status.h"
-#include "src/io/background_consistency.h"
+#include "src/capture/background_consistency.h"
 #include "src/io/dataset.h"
-#include "src/io/support_plane.h"
+#include "src/capture/support_plane.h"
 
 namespace sft {
 
@@ -53,7 +53,7 @@ struct AutoMaskOptions {
   BackgroundConsistencyOptions consistency;  // how the distances are computed.
   // Segmentations with consistency, [1, 4]: each after the first computes the distances again
   // with the previous masks as visibility (a background sample that another view's mask covers
-  // is left out; src/io/background_consistency.h).
+  // is left out; src/capture/background_consistency.h).
   int passes = 3;
 
   bool Check(std::string* why) const;
@@ -78,4 +78,4 @@ double MaskIoU(const Image& a, const Image& b);
 
 }  // namespace sft
 
-#endif  // SFT_IO_AUTO_MASKS_H_
+#endif  // SFT_CAPTURE_AUTO_MASKS_H_

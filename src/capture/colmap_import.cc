@@ -1,4 +1,4 @@
-#include "src/io/colmap_import.h"
+#include "src/capture/colmap_import.h"
 
 #include <algorithm>
 #include <chrono>
@@ -11,12 +11,12 @@
 #include "src/core/progress.h"
 #include "src/geometry/mesh.h"
 #include "src/image/image_io.h"
-#include "src/io/auto_masks.h"
+#include "src/capture/auto_masks.h"
 #include "src/io/colmap_model.h"
 #include "src/io/dataset.h"
-#include "src/io/import_files.h"
+#include "src/capture/import_files.h"
 #include "src/io/point_cloud_ply.h"
-#include "src/io/probe_alignment.h"
+#include "src/capture/probe_alignment.h"
 
 namespace sft {
 namespace {

@@ -18,8 +18,8 @@
 // from nearby objects shows up as residual angle); the object itself is excluded only by masks;
 // repeated structure or a probe taken elsewhere gives few consistent matches, which is reported as
 // an error (fewer than `min_inliers`), never as a rotation.
-#ifndef SFT_IO_PROBE_ALIGNMENT_H_
-#define SFT_IO_PROBE_ALIGNMENT_H_
+#ifndef SFT_CAPTURE_PROBE_ALIGNMENT_H_
+#define SFT_CAPTURE_PROBE_ALIGNMENT_H_
 
 #include <Eigen/Core>
 #include <cstdint>
@@ -66,4 +66,4 @@ std::string AlignedProbeLighting(const ProbeAlignmentResult& result);
 
 }  // namespace sft
 
-#endif  // SFT_IO_PROBE_ALIGNMENT_H_
+#endif  // SFT_CAPTURE_PROBE_ALIGNMENT_H_

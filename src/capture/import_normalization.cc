@@ -1,4 +1,4 @@
-#include "src/io/import_normalization.h"
+#include "src/capture/import_normalization.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "src/io/video_import.h"
+#include "src/capture/video_import.h"
 
 #include <chrono>
 #include <cstdio>
@@ -7,7 +7,7 @@
 
 #include "src/core/file_util.h"
 #include "src/io/colmap_model.h"
-#include "src/io/colmap_runner.h"
+#include "src/capture/colmap_runner.h"
 
 namespace sft {
 namespace {

@@ -1,9 +1,9 @@
-// Probe alignment (src/io/probe_alignment.h) on the stored COLMAP fixture (data/colmap/spot):
+// Probe alignment (src/capture/probe_alignment.h) on the stored COLMAP fixture (data/colmap/spot):
 // synth rendered spot in front of the studio probe with world_from_env = identity, and the
 // fixture's script mapped synth's world into a "COLMAP frame" rotated by a known R
 // (scripts/make_colmap_fixture.py). After `sft import colmap` (which only scales and translates),
 // the probe's true world_from_env is therefore R. A probe of unrelated content must fail.
-#include "src/io/probe_alignment.h"
+#include "src/capture/probe_alignment.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -13,7 +13,7 @@
 #include <random>
 
 #include "src/image/image_io.h"
-#include "src/io/colmap_import.h"
+#include "src/capture/colmap_import.h"
 #include "src/io/dataset.h"
 #include "tests/testing/temp_dir.h"
 

@@ -1,4 +1,4 @@
-#include "src/io/colmap_runner.h"
+#include "src/capture/colmap_runner.h"
 
 #include <sys/wait.h>
 

@@ -10,15 +10,15 @@
 // like `sft synth`'s (import_normalization.h) and the similarity recorded as source_from_world.
 // Everything is written to OUT.partial and renamed to OUT at the end; a failure removes
 // OUT.partial.
-#ifndef SFT_IO_COLMAP_IMPORT_H_
-#define SFT_IO_COLMAP_IMPORT_H_
+#ifndef SFT_CAPTURE_COLMAP_IMPORT_H_
+#define SFT_CAPTURE_COLMAP_IMPORT_H_
 
 #include <string>
 
 #include "src/core/status.h"
-#include "src/io/auto_masks.h"
-#include "src/io/import_normalization.h"
-#include "src/io/probe_alignment.h"
+#include "src/capture/auto_masks.h"
+#include "src/capture/import_normalization.h"
+#include "src/capture/probe_alignment.h"
 
 namespace sft {
 
@@ -65,4 +65,4 @@ Status ImportColmap(const ColmapImportOptions& options, ColmapImportReport* repo
 
 }  // namespace sft
 
-#endif  // SFT_IO_COLMAP_IMPORT_H_
+#endif  // SFT_CAPTURE_COLMAP_IMPORT_H_

@@ -1,4 +1,4 @@
-#include "src/io/auto_masks.h"
+#include "src/capture/auto_masks.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "src/io/support_plane.h"
+#include "src/capture/support_plane.h"
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>

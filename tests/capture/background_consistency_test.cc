@@ -1,9 +1,9 @@
-// Background consistency (src/io/background_consistency.h) against the true coverage of scenes
+// Background consistency (src/capture/background_consistency.h) against the true coverage of scenes
 // whose background is known: an icosphere on sft synth's textured ground plane under the studio
 // probe, shown behind it (both hypotheses: plane and distant), and the stored COLMAP fixture of
 // the spot in front of the studio probe (distant only), where the automatic masks are compared
 // with and without it.
-#include "src/io/background_consistency.h"
+#include "src/capture/background_consistency.h"
 
 #include <gtest/gtest.h>
 
@@ -14,8 +14,8 @@
 #include "src/core/file_util.h"
 #include "src/geometry/mesh.h"
 #include "src/image/image_io.h"
-#include "src/io/auto_masks.h"
-#include "src/io/colmap_import.h"
+#include "src/capture/auto_masks.h"
+#include "src/capture/colmap_import.h"
 #include "src/io/dataset.h"
 #include "src/io/point_cloud_ply.h"
 #include "tests/testing/synth_dataset.h"

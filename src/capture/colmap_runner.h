@@ -6,8 +6,8 @@
 //   exhaustive_matcher  "Matching block [i/n, j/n]"   (block i·n + j of n²)
 //   sequential_matcher  "Matching image [i/n]"
 //   mapper              "Registering image #ID (k)"    (k = images registered so far)
-#ifndef SFT_IO_COLMAP_RUNNER_H_
-#define SFT_IO_COLMAP_RUNNER_H_
+#ifndef SFT_CAPTURE_COLMAP_RUNNER_H_
+#define SFT_CAPTURE_COLMAP_RUNNER_H_
 
 #include <string>
 #include <vector>
@@ -30,4 +30,4 @@ Status RunColmapStage(const std::string& colmap_binary, const std::string& stage
 
 }  // namespace sft
 
-#endif  // SFT_IO_COLMAP_RUNNER_H_
+#endif  // SFT_CAPTURE_COLMAP_RUNNER_H_

@@ -1,7 +1,7 @@
-// The support plane (src/io/support_plane.h) on synthetic points: an object (a small ball of
+// The support plane (src/capture/support_plane.h) on synthetic points: an object (a small ball of
 // points) on a textured floor (a disc of points) seen by an orbit of cameras above it; and the
 // normalisation without masks, which leaves the floor out of the object's box.
-#include "src/io/support_plane.h"
+#include "src/capture/support_plane.h"
 
 #include <gtest/gtest.h>
 
@@ -9,7 +9,7 @@
 #include <cmath>
 #include <random>
 
-#include "src/io/import_normalization.h"
+#include "src/capture/import_normalization.h"
 #include "src/render/camera_rig.h"
 
 namespace sft {

@@ -1,8 +1,8 @@
-// Automatic masks (src/io/auto_masks.h) through `sft import colmap --masks auto` on the stored
+// Automatic masks (src/capture/auto_masks.h) through `sft import colmap --masks auto` on the stored
 // COLMAP fixture (data/colmap/spot), against synth's true coverage masks stored beside it. The
 // fixture's sparse points come from the true mesh (every 4th camera-facing vertex, with 0.3 px
 // noise), so this measures GrabCut given good seeds, not COLMAP's point density.
-#include "src/io/auto_masks.h"
+#include "src/capture/auto_masks.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -13,7 +13,7 @@
 
 #include "src/core/file_util.h"
 #include "src/image/image_io.h"
-#include "src/io/colmap_import.h"
+#include "src/capture/colmap_import.h"
 #include "src/io/dataset.h"
 #include "src/io/point_cloud_ply.h"
 #include "tests/testing/temp_dir.h"
@@ -69,7 +69,7 @@ TEST(AutoMasksTest, ThreeViewsMatchTheTrueMasks) {
   }
 }
 
-// Background consistency (src/io/background_consistency.h) on the same views: the spot stands in
+// Background consistency (src/capture/background_consistency.h) on the same views: the spot stands in
 // front of the probe, which the distant hypothesis explains, so the masks come closer to the
 // truth than GrabCut's from the seeds alone.
 TEST(AutoMasksTest, BackgroundConsistencyBringsTheMasksCloser) {

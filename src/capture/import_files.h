@@ -2,8 +2,8 @@
 // `middlebury`; docs/import.md): decoding photographs as stored, storing them in the dataset
 // (PNG and EXR byte for byte, other formats as lossless PNG), and building the output folder in
 // OUT.partial/ so that a failed import leaves nothing behind.
-#ifndef SFT_IO_IMPORT_FILES_H_
-#define SFT_IO_IMPORT_FILES_H_
+#ifndef SFT_CAPTURE_IMPORT_FILES_H_
+#define SFT_CAPTURE_IMPORT_FILES_H_
 
 #include <functional>
 #include <opencv2/core.hpp>
@@ -48,4 +48,4 @@ Status BuildDatasetFolder(const std::string& out, const RunInputs& inputs, bool 
 
 }  // namespace sft
 
-#endif  // SFT_IO_IMPORT_FILES_H_
+#endif  // SFT_CAPTURE_IMPORT_FILES_H_

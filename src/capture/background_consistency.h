@@ -5,7 +5,7 @@
 //
 // For each view at a working resolution (2^-k of the image, the long side at most `max_side`),
 // each pixel's ray is followed to two background hypotheses:
-//   plane    the support plane (src/io/support_plane.h), when one was found: the point X where
+//   plane    the support plane (src/capture/support_plane.h), when one was found: the point X where
 //            the ray meets it, projected into the other views that see X in front of the camera
 //            and inside the image;
 //   distant  the point at infinity along the ray (an environment far away, such as the probe a
@@ -21,8 +21,8 @@
 // of a room), specular supports, exposure changes between views and occlusion of X in most views
 // make the background inconsistent, so a large distance does not prove the object: the masks take
 // a small distance as background everywhere and a large one as object only near the seeds.
-#ifndef SFT_IO_BACKGROUND_CONSISTENCY_H_
-#define SFT_IO_BACKGROUND_CONSISTENCY_H_
+#ifndef SFT_CAPTURE_BACKGROUND_CONSISTENCY_H_
+#define SFT_CAPTURE_BACKGROUND_CONSISTENCY_H_
 
 #include <string>
 #include <vector>
@@ -30,7 +30,7 @@
 #include "src/core/image.h"
 #include "src/core/status.h"
 #include "src/io/dataset.h"
-#include "src/io/support_plane.h"
+#include "src/capture/support_plane.h"
 
 namespace sft {
 
@@ -65,4 +65,4 @@ Status BackgroundDistances(const Dataset& dataset, const SupportPlane* plane,
 
 }  // namespace sft
 
-#endif  // SFT_IO_BACKGROUND_CONSISTENCY_H_
+#endif  // SFT_CAPTURE_BACKGROUND_CONSISTENCY_H_
