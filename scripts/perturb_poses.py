@@ -8,7 +8,10 @@
       the left (in the camera frame), as sft's pose corrections are.
   perturb_poses.py score DATASET PERTURBED [RUN]
       The mean and largest rotation error (degrees) and mean camera-centre error of PERTURBED's
-      poses against DATASET's, corrected by RUN/poses.json when given.
+      poses against DATASET's, corrected by RUN/poses.json when given, and the mean reprojection
+      error (pixels) of DATASET's true mesh's vertices (ground_truth.mesh, a PLY with float x y z
+      first; pinhole intrinsics fx fy cx cy), which a rotation and translation that orbit the
+      object change little.
 
 Standard library only (no NumPy).
 """
@@ -17,6 +20,7 @@ import json
 import math
 import os
 import random
+import struct
 
 
 def qmul(a, b):
@@ -86,9 +90,64 @@ def perturb(args):
         json.dump(scene, f, indent=1)
 
 
+def ply_vertices(path):
+    """The x y z of a PLY's vertices (ascii or binary little-endian, float x y z first)."""
+    with open(path, "rb") as f:
+        data = f.read()
+    end = data.index(b"end_header") + len(b"end_header")
+    end = data.index(b"\n", end) + 1
+    header = data[:end].decode("ascii").split("\n")
+    count, props, binary = 0, [], "binary_little_endian" in header[1]
+    in_vertex = False
+    for line in header:
+        words = line.split()
+        if words[:2] == ["element", "vertex"]:
+            count, in_vertex = int(words[2]), True
+        elif words[:1] == ["element"]:
+            in_vertex = False
+        elif in_vertex and words[:1] == ["property"]:
+            props.append(words[1])
+    if binary:
+        sizes = {"float": 4, "double": 8, "uchar": 1, "int": 4, "uint": 4}
+        stride = sum(sizes[t] for t in props)
+        fmt = "<ddd" if props[0] == "double" else "<fff"
+        return [struct.unpack_from(fmt, data, end + i * stride) for i in range(count)]
+    lines = data[end:].decode("ascii").split("\n")
+    return [tuple(float(x) for x in lines[i].split()[:3]) for i in range(count)]
+
+
+def project(pose, camera, x):
+    q = pose["rotation"]
+    p = qrot(q, x)
+    p = [p[i] + pose["translation"][i] for i in range(3)]
+    fx, fy, cx, cy = camera["params"][:4]
+    return fx * p[0] / p[2] + cx, fy * p[1] / p[2] + cy
+
+
+def reprojection_px(scene, views, truth, dataset):
+    """Mean pixel distance between the true mesh's vertices projected at both poses."""
+    mesh = scene.get("ground_truth", {}).get("mesh")
+    if not mesh or scene["cameras"][0]["model"] not in ("PINHOLE", "OPENCV"):
+        return None
+    points = ply_vertices(os.path.join(dataset, mesh))[::10]
+    cameras = {c["id"]: c for c in scene["cameras"]}
+    total, n = 0.0, 0
+    for i, (a, b) in enumerate(zip(views, truth)):
+        if i == 0:
+            continue
+        camera = cameras[b["camera"]]
+        for x in points:
+            u0, v0 = project(a["cam_from_world"], camera, x)
+            u1, v1 = project(b["cam_from_world"], camera, x)
+            total += math.hypot(u0 - u1, v0 - v1)
+            n += 1
+    return total / n
+
+
 def score(args):
     with open(os.path.join(args.dataset, "scene.json")) as f:
-        truth = json.load(f)["views"]
+        scene = json.load(f)
+    truth = scene["views"]
     with open(os.path.join(args.perturbed, "scene.json")) as f:
         views = json.load(f)["views"]
     if args.run:
@@ -104,8 +163,10 @@ def score(args):
         rot.append(angle_deg(a["cam_from_world"]["rotation"], b["cam_from_world"]["rotation"]))
         ca, cb = centre(a["cam_from_world"]), centre(b["cam_from_world"])
         trans.append(math.sqrt(sum((x - y) ** 2 for x, y in zip(ca, cb))))
-    print("rotation error: mean %.4f deg, max %.4f deg; camera centre error: mean %.5f" %
-          (sum(rot) / len(rot), max(rot), sum(trans) / len(trans)))
+    line = "rotation error: mean %.4f deg, max %.4f deg; camera centre error: mean %.5f" % (
+        sum(rot) / len(rot), max(rot), sum(trans) / len(trans))
+    px = reprojection_px(scene, views, truth, args.dataset)
+    print(line + ("" if px is None else "; reprojection error: mean %.3f px" % px))
 
 
 def main():

@@ -274,6 +274,23 @@ const std::map<std::string, Key>& Keys() {
       {"fit_poses", Bool([](O* o) -> bool& { return o->fit_poses; })},
       {"exposure_prior",
        Real([](O* o) -> double& { return o->regularizers.exposure_prior; }, 0, 1e12)},
+      {"pose_prior",
+       {[](const json& v, O* o) -> std::string {
+          if (v.is_string() && v.get<std::string>() == "auto") {
+            o->regularizers.pose_prior = kPosePriorAuto;
+            return "";
+          }
+          if (!v.is_number() || !std::isfinite(v.get<double>()) || v.get<double>() < 0 ||
+              v.get<double>() > 1e12) {
+            return "expected \"auto\" or a number in [0, 1e12]";
+          }
+          o->regularizers.pose_prior = v.get<double>();
+          return "";
+        },
+        [](const O& o) {
+          return o.regularizers.pose_prior == kPosePriorAuto ? json("auto")
+                                                             : json(o.regularizers.pose_prior);
+        }}},
       {"fit_environment", Bool([](O* o) -> bool& { return o->fit_environment; })},
       {"environment_smoothness",
        Real([](O* o) -> double& { return o->regularizers.environment_smoothness; }, 0, 1e12)},

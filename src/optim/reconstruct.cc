@@ -328,6 +328,21 @@ Status Reconstruction::PlanEffects(int outer, EffectPlanReport* report, double i
   return sft::PlanEffects(options_.planner, context, cache_.get(), report);
 }
 
+double Reconstruction::ResolvedPosePrior() const {
+  const double prior = options_.regularizers.pose_prior;
+  if (prior != kPosePriorAuto) return prior;
+  for (int v : cache_->view_indices()) {
+    const ViewSetup& view = views_.views[v];
+    for (const PointLight& light : view.point_lights) {
+      if (light.camera_frame) return 0.0;
+    }
+    for (const DirectionalLight& light : view.directional_lights) {
+      if (light.camera_frame) return 0.0;
+    }
+  }
+  return kPosePriorWorldLights;
+}
+
 Status Reconstruction::RunOuter(int outer,
                                 const std::function<bool(const IterationRecord&)>& on_iteration) {
   std::vector<std::pair<std::string, ActiveParameters>> phases;
@@ -348,9 +363,20 @@ Status Reconstruction::RunOuter(int outer,
     for (int v = 0; active.exposure && v < params_.num_gain_views(); ++v) {
       gain_curvature.push_back(cache_->GainCurvature(v));
     }
+    std::vector<Eigen::Vector2d> pose_curvature;
+    if (active.poses && params_.num_pose_views() > 0) {
+      Eigen::Vector3d lo, hi;
+      MeshBounds(rest, &lo, &hi);
+      const Eigen::Vector3d centre = 0.5 * (lo + hi);
+      for (int v = 0; v < params_.num_pose_views(); ++v) {
+        pose_curvature.push_back(cache_->PoseCurvature(v, centre));
+      }
+    }
+    RegularizerOptions regularizers = options_.regularizers;
+    regularizers.pose_prior = ResolvedPosePrior();
     hooks.add_regularizers = [&](ceres::Problem* problem) {
-      AddRegularizers(rest, active, options_.regularizers, options_.problem.bounds, material_,
-                      &params_, problem, gain_curvature);
+      AddRegularizers(rest, active, regularizers, options_.problem.bounds, material_, &params_,
+                      problem, gain_curvature, pose_curvature);
     };
     std::vector<double> last_psnr;
     hooks.on_iteration = [&](const IterationInfo& info) {

@@ -122,6 +122,10 @@ class Reconstruction {
   // iteration; returning false stops the run (the state so far is kept).
   Status RunOuter(int outer, const std::function<bool(const IterationRecord&)>& on_iteration);
 
+  // The pose prior's weight this run uses: RegularizerOptions::pose_prior, its auto value resolved
+  // from the fitted views' lights.
+  double ResolvedPosePrior() const;
+
   // The current state.
   TriMesh Mesh() const;
   Material CurrentMaterial() const;  // unsampled texels filled from their neighbours.

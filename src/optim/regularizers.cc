@@ -7,6 +7,7 @@
 #include "cost_functions/environment_smoothness.h"
 #include "cost_functions/exposure_prior.h"
 #include "cost_functions/face_orientation.h"
+#include "cost_functions/pose_prior.h"
 #include "cost_functions/proximal_smoothing.h"
 #include "cost_functions/texel_smoothness.h"
 #include "cost_functions/uv_texel_smoothness.h"
@@ -50,6 +51,10 @@ bool RegularizerOptions::Check(std::string* why) const {
     *why = "environment_smoothness: must be finite and >= 0";
     return false;
   }
+  if (!(pose_prior == kPosePriorAuto || (pose_prior >= 0.0 && std::isfinite(pose_prior)))) {
+    *why = "pose_prior: must be auto or finite and >= 0";
+    return false;
+  }
   if (!(exposure_prior >= 0.0 && std::isfinite(exposure_prior))) {
     *why = "exposure_prior: must be finite and >= 0";
     return false;
@@ -70,7 +75,8 @@ bool RegularizerOptions::Check(std::string* why) const {
 void AddRegularizers(const TriMesh& rest, const ActiveParameters& active,
                      const RegularizerOptions& options, const ParameterBounds& bounds,
                      const Material& material, SceneParameters* params, ceres::Problem* problem,
-                     const std::vector<Eigen::Vector3d>& gain_curvature) {
+                     const std::vector<Eigen::Vector3d>& gain_curvature,
+                     const std::vector<Eigen::Vector2d>& pose_curvature) {
   const ParameterLayout& layout = params->layout();
   if (active.vertices && options.laplacian_weight > 0.0) {
     VertexLaplacianOptions laplacian;
@@ -143,6 +149,19 @@ void AddRegularizers(const TriMesh& rest, const ActiveParameters& active,
       for (int c = 0; c < 3; ++c) {
         problem->SetParameterLowerBound(block, c, params->Lower(params->GainIndex(v, c), bounds));
         problem->SetParameterUpperBound(block, c, params->Upper(params->GainIndex(v, c), bounds));
+      }
+    }
+  }
+  if (active.poses && options.pose_prior > 0.0) {
+    CHECK_EQ(static_cast<int>(pose_curvature.size()), params->num_pose_views());
+    for (int v = 0; v < params->num_pose_views(); ++v) {
+      if (!params->PoseFitted(v)) continue;
+      double* block = params->data() + params->PoseIndex(v, 0);
+      const Eigen::Vector2d w = (options.pose_prior * pose_curvature[v]).cwiseSqrt();
+      problem->AddResidualBlock(new PosePriorCost(w[0], w[1]), nullptr, block);
+      for (int k = 0; k < 6; ++k) {
+        problem->SetParameterLowerBound(block, k, params->Lower(params->PoseIndex(v, k), bounds));
+        problem->SetParameterUpperBound(block, k, params->Upper(params->PoseIndex(v, k), bounds));
       }
     }
   }

@@ -1,6 +1,6 @@
 // Regularizer residual blocks of the reconstruction (cost_functions/vertex_laplacian.h,
 // cost_functions/face_orientation.h, cost_functions/proximal_smoothing.h,
-// cost_functions/texel_smoothness.h, cost_functions/exposure_prior.h,
+// cost_functions/texel_smoothness.h, cost_functions/exposure_prior.h, cost_functions/pose_prior.h,
 // cost_functions/environment_smoothness.h), added for the parameter
 // kinds a phase varies.
 #ifndef SFT_OPTIM_REGULARIZERS_H_
@@ -15,6 +15,12 @@
 #include "src/optim/parameters.h"
 
 namespace sft {
+
+// RegularizerOptions::pose_prior: chosen from the lighting (ResolvedPosePrior).
+constexpr double kPosePriorAuto = -1.0;
+// The auto pose prior under world-fixed lights (docs/design-notes.md, "Pose refinement under
+// world-fixed lights").
+constexpr double kPosePriorWorldLights = 0.01;
 
 struct RegularizerOptions {
   // Weight of the vertex Laplacian term (√ of the weight multiplies each residual), ≥ 0; 0 = off.
@@ -51,6 +57,14 @@ struct RegularizerOptions {
   // in the gain), finite, ≥ 0: the prior counts λ times as much as the view's photograph; 0 = no
   // prior (the gauge view alone fixes the scale). The default pulls a gain by 1e-3 of its offset.
   double exposure_prior = 1e-3;
+  // Relative weight λ of the pose corrections' prior towards the dataset's poses
+  // (cost_functions/pose_prior.h: ½·λ·C·|δ|² per view, C the image term's curvature along a
+  // correction that slides the image, RenderCache::PoseCurvature), finite, ≥ 0, or
+  // kPosePriorAuto; 0 = no prior (the bounds alone). Holds the corrections the photographs hardly
+  // see (under world-fixed lights, a turn about the object with the matching shift) while costing
+  // those they see a fraction λ. Auto: kPosePriorWorldLights when no fitted view has a light that
+  // rides with the camera, else 0 (a flash's shading tells that turn; docs/reconstruct.md).
+  double pose_prior = kPosePriorAuto;
   // Weight of differences between neighbouring texels of a fitted environment
   // (cost_functions/environment_smoothness.h; unknown lighting), finite, ≥ 0; 0 = off. Residuals
   // are radiance differences, weighed against image residuals of radiance: 1 lets a few pixels'
@@ -65,11 +79,14 @@ struct RegularizerOptions {
 // `params`; blocks new to the problem get the bounds of `bounds`. `rest` is the mesh whose
 // positions the Laplacian measures displacements from and the proximal term is anchored at (and
 // whose connectivity they use). `gain_curvature` holds E_v per fitted view for the exposure prior
-// (RenderCache::GainCurvature); needed only when `active.exposure`.
+// (RenderCache::GainCurvature); needed only when `active.exposure`. `pose_curvature` holds the
+// rotation's and translation's curvature per fitted view for the pose prior
+// (RenderCache::PoseCurvature); needed only when `active.poses`.
 void AddRegularizers(const TriMesh& rest, const ActiveParameters& active,
                      const RegularizerOptions& options, const ParameterBounds& bounds,
                      const Material& material, SceneParameters* params, ceres::Problem* problem,
-                     const std::vector<Eigen::Vector3d>& gain_curvature = {});
+                     const std::vector<Eigen::Vector3d>& gain_curvature = {},
+                     const std::vector<Eigen::Vector2d>& pose_curvature = {});
 
 }  // namespace sft
 

@@ -476,6 +476,37 @@ Eigen::Vector3d RenderCache::GainCurvature(int v) const {
   return sum;
 }
 
+Eigen::Vector2d RenderCache::PoseCurvature(int v, const Eigen::Vector3d& object_centre) const {
+  double energy = 0.0;
+  for (int l = 0; l < num_levels(v); ++l) {
+    const LevelCache& level = *levels_[v][l];
+    const std::vector<uint8_t>& active = targets_[v].active[l];
+    const int w = level.target.width, h = level.target.height;
+    const double level_scale = std::ldexp(1.0, -2 * l);  // 4^-l: level pixels per level-0 pixel.
+    for (int y = 1; y + 1 < h; ++y) {
+      for (int x = 1; x + 1 < w; ++x) {
+        const int p = y * w + x;
+        if (!active[p] || !active[p - 1] || !active[p + 1] || !active[p - w] || !active[p + w]) {
+          continue;
+        }
+        double g2 = 0.0;
+        for (int c = 0; c < 3; ++c) {
+          const double gx = 0.5 * (level.target.at(x + 1, y, c) - level.target.at(x - 1, y, c));
+          const double gy = 0.5 * (level.target.at(x, y + 1, c) - level.target.at(x, y - 1, c));
+          g2 += gx * gx + gy * gy;
+        }
+        const double sw = level.SqrtWeight(p);
+        energy += sw * sw * g2 * level_scale;
+      }
+    }
+  }
+  const ViewSetup& view = views_->views[view_indices_[v]];
+  const Camera camera = DownscaledCamera(view.camera, options_.image_scale_log2);
+  const double f = camera.Focal().mean();
+  const double z = std::max((view.cam_from_world * object_centre).z(), 1e-9);
+  return Eigen::Vector2d(energy * f * f, energy * f * f / (z * z));
+}
+
 double RenderCache::ImageCost() const {
   double cost = 0.0;
   for (int v = 0; v < num_views(); ++v) cost += ViewImageCost(v);
