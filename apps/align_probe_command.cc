@@ -1,16 +1,16 @@
 // sft align-probe: finds the rotation of a dataset's environment light (a 360° probe) from the
-// frames' background (src/capture/probe_alignment.h) and writes a copy of the dataset with it stored as
-// the light's world_from_env. `sft import colmap --probe` runs the same alignment itself; this
-// command is for datasets imported with --no-align-probe or made elsewhere. Decisions in
+// frames' background (src/capture/probe_alignment.h) and writes a copy of the dataset with it
+// stored as the light's world_from_env. `sft import colmap --probe` runs the same alignment itself;
+// this command is for datasets imported with --no-align-probe or made elsewhere. Decisions in
 // docs/import.md "Probe alignment".
 #include <cstdio>
 #include <filesystem>
 #include <memory>
 
 #include "apps/commands.h"
+#include "src/capture/probe_alignment.h"
 #include "src/core/file_util.h"
 #include "src/io/dataset.h"
-#include "src/capture/probe_alignment.h"
 
 namespace sft {
 namespace {

@@ -1,7 +1,7 @@
 // sft import: brings captures into the sft-dataset/1 format. `sft import colmap` converts a COLMAP
 // sparse model and its images (src/capture/colmap_import.h); `sft import video` selects frames of a
-// video and runs COLMAP on them first (src/capture/video_import.h); `nerf`, `idr` and `middlebury` are
-// in import_calibrated_command.cc. Decisions in docs/import.md.
+// video and runs COLMAP on them first (src/capture/video_import.h); `nerf`, `idr` and `middlebury`
+// are in import_calibrated_command.cc. Decisions in docs/import.md.
 #include <cstdio>
 #include <memory>
 

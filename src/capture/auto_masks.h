@@ -28,11 +28,11 @@
 #include <string>
 #include <vector>
 
+#include "src/capture/background_consistency.h"
+#include "src/capture/support_plane.h"
 #include "src/core/image.h"
 #include "src/core/status.h"
-#include "src/capture/background_consistency.h"
 #include "src/io/dataset.h"
-#include "src/capture/support_plane.h"
 
 namespace sft {
 

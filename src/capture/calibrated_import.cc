@@ -6,9 +6,9 @@
 #include <opencv2/imgproc.hpp>
 #include <set>
 
+#include "src/capture/import_files.h"
 #include "src/core/progress.h"
 #include "src/io/dataset.h"
-#include "src/capture/import_files.h"
 
 namespace sft {
 namespace {

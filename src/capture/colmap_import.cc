@@ -7,16 +7,16 @@
 #include <opencv2/imgcodecs.hpp>
 #include <set>
 
+#include "src/capture/auto_masks.h"
+#include "src/capture/import_files.h"
+#include "src/capture/probe_alignment.h"
 #include "src/core/file_util.h"
 #include "src/core/progress.h"
 #include "src/geometry/mesh.h"
 #include "src/image/image_io.h"
-#include "src/capture/auto_masks.h"
 #include "src/io/colmap_model.h"
 #include "src/io/dataset.h"
-#include "src/capture/import_files.h"
 #include "src/io/point_cloud_ply.h"
-#include "src/capture/probe_alignment.h"
 
 namespace sft {
 namespace {

@@ -15,10 +15,10 @@
 
 #include <string>
 
-#include "src/core/status.h"
 #include "src/capture/auto_masks.h"
 #include "src/capture/import_normalization.h"
 #include "src/capture/probe_alignment.h"
+#include "src/core/status.h"
 
 namespace sft {
 

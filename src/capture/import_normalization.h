@@ -8,10 +8,9 @@
 // camera and its normalised image coordinates (x/z, y/z) fall inside the ellipse whose semi-axes
 // are `axis_cone` times the half-image's extent (w/(2 fx), h/(2 fy)); a point belongs to the
 // object when at least half of its observing views see it that way, unless it lies on or beyond
-// the support plane (src/capture/support_plane.h: a table top or floor under the object, whose points
-// every view also sees near its axis); the box runs from the
-// `percentile`-th to the (100 − percentile)-th percentile of those points on each axis, so stray
-// points do not stretch it.
+// the support plane (src/capture/support_plane.h: a table top or floor under the object, whose
+// points every view also sees near its axis); the box runs from the `percentile`-th to the (100 −
+// percentile)-th percentile of those points on each axis, so stray points do not stretch it.
 #ifndef SFT_CAPTURE_IMPORT_NORMALIZATION_H_
 #define SFT_CAPTURE_IMPORT_NORMALIZATION_H_
 
@@ -21,9 +20,9 @@
 #include <unordered_map>
 #include <vector>
 
+#include "src/capture/support_plane.h"
 #include "src/core/status.h"
 #include "src/io/colmap_model.h"
-#include "src/capture/support_plane.h"
 #include "src/render/camera.h"
 
 namespace sft {

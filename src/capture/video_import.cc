@@ -5,9 +5,9 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
+#include "src/capture/colmap_runner.h"
 #include "src/core/file_util.h"
 #include "src/io/colmap_model.h"
-#include "src/capture/colmap_runner.h"
 
 namespace sft {
 namespace {

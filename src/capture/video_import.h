@@ -2,18 +2,18 @@
 // Steps: frame selection (src/io/video_frames.h), COLMAP's CPU pipeline through its command line
 // (src/capture/colmap_runner.h: feature_extractor with one shared camera, exhaustive_matcher up to
 // `exhaustive_limit` frames else sequential_matcher, mapper), then the largest model is imported
-// by ImportColmap (src/capture/colmap_import.h). The COLMAP workspace (frames, database, models) lives
-// in OUT.video-work, beside OUT; COLMAP's output goes to OUT/colmap/log.txt and the selected frames
-// to OUT/colmap/frames.json. On success OUT.video-work is removed; when COLMAP fails it is kept
-// for inspection and the error names its log.
+// by ImportColmap (src/capture/colmap_import.h). The COLMAP workspace (frames, database, models)
+// lives in OUT.video-work, beside OUT; COLMAP's output goes to OUT/colmap/log.txt and the selected
+// frames to OUT/colmap/frames.json. On success OUT.video-work is removed; when COLMAP fails it is
+// kept for inspection and the error names its log.
 #ifndef SFT_CAPTURE_VIDEO_IMPORT_H_
 #define SFT_CAPTURE_VIDEO_IMPORT_H_
 
 #include <string>
 #include <vector>
 
-#include "src/core/status.h"
 #include "src/capture/colmap_import.h"
+#include "src/core/status.h"
 #include "src/io/video_frames.h"
 
 namespace sft {

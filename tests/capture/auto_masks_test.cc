@@ -11,9 +11,9 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "src/capture/colmap_import.h"
 #include "src/core/file_util.h"
 #include "src/image/image_io.h"
-#include "src/capture/colmap_import.h"
 #include "src/io/dataset.h"
 #include "src/io/point_cloud_ply.h"
 #include "tests/testing/temp_dir.h"
@@ -69,8 +69,8 @@ TEST(AutoMasksTest, ThreeViewsMatchTheTrueMasks) {
   }
 }
 
-// Background consistency (src/capture/background_consistency.h) on the same views: the spot stands in
-// front of the probe, which the distant hypothesis explains, so the masks come closer to the
+// Background consistency (src/capture/background_consistency.h) on the same views: the spot stands
+// in front of the probe, which the distant hypothesis explains, so the masks come closer to the
 // truth than GrabCut's from the seeds alone.
 TEST(AutoMasksTest, BackgroundConsistencyBringsTheMasksCloser) {
   testing::TempDir tmp;

@@ -11,11 +11,11 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "src/capture/auto_masks.h"
+#include "src/capture/colmap_import.h"
 #include "src/core/file_util.h"
 #include "src/geometry/mesh.h"
 #include "src/image/image_io.h"
-#include "src/capture/auto_masks.h"
-#include "src/capture/colmap_import.h"
 #include "src/io/dataset.h"
 #include "src/io/point_cloud_ply.h"
 #include "tests/testing/synth_dataset.h"

@@ -12,8 +12,8 @@
 #include <cmath>
 #include <random>
 
-#include "src/image/image_io.h"
 #include "src/capture/colmap_import.h"
+#include "src/image/image_io.h"
 #include "src/io/dataset.h"
 #include "tests/testing/temp_dir.h"
 
