@@ -58,7 +58,7 @@ struct RegularizerOptions {
   // prior (the gauge view alone fixes the scale). The default pulls a gain by 1e-3 of its offset.
   double exposure_prior = 1e-3;
   // Relative weight λ of the pose corrections' prior towards the dataset's poses
-  // (cost_functions/pose_prior.h: ½·λ·C·|δ|² per view, C the image term's curvature along a
+  // (cost_functions/pose_prior.h: ½·λ·C·‖δ‖² per view, C the image term's curvature along a
   // correction that slides the image, RenderCache::PoseCurvature), finite, ≥ 0, or
   // kPosePriorAuto; 0 = no prior (the bounds alone). Holds the corrections the photographs hardly
   // see (under world-fixed lights, a turn about the object with the matching shift) while costing
