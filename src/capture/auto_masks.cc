@@ -4,6 +4,7 @@
 #include <cmath>
 #include <exception>
 #include <filesystem>
+#include <memory>
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 #include <vector>
@@ -200,10 +201,11 @@ Status WriteAutoMasks(Dataset* dataset, const std::vector<Eigen::Vector3d>& spar
   BackgroundConsistencyOptions consistency = options.consistency;
   consistency.quiet = consistency.quiet || options.quiet;
   std::vector<Image> masks(n), distances;
+  std::unique_ptr<BackgroundViews> views;
+  if (consistent) SFT_RETURN_IF_ERROR(BackgroundViews::Load(*dataset, consistency, &views));
   for (int pass = 0; pass < (consistent ? options.passes : 1); ++pass) {
     if (consistent) {
-      SFT_RETURN_IF_ERROR(BackgroundDistances(*dataset, plane, pass == 0 ? nullptr : &masks,
-                                              consistency, &distances));
+      SFT_RETURN_IF_ERROR(views->Distances(plane, pass == 0 ? nullptr : &masks, &distances));
     }
     Progress progress("auto masks", static_cast<int64_t>(n), !options.quiet);
     std::vector<Image> next(n);

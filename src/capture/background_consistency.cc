@@ -14,15 +14,9 @@
 #include "src/core/progress.h"
 
 namespace sft {
-namespace {
-
-bool Fail(std::string* why, const std::string& text) {
-  *why = text;
-  return false;
-}
 
 // A view at the working resolution: its camera, pose and display image (8-bit RGB, row-major).
-struct WorkView {
+struct BackgroundWorkView {
   Camera camera;
   Rigid3d cam_from_world;
   double max_radius2 = std::numeric_limits<double>::infinity();  // of normalized coordinates.
@@ -30,6 +24,15 @@ struct WorkView {
   // 1 where an earlier mask says the view sees the object (row-major); empty = no mask.
   std::vector<uint8_t> object;
 };
+
+namespace {
+
+using WorkView = BackgroundWorkView;
+
+bool Fail(std::string* why, const std::string& text) {
+  *why = text;
+  return false;
+}
 
 // The linear image of view `index` box-filtered to `camera`'s size (cv::INTER_AREA).
 Status LoadWorkImage(const Dataset& dataset, int index, const Camera& camera, Image* out) {
@@ -270,6 +273,53 @@ std::vector<uint8_t> WorkMask(const Image& mask, const Camera& camera) {
 
 }  // namespace
 
+BackgroundViews::BackgroundViews() = default;
+BackgroundViews::~BackgroundViews() = default;
+
+Status BackgroundViews::Load(const Dataset& dataset, const BackgroundConsistencyOptions& options,
+                             std::unique_ptr<BackgroundViews>* out) {
+  std::string why;
+  if (!options.Check(&why)) return Status::Error("background consistency: " + why);
+  if (dataset.views.size() < 2) {
+    return Status::Error("background consistency: needs at least 2 views");
+  }
+  std::unique_ptr<BackgroundViews> loaded(new BackgroundViews());
+  loaded->options_ = options;
+  try {
+    SFT_RETURN_IF_ERROR(LoadWorkViews(dataset, options, &loaded->views_));
+  } catch (const std::exception& e) {
+    return Status::Error("background consistency: OpenCV: " + std::string(e.what()));
+  }
+  *out = std::move(loaded);
+  return Status::Ok();
+}
+
+Status BackgroundViews::Distances(const SupportPlane* plane, const std::vector<Image>* masks,
+                                  std::vector<Image>* distances) {
+  const int n = static_cast<int>(views_.size());
+  if (masks != nullptr && static_cast<int>(masks->size()) != n) {
+    return Status::Error("background consistency: one mask per view needed");
+  }
+  for (int i = 0; i < n; ++i) {
+    const bool has_mask = masks != nullptr && !(*masks)[i].empty();
+    views_[i].object = has_mask ? WorkMask((*masks)[i], views_[i].camera) : std::vector<uint8_t>();
+  }
+  distances->assign(n, Image());
+  Progress progress("background", n, !options_.quiet);
+  for (int i = 0; i < n; ++i) {
+    Image& distance = (*distances)[i];
+    distance = Image(views_[i].camera.width, views_[i].camera.height, 1);
+    const std::vector<int> others = OtherViews(i, n, options_.max_views);
+    tbb::parallel_for(0, distance.height, [&](int y) {
+      DistanceRow(views_, i, others, plane, options_.min_views, y, &distance);
+    });
+    MedianFilter3(&distance);
+    progress.Advance();
+  }
+  progress.Finish();
+  return Status::Ok();
+}
+
 Status BackgroundDistances(const Dataset& dataset, const SupportPlane* plane,
                            const BackgroundConsistencyOptions& options,
                            std::vector<Image>* distances) {
@@ -280,36 +330,9 @@ Status BackgroundDistances(const Dataset& dataset, const SupportPlane* plane,
                            const std::vector<Image>* masks,
                            const BackgroundConsistencyOptions& options,
                            std::vector<Image>* distances) {
-  std::string why;
-  if (!options.Check(&why)) return Status::Error("background consistency: " + why);
-  const int n = static_cast<int>(dataset.views.size());
-  if (n < 2) return Status::Error("background consistency: needs at least 2 views");
-  std::vector<WorkView> views;
-  try {
-    SFT_RETURN_IF_ERROR(LoadWorkViews(dataset, options, &views));
-    if (masks != nullptr && masks->size() != views.size()) {
-      return Status::Error("background consistency: one mask per view needed");
-    }
-    for (size_t i = 0; masks != nullptr && i < views.size(); ++i) {
-      if (!(*masks)[i].empty()) views[i].object = WorkMask((*masks)[i], views[i].camera);
-    }
-  } catch (const std::exception& e) {
-    return Status::Error("background consistency: OpenCV: " + std::string(e.what()));
-  }
-  distances->assign(n, Image());
-  Progress progress("background", n, !options.quiet);
-  for (int i = 0; i < n; ++i) {
-    Image& distance = (*distances)[i];
-    distance = Image(views[i].camera.width, views[i].camera.height, 1);
-    const std::vector<int> others = OtherViews(i, n, options.max_views);
-    tbb::parallel_for(0, distance.height, [&](int y) {
-      DistanceRow(views, i, others, plane, options.min_views, y, &distance);
-    });
-    MedianFilter3(&distance);
-    progress.Advance();
-  }
-  progress.Finish();
-  return Status::Ok();
+  std::unique_ptr<BackgroundViews> views;
+  SFT_RETURN_IF_ERROR(BackgroundViews::Load(dataset, options, &views));
+  return views->Distances(plane, masks, distances);
 }
 
 }  // namespace sft

@@ -24,6 +24,7 @@
 #ifndef SFT_CAPTURE_BACKGROUND_CONSISTENCY_H_
 #define SFT_CAPTURE_BACKGROUND_CONSISTENCY_H_
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -62,6 +63,27 @@ Status BackgroundDistances(const Dataset& dataset, const SupportPlane* plane,
                            const std::vector<Image>* masks,
                            const BackgroundConsistencyOptions& options,
                            std::vector<Image>* distances);
+
+struct BackgroundWorkView;
+
+// The views at the working resolution, loaded once (each image is read twice: once for the
+// common white, once for its display colours) and compared as often as the masks' passes ask.
+class BackgroundViews {
+ public:
+  // Errors name the unreadable image; a dataset of one view is an error (nothing to compare with).
+  static Status Load(const Dataset& dataset, const BackgroundConsistencyOptions& options,
+                     std::unique_ptr<BackgroundViews>* out);
+  ~BackgroundViews();
+
+  // As BackgroundDistances above, with these views (`masks`: nullptr = no visibility).
+  Status Distances(const SupportPlane* plane, const std::vector<Image>* masks,
+                   std::vector<Image>* distances);
+
+ private:
+  BackgroundViews();
+  BackgroundConsistencyOptions options_;
+  std::vector<BackgroundWorkView> views_;
+};
 
 }  // namespace sft
 
