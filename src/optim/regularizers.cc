@@ -16,6 +16,17 @@
 namespace sft {
 namespace {
 
+// Gives the block of `size` numbers at flat index `first` (already in `problem`) the bounds of its
+// parameters.
+void SetBlockBounds(int first, int size, const ParameterBounds& bounds, SceneParameters* params,
+                    ceres::Problem* problem) {
+  double* block = params->data() + first;
+  for (int i = 0; i < size; ++i) {
+    problem->SetParameterLowerBound(block, i, params->Lower(first + i, bounds));
+    problem->SetParameterUpperBound(block, i, params->Upper(first + i, bounds));
+  }
+}
+
 // Smoothness over the texel pairs `pairs` of one attribute (mesh colors or a UV texture) whose
 // texel k is the block at offset + channels·k.
 void AddSmoothness(const std::vector<TexelPair>& pairs, int num_texels, int channels, int offset,
@@ -29,11 +40,8 @@ void AddSmoothness(const std::vector<TexelPair>& pairs, int num_texels, int chan
   // Texels no render touches (mesh colors' i + j = r) enter the problem here: give every texel
   // the bounds.
   for (int k = 0; k < num_texels; ++k) {
-    if (!problem->HasParameterBlock(blocks[k])) continue;
-    for (int c = 0; c < channels; ++c) {
-      const int index = offset + channels * k + c;
-      problem->SetParameterLowerBound(blocks[k], c, params->Lower(index, bounds));
-      problem->SetParameterUpperBound(blocks[k], c, params->Upper(index, bounds));
+    if (problem->HasParameterBlock(blocks[k])) {
+      SetBlockBounds(offset + channels * k, channels, bounds, params, problem);
     }
   }
 }
@@ -131,11 +139,8 @@ void AddRegularizers(const TriMesh& rest, const ActiveParameters& active,
         EnvironmentNeighbourPairs(params->environment_width(), params->environment_height()), 3,
         smoothness, blocks, problem);
     for (int t = 0; t < num_texels; ++t) {
-      if (!problem->HasParameterBlock(blocks[t])) continue;
-      for (int c = 0; c < 3; ++c) {
-        const int index = layout.EnvironmentOffset() + 3 * t + c;
-        problem->SetParameterLowerBound(blocks[t], c, params->Lower(index, bounds));
-        problem->SetParameterUpperBound(blocks[t], c, params->Upper(index, bounds));
+      if (problem->HasParameterBlock(blocks[t])) {
+        SetBlockBounds(layout.EnvironmentOffset() + 3 * t, 3, bounds, params, problem);
       }
     }
   }
@@ -146,10 +151,7 @@ void AddRegularizers(const TriMesh& rest, const ActiveParameters& active,
       double* block = params->data() + params->GainIndex(v, 0);
       const Eigen::Vector3d w = (options.exposure_prior * gain_curvature[v]).cwiseSqrt();
       problem->AddResidualBlock(new ExposurePriorCost(w[0], w[1], w[2]), nullptr, block);
-      for (int c = 0; c < 3; ++c) {
-        problem->SetParameterLowerBound(block, c, params->Lower(params->GainIndex(v, c), bounds));
-        problem->SetParameterUpperBound(block, c, params->Upper(params->GainIndex(v, c), bounds));
-      }
+      SetBlockBounds(params->GainIndex(v, 0), 3, bounds, params, problem);
     }
   }
   if (active.poses && options.pose_prior > 0.0) {
@@ -159,10 +161,7 @@ void AddRegularizers(const TriMesh& rest, const ActiveParameters& active,
       double* block = params->data() + params->PoseIndex(v, 0);
       const Eigen::Vector2d w = (options.pose_prior * pose_curvature[v]).cwiseSqrt();
       problem->AddResidualBlock(new PosePriorCost(w[0], w[1]), nullptr, block);
-      for (int k = 0; k < 6; ++k) {
-        problem->SetParameterLowerBound(block, k, params->Lower(params->PoseIndex(v, k), bounds));
-        problem->SetParameterUpperBound(block, k, params->Upper(params->PoseIndex(v, k), bounds));
-      }
+      SetBlockBounds(params->PoseIndex(v, 0), 6, bounds, params, problem);
     }
   }
 }

@@ -29,16 +29,26 @@ double AngleDegrees(const Eigen::Quaterniond& a, const Eigen::Quaterniond& b) {
   return a.angularDistance(b) * 180.0 / M_PI;
 }
 
+// Every view's cam_from_world in `dataset` corrected by `poses_json` (empty: as given).
+std::vector<Rigid3d> CorrectedPoses(const Dataset& dataset, const std::string& poses_json) {
+  std::vector<PoseDelta> deltas(dataset.views.size(), PoseDelta::Zero());
+  if (!poses_json.empty()) {
+    EXPECT_TRUE(ParsePosesJson(poses_json, static_cast<int>(deltas.size()), &deltas).ok());
+  }
+  std::vector<Rigid3d> poses;
+  for (size_t v = 0; v < deltas.size(); ++v) {
+    poses.push_back(CorrectedCamFromWorld(dataset.views[v].cam_from_world, deltas[v]));
+  }
+  return poses;
+}
+
 // The mean rotation error (degrees) of views 1–3 of `dataset` corrected by `poses_json` (empty:
 // as given) against `truth`.
 double MeanError(const Dataset& dataset, const Dataset& truth, const std::string& poses_json) {
-  std::vector<PoseDelta> poses(dataset.views.size(), PoseDelta::Zero());
-  if (!poses_json.empty()) {
-    EXPECT_TRUE(ParsePosesJson(poses_json, static_cast<int>(poses.size()), &poses).ok());
-  }
+  const std::vector<Rigid3d> poses = CorrectedPoses(dataset, poses_json);
   double sum = 0.0;
   for (int v = 1; v < 4; ++v) {
-    const Rigid3d pose = CorrectedCamFromWorld(dataset.views[v].cam_from_world, poses[v]);
+    const Rigid3d& pose = poses[v];
     sum += AngleDegrees(pose.rotation, truth.views[v].cam_from_world.rotation);
   }
   return sum / 3.0;
@@ -48,13 +58,10 @@ double MeanError(const Dataset& dataset, const Dataset& truth, const std::string
 // from the true ones, scene units.
 double MeanCentreError(const Dataset& dataset, const Dataset& truth,
                        const std::string& poses_json) {
-  std::vector<PoseDelta> poses(dataset.views.size(), PoseDelta::Zero());
-  if (!poses_json.empty()) {
-    EXPECT_TRUE(ParsePosesJson(poses_json, static_cast<int>(poses.size()), &poses).ok());
-  }
+  const std::vector<Rigid3d> poses = CorrectedPoses(dataset, poses_json);
   double sum = 0.0;
   for (int v = 1; v < 4; ++v) {
-    const Rigid3d pose = CorrectedCamFromWorld(dataset.views[v].cam_from_world, poses[v]);
+    const Rigid3d& pose = poses[v];
     sum +=
         (pose.Inverse().translation - truth.views[v].cam_from_world.Inverse().translation).norm();
   }
@@ -65,16 +72,13 @@ double MeanCentreError(const Dataset& dataset, const Dataset& truth,
 // corrected by `poses_json` (empty: as given) and at the true poses.
 double MeanReprojectionPx(const Dataset& dataset, const Dataset& truth,
                           const std::string& poses_json, const std::string& mesh_path) {
-  std::vector<PoseDelta> poses(dataset.views.size(), PoseDelta::Zero());
-  if (!poses_json.empty()) {
-    EXPECT_TRUE(ParsePosesJson(poses_json, static_cast<int>(poses.size()), &poses).ok());
-  }
+  const std::vector<Rigid3d> poses = CorrectedPoses(dataset, poses_json);
   TriMesh mesh;
   EXPECT_TRUE(ReadMesh(mesh_path, &mesh).ok());
   double sum = 0.0;
   int n = 0;
   for (int v = 1; v < 4; ++v) {
-    const Rigid3d pose = CorrectedCamFromWorld(dataset.views[v].cam_from_world, poses[v]);
+    const Rigid3d& pose = poses[v];
     const Camera& camera = truth.cameras.at(truth.views[v].camera);
     for (const auto& vh : mesh.vertices()) {
       const OpenMesh::Vec3d p = mesh.point(vh);
@@ -88,7 +92,7 @@ double MeanReprojectionPx(const Dataset& dataset, const Dataset& truth,
   return sum / n;
 }
 
-// Synthesises a 4-view bunny at 48² (`lights`: synth's flags for the lighting) into DIR/ds, reads
+// Synthesises a 4-view bunny at 48² (`lights`: synth's flags for the lighting) into tmp/ds, reads
 // it as `truth`, and writes `dataset`: views 1–3 turned by 1° and shifted by 0.005 units.
 void PerturbedBunny(const testing::TempDir& tmp, const std::string& lights, Dataset* truth,
                     Dataset* dataset) {
