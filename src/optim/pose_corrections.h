@@ -14,7 +14,9 @@
 // with the camera and do not move relative to it. So ∂I/∂δ = Σ ∂I/∂x·∂x/∂δ over those parameters:
 // the renderer's rows (or adjoint gradient) of vertices, light positions, light directions and
 // environment rotations — edge terms included — contracted with the matrices above (PoseChain).
-// A camera-fixed probe would have to be turned with every pose change; it is not supported.
+// A fitted world-fixed environment (unknown lighting) takes a probe's route: its rotation
+// parameter, held at 0, carries the chain. A camera-fixed probe or fitted map would have to be
+// turned with every pose change; they are not supported.
 #ifndef SFT_OPTIM_POSE_CORRECTIONS_H_
 #define SFT_OPTIM_POSE_CORRECTIONS_H_
 

@@ -79,8 +79,10 @@ Status AddLightGeometry(const Dataset& dataset, const ReconstructOptions& option
 }
 
 // Environment rotations are parameters whenever an earlier fit turned a probe (`rotations` not
-// empty) or this fit refines them (starting at 0, the dataset's alignment). Only given probes
-// have an alignment to refine: a fitted environment's texels are the map in its own frame.
+// empty) or this fit refines them (starting at 0, the dataset's alignment), and whenever a pose fit
+// turns a world-fixed map relative to the camera (pose_corrections.h). Only given probes have an
+// alignment to refine: a fitted environment's texels are the map in its own frame, so its rotation
+// is held at 0 and serves the pose chain only (the texels would absorb any turn).
 Status AddEnvironmentRotations(const Dataset& dataset, const ReconstructOptions& options,
                                const std::vector<Eigen::Vector3d>& rotations,
                                SceneParameters* params) {
@@ -89,7 +91,6 @@ Status AddEnvironmentRotations(const Dataset& dataset, const ReconstructOptions&
     world_probe =
         world_probe || (light.type == LightType::kEnvironment && light.frame == LightFrame::kWorld);
   }
-  // A pose fit turns a world-fixed probe relative to the camera (pose_corrections.h).
   const bool needed = options.fit_environment_rotation || (options.fit_poses && world_probe);
   if (!needed && rotations.empty()) return Status::Ok();
   const size_t num_lights = dataset.lights.size();
@@ -97,16 +98,14 @@ Status AddEnvironmentRotations(const Dataset& dataset, const ReconstructOptions&
     return Status::Error("environment rotations: " + std::to_string(rotations.size()) +
                          " given, the dataset has " + std::to_string(num_lights) + " lights");
   }
-  if (FittedEnvironmentLight(dataset) >= 0 && !options.fit_environment_rotation &&
-      options.fit_poses) {
-    return Status::Error(
-        "fit_poses: the lighting is unknown (a fitted environment); refining poses under a "
-        "fitted environment is not supported yet");
-  }
-  if (FittedEnvironmentLight(dataset) >= 0) {
+  const int fitted = FittedEnvironmentLight(dataset);
+  if (fitted >= 0 && options.fit_environment_rotation) {
     return Status::Error(
         "fit_environment_rotation: the lighting is unknown (a fitted environment); only a given "
         "probe's alignment can be refined");
+  }
+  if (fitted >= 0 && !rotations.empty() && !rotations[fitted].isZero(0.0)) {
+    return Status::Error("environment rotations: the fitted environment's rotation must be 0");
   }
   bool any_probe = false;
   for (const LightSpec& light : dataset.lights) any_probe |= light.type == LightType::kEnvironment;
@@ -129,15 +128,15 @@ Status AddPoses(const Dataset& dataset, const ReconstructOptions& options,
   if (!any) return Status::Ok();
   for (const LightSpec& light : dataset.lights) {
     if (light.type == LightType::kEnvironment && light.frame == LightFrame::kCamera) {
+      if (light.id == kFittedEnvironmentId) {
+        return Status::Error(
+            "fit_poses: the fitted environment is camera-fixed (environment_frame camera); "
+            "refining poses under it is not supported");
+      }
       return Status::Error("fit_poses: light '" + light.id +
                            "' is a camera-fixed environment; refining poses under it is not "
                            "supported");
     }
-  }
-  if (FittedEnvironmentLight(dataset) >= 0) {
-    return Status::Error(
-        "fit_poses: the lighting is unknown (a fitted environment); refining poses under a "
-        "fitted environment is not supported yet");
   }
   params->AddPoses(static_cast<int>(views.size()));
   for (size_t k = 0; k < views.size(); ++k) {

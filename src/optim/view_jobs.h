@@ -137,7 +137,10 @@ class RotatedEnvironmentMaps {
 };
 
 // Makes dataset view `dataset_view`'s setup render with the fitted environment (the maps of the
-// state's texels) when its environment light is the one whose texels `layout` fits.
+// state's texels) when its environment light is the one whose texels `layout` fits. Called after
+// RotatedEnvironmentMaps::Use: a fitted map's rotation is held at 0 (a pose fit still needs its
+// parameter for the chain), so only the dataset's start map would be turned, and the fitted map
+// replaces it.
 void UseFittedEnvironment(const ParameterLayout& layout, const FittedEnvironmentMaps& fitted,
                           int dataset_view, ViewSetup* view);
 

@@ -222,9 +222,10 @@ TEST(PosesFileTest, RoundTripAndBadInput) {
               HasSubstr("views[0].translation: expected 3 finite numbers"));
 }
 
-// A pose fit under a camera-fixed probe, or under unknown lighting (a fitted environment), is
-// refused with one line naming the key.
-TEST(PoseFitTest, UnsupportedLightingIsRefused) {
+// A pose fit under a camera-fixed probe or a camera-fixed fitted environment is refused with one
+// line naming the key; under a world-fixed fitted environment (unknown lighting) it runs, with the
+// map's rotation a held parameter (0) for the chain. Refining that rotation is refused.
+TEST(PoseFitTest, LightingThatRidesWithTheCameraIsRefused) {
   testing::TempDir dir;
   Image probe(8, 4, 3, 1.f);
   ASSERT_TRUE(WriteExr(dir.Join("probe.exr"), probe).ok());
@@ -237,12 +238,27 @@ TEST(PoseFitTest, UnsupportedLightingIsRefused) {
   std::unique_ptr<Reconstruction> r;
   EXPECT_THAT(testing::RunLightFit(fit, {}, {}, &r),
               HasSubstr("fit_poses: light 'probe' is a camera-fixed environment"));
+
   ASSERT_EQ(testing::ReadLightFit(dir.Join("ds"), &fit), "");
   fit.options.fit_poses = true;
   testing::RemoveLights(&fit.dataset);
-  ASSERT_TRUE(AddFittedEnvironment(probe, LightFrame::kWorld, &fit.dataset).ok());
+  ASSERT_TRUE(AddFittedEnvironment(probe, LightFrame::kCamera, &fit.dataset).ok());
   EXPECT_THAT(testing::RunLightFit(fit, {}, {}, &r),
-              HasSubstr("fit_poses: the lighting is unknown"));
+              HasSubstr("fit_poses: the fitted environment is camera-fixed"));
+
+  ASSERT_EQ(testing::ReadLightFit(dir.Join("ds"), &fit), "");
+  testing::RemoveLights(&fit.dataset);
+  ASSERT_TRUE(AddFittedEnvironment(probe, LightFrame::kWorld, &fit.dataset).ok());
+  fit.options.fit_poses = true;
+  fit.options.outer_iterations = 1;
+  EXPECT_EQ(testing::RunLightFit(fit, {}, {}, &r), "");
+  ASSERT_NE(r, nullptr);
+  ASSERT_EQ(r->EnvironmentRotations().size(), 1u);
+  EXPECT_EQ(r->EnvironmentRotations()[0], Eigen::Vector3d::Zero());  // held: the chain's only.
+  EXPECT_EQ(r->EnvironmentTexels().width, 8);
+  fit.options.fit_environment_rotation = true;
+  EXPECT_THAT(testing::RunLightFit(fit, {}, {}, &r),
+              HasSubstr("fit_environment_rotation: the lighting is unknown"));
 }
 
 }  // namespace
