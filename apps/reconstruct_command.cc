@@ -51,6 +51,7 @@ struct ReconstructCommandOptions {
   std::vector<int> views;
   int holdout = 0;                // every K-th selected view is held out of the fit; 0 = off.
   std::string environment_frame;  // unknown lighting's fitted map: "world" or "camera".
+  std::string estimate_lights;    // unknown lighting: a lights file estimated beside the map.
   std::set<std::string> given;    // config keys whose flag was on the command line.
   std::string reference;          // ground-truth mesh: F1 and Chamfer after every outer iteration.
   double reference_tolerance = 0.005;  // F1 tolerance, fraction of the reference's diagonal.
@@ -78,7 +79,8 @@ Status FlagKeys(const ReconstructCommandOptions& cli, ScheduleConfig* config) {
                               {"views", cli.views},
                               {"effects", cli.effects},
                               {"holdout", cli.holdout},
-                              {"environment_frame", cli.environment_frame}};
+                              {"environment_frame", cli.environment_frame},
+                              {"estimate_lights", cli.estimate_lights}};
   for (const auto& [key, value] : all.items()) {
     if (cli.given.count(key) == 0) continue;
     const Status status = MergeScheduleConfig({{key, value}}, "flag", config);
@@ -86,6 +88,7 @@ Status FlagKeys(const ReconstructCommandOptions& cli, ScheduleConfig* config) {
       std::string message = status.message().substr(status.message().find(": ") + 2);
       if (message.rfind("outer_iterations", 0) == 0) message.replace(0, 16, "outer");
       if (message.rfind("environment_frame", 0) == 0) message.replace(0, 17, "environment-frame");
+      if (message.rfind("estimate_lights", 0) == 0) message.replace(0, 15, "estimate-lights");
       return Status::Error("--" + message);
     }
   }
@@ -113,11 +116,14 @@ Status ResumedStages(const ReconstructCommandOptions& cli, const RunState& state
                            "(only flat keys may change)");
     }
     if (overrides.environment_given) {
-      return Status::Error(cli.config + ": environment_stage/environment_size: a resumed run " +
-                           "keeps its stages and its fitted environment");
+      return Status::Error(cli.config + ": environment_stage/environment_size/estimate_lights: " +
+                           "a resumed run keeps its stages and its fitted lighting");
     }
   }
   SFT_RETURN_IF_ERROR(FlagKeys(cli, &overrides));
+  if (overrides.environment_given) {
+    return Status::Error("--estimate-lights: a resumed run keeps its fitted lighting");
+  }
   if (overrides.holdout_given && overrides.holdout != state.holdout) {
     return Status::Error("--holdout " + std::to_string(overrides.holdout) + ": the run in " +
                          cli.resume + " was started with --holdout " +
@@ -344,6 +350,13 @@ int RunReconstructMpi(const ReconstructCommandOptions& cli) {
   const BeforeStart before_start = [&](const std::string& path, const Dataset& dataset,
                                        const std::vector<StageOptions>& stages) {
     agreed = true;
+    // The workers read the dataset from its path and add the fitted map themselves; estimated
+    // lights are not sent to them.
+    if (FittedEnvironmentLight(dataset) >= 0 && dataset.views.front().lights.size() > 1) {
+      const Status refused =
+          Status::Error("--estimate-lights: not supported under mpirun yet (run on one machine)");
+      SFT_RETURN_IF_ERROR(MpiHandshake(*session, refused, path, 0, nullptr));
+    }
     SFT_RETURN_IF_ERROR(
         MpiHandshake(*session, Status::Ok(), path, FittedViews(dataset, stages), nullptr));
     g_terminating = false;
@@ -436,6 +449,11 @@ CommandRunner SetupReconstructCommand(CLI::App* app) {
                            "Unknown lighting: fit an environment fixed in the world (lights in "
                            "the room; default) or in the camera (lights riding with it)"),
            "environment_frame");
+  key_flag(app->add_option("--estimate-lights", opts->estimate_lights,
+                           "Unknown lighting: a lights file ({\"lights\": [...]}, scene.json's "
+                           "format) of point or directional lights whose place is roughly known, "
+                           "fitted beside the environment"),
+           "estimate_lights");
   app->add_option("--reference", opts->reference,
                   "Ground-truth mesh: F1 and Chamfer after every outer iteration (metrics.json)");
   app->add_option("--reference-tolerance", opts->reference_tolerance,

@@ -9,6 +9,7 @@
 #include "src/eval/view_scores.h"
 #include "src/image/image_io.h"
 #include "src/io/dataset.h"
+#include "src/io/lights_file.h"
 #include "src/io/scene_setup.h"
 
 namespace sft {

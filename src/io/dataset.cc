@@ -18,6 +18,7 @@
 #include "src/core/file_util.h"
 #include "src/image/image_io.h"
 #include "src/io/dataset_internal.h"
+#include "src/io/lights_file.h"
 
 namespace sft {
 namespace dataset_internal {

@@ -143,12 +143,7 @@ Status ReadDataset(const std::string& dir, Dataset* dataset);
 // the messages); ReadDataset reads DIR/scene.json and calls this. Touches no file.
 Status ParseSceneJson(std::string text, const std::string& dir, Dataset* dataset);
 
-// Reads a lights file (`sft eval --relight`, docs/cli.md): a JSON object whose "lights" array
-// (required, at least one light) holds lights in scene.json's format (docs/dataset.md), checked
-// by the same reader; errors name the file and the JSON path ("l.json: lights[0].intensity: must
-// be non-negative"). An environment light's `image` may be absolute or relative to the file's
-// folder (".." allowed); it is returned as an absolute path. Does not open the probes.
-Status ReadLightsFile(const std::string& file, std::vector<LightSpec>* lights);
+// Lights files (a "lights" array in scene.json's format): src/io/lights_file.h.
 
 // Renderers need every view's lighting: an error naming the first view whose `lights` list is empty
 // (unknown lighting, as importers write it; docs/dataset.md), else OK. Reading such a dataset is

@@ -7,6 +7,7 @@
 #include "src/core/file_util.h"
 #include "src/io/dataset.h"
 #include "src/io/dataset_internal.h"
+#include "src/io/lights_file.h"
 
 namespace sft {
 namespace {
@@ -40,9 +41,9 @@ ojson CamerasJson(const Dataset& dataset) {
   return cameras;
 }
 
-ojson LightsJson(const Dataset& dataset) {
+ojson LightsJson(const std::vector<LightSpec>& specs) {
   ojson lights = ojson::array();
-  for (const LightSpec& light : dataset.lights) {
+  for (const LightSpec& light : specs) {
     ojson entry;
     entry["id"] = light.id;
     if (light.type == LightType::kPoint) {
@@ -175,7 +176,7 @@ Status WriteSceneJson(const Dataset& dataset, const std::string& dir) {
     ojson root;
     root["format"] = dataset_internal::kFormatTag;
     root["cameras"] = CamerasJson(dataset);
-    root["lights"] = LightsJson(dataset);
+    root["lights"] = LightsJson(dataset.lights);
     ojson views;
     SFT_RETURN_IF_ERROR(ViewsJson(dataset, file, &views));
     root["views"] = std::move(views);
@@ -185,6 +186,17 @@ Status WriteSceneJson(const Dataset& dataset, const std::string& dir) {
     return WriteTextFile(file, root.dump(1, ' ', false, json::error_handler_t::replace) + "\n");
   } catch (const std::exception& e) {
     return Status::Error(file + ": cannot serialize scene (" +
+                         dataset_internal::StripJsonExceptionId(e.what()) + ")");
+  }
+}
+
+Status WriteLightsFile(const std::string& file, const std::vector<LightSpec>& lights) {
+  try {
+    ojson root;
+    root["lights"] = LightsJson(lights);
+    return WriteTextFile(file, root.dump(1, ' ', false, json::error_handler_t::replace) + "\n");
+  } catch (const std::exception& e) {
+    return Status::Error(file + ": cannot serialize lights (" +
                          dataset_internal::StripJsonExceptionId(e.what()) + ")");
   }
 }

@@ -8,6 +8,7 @@
 
 #include "src/core/file_util.h"
 #include "src/image/image_io.h"
+#include "src/io/lights_file.h"
 
 namespace sft {
 
@@ -19,6 +20,25 @@ bool EnvironmentEstimateOptions::Check(std::string* why) const {
   if (!(assumed_albedo > 0.0 && assumed_albedo <= 1.0)) {
     *why = "assumed_albedo: must be in (0, 1]";
     return false;
+  }
+  for (size_t k = 0; k < lights.size(); ++k) {
+    const std::string name =
+        "estimate_lights: lights[" + std::to_string(k) + "] (\"" + lights[k].id + "\")";
+    if (lights[k].type == LightType::kEnvironment) {
+      *why = name + ": an environment light; unknown lighting's map is the fitted environment " +
+             "(environment_size), so estimate point or directional lights beside it";
+      return false;
+    }
+    if (lights[k].id == kFittedEnvironmentId) {
+      *why = name + ": the id is the fitted environment's; choose another";
+      return false;
+    }
+    for (size_t j = 0; j < k; ++j) {
+      if (lights[j].id == lights[k].id) {
+        *why = name + ": the id is also lights[" + std::to_string(j) + "]'s";
+        return false;
+      }
+    }
   }
   return true;
 }
@@ -103,9 +123,8 @@ Status ReadFittedEnvironmentFrame(const std::string& run, LightFrame* frame) {
 }
 
 Status AddFittedEnvironment(const Image& texels, LightFrame frame, Dataset* dataset) {
-  if (!LightingUnknown(*dataset)) {
-    return Status::Error(
-        "a fitted environment replaces unknown lighting only: the dataset's views have lights");
+  if (FittedEnvironmentLight(*dataset) >= 0) {
+    return Status::Error("the dataset has a fitted environment already");
   }
   if (texels.width < 2 || texels.height < 1 || texels.channels < 3) {
     return Status::Error("fitted environment: needs at least 2 × 1 RGB texels");
@@ -118,10 +137,44 @@ Status AddFittedEnvironment(const Image& texels, LightFrame frame, Dataset* data
   const int index = static_cast<int>(dataset->lights.size());
   dataset->lights.push_back(std::move(light));
   for (ViewSpec& view : dataset->views) {
-    view.light_ids = {kFittedEnvironmentId};
-    view.lights = {index};
+    view.light_ids.push_back(kFittedEnvironmentId);
+    view.lights.push_back(index);
   }
   return Status::Ok();
+}
+
+Status AddEstimatedLights(const std::vector<LightSpec>& lights, Dataset* dataset) {
+  EnvironmentEstimateOptions options;
+  options.lights = lights;
+  std::string why;
+  if (!options.Check(&why)) return Status::Error(why);
+  for (const LightSpec& light : lights) {
+    for (const LightSpec& known : dataset->lights) {
+      if (known.id == light.id) {
+        return Status::Error("estimate_lights: light \"" + light.id +
+                             "\": the dataset has a light of that id; choose another");
+      }
+    }
+  }
+  for (const LightSpec& light : lights) {
+    const int index = static_cast<int>(dataset->lights.size());
+    dataset->lights.push_back(light);
+    for (ViewSpec& view : dataset->views) {
+      view.light_ids.push_back(light.id);
+      view.lights.push_back(index);
+    }
+  }
+  return Status::Ok();
+}
+
+Status WriteEstimatedLights(const std::string& run, const Dataset& dataset) {
+  std::vector<LightSpec> lights;
+  const int fitted = FittedEnvironmentLight(dataset);
+  for (size_t l = 0; l < dataset.lights.size(); ++l) {
+    if (static_cast<int>(l) != fitted) lights.push_back(dataset.lights[l]);
+  }
+  if (lights.empty()) return Status::Ok();
+  return WriteLightsFile(JoinPath(run, kEstimatedLightsFile), lights);
 }
 
 int FittedEnvironmentLight(const Dataset& dataset) {
@@ -133,10 +186,42 @@ int FittedEnvironmentLight(const Dataset& dataset) {
   return -1;
 }
 
+namespace {
+
+// The estimated lights of PrepareUnknownLighting: the run folder's when it has them, else
+// `given`; *names lists their ids for the console line ("" when none).
+Status EstimatedLightsToAdd(const std::string& run, const std::vector<LightSpec>& given,
+                            std::vector<LightSpec>* lights, std::string* names) {
+  *lights = given;
+  const std::string saved = run.empty() ? "" : JoinPath(run, kEstimatedLightsFile);
+  if (!saved.empty() && FileExists(saved)) SFT_RETURN_IF_ERROR(ReadLightsFile(saved, lights));
+  names->clear();
+  for (const LightSpec& light : *lights) {
+    *names += (names->empty() ? "" : ", ") + light.id;
+  }
+  return Status::Ok();
+}
+
+}  // namespace
+
 Status PrepareUnknownLighting(const std::string& run, const EnvironmentEstimateOptions& options,
                               Dataset* dataset, std::string* note) {
   note->clear();
-  if (!LightingUnknown(*dataset)) return Status::Ok();
+  if (!LightingUnknown(*dataset)) {
+    if (options.lights.empty()) return Status::Ok();
+    return Status::Error(
+        "estimate_lights: the dataset lists its lights (its lighting is known); estimated lights "
+        "join unknown lighting only (fit a dataset light's place with fit_light_positions or "
+        "fit_light_directions)");
+  }
+  std::vector<LightSpec> lights;
+  std::string names;
+  SFT_RETURN_IF_ERROR(EstimatedLightsToAdd(run, options.lights, &lights, &names));
+  SFT_RETURN_IF_ERROR(AddEstimatedLights(lights, dataset));
+  const std::string beside = lights.empty()
+                                 ? ""
+                                 : " and " + std::to_string(lights.size()) + " estimated light" +
+                                       (lights.size() == 1 ? "" : "s") + " (" + names + ")";
   Image texels;
   LightFrame frame = options.frame;
   const std::string saved = run.empty() ? "" : JoinPath(run, kFittedEnvironmentFile);
@@ -158,13 +243,13 @@ Status PrepareUnknownLighting(const std::string& run, const EnvironmentEstimateO
     }
     *note = std::string("lighting: unknown in the dataset; continuing the fitted ") +
             std::to_string(texels.width) + "×" + std::to_string(texels.height) + " " +
-            LightFrameName(frame) + "-fixed environment of " + saved;
+            LightFrameName(frame) + "-fixed environment of " + saved + beside;
   } else {
     SFT_RETURN_IF_ERROR(InitialEnvironment(*dataset, options, &texels));
     *note = std::string("lighting: unknown in the dataset (no view lists lights); fitting a ") +
             (frame == LightFrame::kCamera ? "camera-fixed " : "world-fixed ") +
-            std::to_string(texels.width) + "×" + std::to_string(texels.height) +
-            " environment with the material (albedo is then known up to one scale per channel)";
+            std::to_string(texels.width) + "×" + std::to_string(texels.height) + " environment" +
+            beside + " with the material (albedo is then known up to one scale per channel)";
   }
   return AddFittedEnvironment(texels, frame, dataset);
 }

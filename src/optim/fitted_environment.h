@@ -11,13 +11,19 @@
 // Albedo is therefore known up to one scale per channel: score it after the best per-channel
 // scale (`sft eval` does when the run estimated its lighting).
 //
+// Beside the map, point and directional lights of roughly known place (a lamp on a gantry, a
+// flash, the sun) can be estimated too (`estimate_lights`): they join every view's lights and the
+// environment stage fits their intensity and position or direction with the map.
+//
 // The map lives in memory as the dataset light kFittedEnvironmentId (LightSpec::pixels); the run
-// folder keeps it as kFittedEnvironmentFile.
+// folder keeps it as kFittedEnvironmentFile, and the estimated lights' start specs as
+// kEstimatedLightsFile (their fitted values are in lights.json, as for any dataset light).
 #ifndef SFT_OPTIM_FITTED_ENVIRONMENT_H_
 #define SFT_OPTIM_FITTED_ENVIRONMENT_H_
 
 #include <Eigen/Core>
 #include <string>
+#include <vector>
 
 #include "src/core/image.h"
 #include "src/core/status.h"
@@ -30,6 +36,8 @@ constexpr char kFittedEnvironmentFile[] = "environment.exr";
 // Beside it: {"format": "sft-fitted-environment/1", "frame": "world" | "camera"}. A run folder
 // without it (runs before camera-fixed maps) holds a world-fixed map.
 constexpr char kFittedEnvironmentInfoFile[] = "environment.json";
+// The estimated lights as they started, a lights file (ReadLightsFile); absent when there are none.
+constexpr char kEstimatedLightsFile[] = "estimated_lights.json";
 
 struct EnvironmentEstimateOptions {
   int width = 32;               // texels around the horizon (u), [2, 512].
@@ -39,6 +47,9 @@ struct EnvironmentEstimateOptions {
   // with the camera: a ring light, a lamp on the gantry's camera arm, a turntable capture; the
   // map's frame is then each view's camera frame, z-up in the env convention).
   LightFrame frame = LightFrame::kWorld;
+  // Point and directional lights estimated beside the map (scene.json's light format; ids unique,
+  // not kFittedEnvironmentId); empty = the map alone. Their specs are the fit's start.
+  std::vector<LightSpec> lights;
 
   bool Check(std::string* why) const;
 };
@@ -52,9 +63,18 @@ Status InitialEnvironment(const Dataset& dataset, const EnvironmentEstimateOptio
                           Image* texels);
 
 // Adds the light kFittedEnvironmentId with map `texels` (fixed in `frame`, whose axes are the
-// env frame's; scale 1) to `dataset` and makes it every view's only light. Refuses a dataset
-// whose views have lights.
+// env frame's; scale 1) to `dataset` and to every view's lights (after the estimated lights, when
+// AddEstimatedLights ran first). Refuses a dataset that has a fitted environment already.
 Status AddFittedEnvironment(const Image& texels, LightFrame frame, Dataset* dataset);
+
+// Adds estimated lights (EnvironmentEstimateOptions::lights) to `dataset` and to every view's
+// lights. Errors: a type other than point or directional, an id the dataset has already.
+Status AddEstimatedLights(const std::vector<LightSpec>& lights, Dataset* dataset);
+
+// Writes the estimated lights of `dataset` — every light but the fitted environment, when the
+// dataset has one — into run folder `run` as kEstimatedLightsFile; writes nothing when there are
+// none.
+Status WriteEstimatedLights(const std::string& run, const Dataset& dataset);
 
 // Writes the fitted map and its frame into run folder `run` (kFittedEnvironmentFile,
 // kFittedEnvironmentInfoFile).
@@ -70,10 +90,11 @@ const char* LightFrameName(LightFrame frame);
 int FittedEnvironmentLight(const Dataset& dataset);
 
 // What `sft reconstruct` does with a dataset before fitting it: when its lighting is unknown
-// (LightingUnknown), adds the fitted environment — the checkpoint's `run`/kFittedEnvironmentFile
-// in its recorded frame when `run` is a run folder holding one (--resume, sft eval), else
+// (LightingUnknown), adds the estimated lights — `run`/kEstimatedLightsFile when `run` is a run
+// folder holding one (--resume, sft eval), else options.lights — and then the fitted environment
+// — the checkpoint's `run`/kFittedEnvironmentFile in its recorded frame when `run` holds one, else
 // InitialEnvironment in options.frame — and sets *note to the one console line saying so;
-// otherwise changes nothing (*note empty). Errors name the file.
+// otherwise changes nothing (*note empty), and refuses options.lights. Errors name the file.
 Status PrepareUnknownLighting(const std::string& run, const EnvironmentEstimateOptions& options,
                               Dataset* dataset, std::string* note);
 

@@ -570,6 +570,7 @@ Status Schedule::Checkpoint() {
   if (!current_.environment.empty()) {
     const LightSpec& light = dataset_->lights.at(FittedEnvironmentLight(*dataset_));
     SFT_RETURN_IF_ERROR(WriteFittedEnvironment(out_, current_.environment, light.frame));
+    SFT_RETURN_IF_ERROR(WriteEstimatedLights(out_, *dataset_));
   }
   // Before state.json (the commit point): see src/optim/adam_checkpoint.h.
   if (reconstruction_ && !reconstruction_->adam_state().m.empty()) {

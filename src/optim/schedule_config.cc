@@ -7,6 +7,7 @@
 #include <map>
 
 #include "src/core/file_util.h"
+#include "src/io/lights_file.h"
 #include "src/optim/config.h"
 #include "src/optim/holdout.h"
 
@@ -278,6 +279,22 @@ Status MergeScheduleConfig(const json& config, const std::string& source, Schedu
       }
       out->environment = size;
       out->environment_given = true;
+    } else if (name == "estimate_lights") {
+      if (!value.is_string() || value.get<std::string>().empty()) {
+        return Status::Error(source + ": estimate_lights: expected the path of a lights file " +
+                             "({\"lights\": [...]} in scene.json's light format)");
+      }
+      const std::string file = value.get<std::string>();
+      EnvironmentEstimateOptions estimate = out->environment;
+      SFT_RETURN_IF_ERROR(
+          ReadLightsFile(file, &estimate.lights).Prefixed(source + ": estimate_lights"));
+      std::string why;
+      if (!estimate.Check(&why)) {  // why: "estimate_lights: lights[k] ...: ...".
+        return Status::Error(source + ": estimate_lights: " + file + ": " +
+                             why.substr(why.find(": ") + 2));
+      }
+      out->environment = estimate;
+      out->environment_given = true;
     } else if (name == "environment_stage") {
       if (value.is_boolean()) {
         out->environment_stage = value.get<bool>();
@@ -319,6 +336,12 @@ Status EnvironmentStage(const ScheduleConfig& config, const StageOptions& first,
   stage->fit.cache.pyramid_levels = first.fit.cache.pyramid_levels;
   SFT_RETURN_IF_ERROR(ApplyStageConfig(config.flat, "flat keys", stage));
   SFT_RETURN_IF_ERROR(ApplyStageConfig(json::parse(kEnvironmentStageRole), where, stage));
+  // Estimated lights are lighting too: the stage fits their intensity and place with the map.
+  for (const LightSpec& light : config.environment.lights) {
+    stage->fit.fit_lights = true;
+    if (light.type == LightType::kPoint) stage->fit.fit_light_positions = true;
+    if (light.type == LightType::kDirectional) stage->fit.fit_light_directions = true;
+  }
   SFT_RETURN_IF_ERROR(ApplyStageConfig(config.environment_stage_keys, where, stage));
   std::string why;
   if (!stage->Check(&why)) return Status::Error(where + ": " + why);

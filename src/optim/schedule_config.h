@@ -7,7 +7,9 @@
 //   - "holdout": K, every K-th selected view is kept out of the fit (src/optim/holdout.h);
 //   - "environment_frame": "world" or "camera", where unknown lighting's fitted map is fixed.
 //   - "environment_size": [W, H] and "environment_stage": unknown lighting's fitted map and the
-//     automatic first stage that fits it alone (src/optim/fitted_environment.h).
+//     automatic first stage that fits it alone (src/optim/fitted_environment.h);
+//   - "estimate_lights": the path of a lights file whose point and directional lights unknown
+//     lighting estimates beside the map (read when the config is merged; errors name that file).
 // A stage object holds any flat key plus "name", and the stage-only keys "texel_resolution",
 // "remesh", "remesh_edge_pixels", "resample", "resample_fold_fraction", "material_model" and
 // "texture_size" (the effect planner's keys, "effects": "auto" and "pin", are flat keys: config.h).
@@ -32,15 +34,18 @@ struct ScheduleConfig {
   nlohmann::json flat = nlohmann::json::object();  // keys that override every stage.
   int holdout = 0;             // "holdout": every K-th selected view held out; 0 = off, K >= 2.
   bool holdout_given = false;  // "holdout" was given (a resumed run must not change it).
-  // Unknown lighting: the fitted map's size ("environment_size": [W, H]) and the frame it is
-  // fixed in ("environment_frame": "world" or "camera"; src/optim/fitted_environment.h).
+  // Unknown lighting: the fitted map's size ("environment_size": [W, H]), the frame it is fixed
+  // in ("environment_frame": "world" or "camera") and the lights estimated beside it
+  // ("estimate_lights": the path of a lights file; src/optim/fitted_environment.h).
   EnvironmentEstimateOptions environment;
   bool environment_frame_given = false;  // "environment_frame" given (a resume must not change it).
   // "environment_stage": false = no automatic environment stage; an object = stage keys over
   // the built-in stage's (EnvironmentStage).
   bool environment_stage = true;
   nlohmann::json environment_stage_keys = nlohmann::json::object();
-  bool environment_given = false;  // either key was given (a resumed run keeps its map and stages).
+  // environment_size, environment_stage or estimate_lights was given (a resumed run keeps its
+  // map, its lights and its stages).
+  bool environment_given = false;
 };
 
 // Adds `config`'s keys to *out (later calls override earlier ones key by key; "stages" and
@@ -59,7 +64,8 @@ Status ResolveStages(const ScheduleConfig& config, bool carved_start,
 // lighting"): "environment", a texture stage that fits the environment map alone with the
 // material held as it starts (LM), at the image scale and pyramid levels of `first`, the list's
 // first stage. Its keys: the built-in ones and first's scale < the flat keys < its role
-// (phases texture, fit_albedo/fit_roughness/fit_specular false, fit_environment true) <
+// (phases texture, fit_albedo/fit_roughness/fit_specular false, fit_environment true; with
+// estimated lights also fit_lights and fit_light_positions or fit_light_directions) <
 // config.environment_stage_keys.
 Status EnvironmentStage(const ScheduleConfig& config, const StageOptions& first,
                         StageOptions* stage);

@@ -10,6 +10,8 @@
 
 #include "src/core/image.h"
 #include "src/image/image_io.h"
+#include "src/io/dataset.h"
+#include "src/io/lights_file.h"
 #include "tests/testing/synth_dataset.h"
 #include "tests/testing/temp_dir.h"
 
@@ -244,6 +246,72 @@ TEST(ReconstructCliTest, UnknownLightingStartsWithTheEnvironmentStage) {
   ASSERT_TRUE(eval["environment"].is_object()) << eval.dump(1);
   EXPECT_GT(eval["environment"]["irradiance_rel_rmse"].get<double>(), 0.0);
   EXPECT_EQ(eval["environment"]["width"], 32);
+}
+
+// A lamp estimated beside the fitted map (--estimate-lights): the run keeps the lamp's start in
+// estimated_lights.json and its fitted place in lights.json, sft eval renders with both, a resume
+// refuses new lights, and bad lights files or known lighting are one line with no output folder.
+TEST(ReconstructCliTest, EstimatedLampBesideTheFittedEnvironment) {
+  testing::TempDir tmp;
+  ASSERT_EQ(testing::SynthIcosphere(tmp.Join("ds"), "--cameras 3 --zooms 1 --res 12 --spp 4"), "");
+  const std::string known = "reconstruct --quiet --dataset " + tmp.Join("ds") + " --init " +
+                            tmp.Join("ds/gt/mesh.ply") + " --outer 1 --steps 1 --spp 2";
+  nlohmann::json scene = nlohmann::json::parse(testing::ReadTestFile(tmp.Join("ds/scene.json")));
+  scene["lights"] = nlohmann::json::array();
+  for (nlohmann::json& view : scene["views"]) view["lights"] = nlohmann::json::array();
+  testing::WriteTestFile(tmp.Join("ds/scene.json"), scene.dump(1));
+  testing::WriteTestFile(tmp.Join("lamp.json"), R"({"lights": [{"id": "lamp", "type": "point",
+      "frame": "camera", "position": [0.2, -0.1, 0], "intensity": [0.5, 0.5, 0.5]}]})");
+  const std::string base = known + " --estimate-lights " + tmp.Join("lamp.json");
+  std::string out;
+  ASSERT_EQ(RunSft(base + " --print-schedule", &out), 0) << out;
+  EXPECT_LT(out.find("environment"), out.find("refine")) << out;
+  ASSERT_EQ(RunSft(base + " --no-report --out " + tmp.Join("o"), &out), 0) << out;
+  std::vector<LightSpec> start;
+  ASSERT_TRUE(ReadLightsFile(tmp.Join("o/estimated_lights.json"), &start).ok());
+  ASSERT_EQ(start.size(), 1u);
+  EXPECT_EQ(start[0].frame, LightFrame::kCamera);
+  EXPECT_EQ(start[0].position, Eigen::Vector3d(0.2, -0.1, 0));
+  const nlohmann::json lights =
+      nlohmann::json::parse(testing::ReadTestFile(tmp.Join("o/lights.json")));
+  ASSERT_EQ(lights["lights"].size(), 2u) << lights.dump(1);
+  EXPECT_EQ(lights["lights"][0]["id"], "lamp");
+  EXPECT_EQ(lights["lights"][0]["frame"], "camera");
+  EXPECT_EQ(lights["lights"][0]["position"].size(), 3u) << "the environment stage fits its place";
+  ASSERT_EQ(RunSft("eval --dataset " + tmp.Join("ds") + " --reconstruction " + tmp.Join("o") +
+                       " --spp 2 --json " + tmp.Join("eval.json"),
+                   &out),
+            0)
+      << out;
+  EXPECT_EQ(RunSft("reconstruct --quiet --resume " + tmp.Join("o") + " --estimate-lights " +
+                       tmp.Join("lamp.json"),
+                   &out),
+            1);
+  EXPECT_THAT(out, HasSubstr("--estimate-lights: a resumed run keeps its fitted lighting"));
+  EXPECT_EQ(CountLines(out), 1) << out;
+  ASSERT_EQ(
+      RunSft("reconstruct --quiet --no-report --resume " + tmp.Join("o") + " --outer 2", &out), 0)
+      << out;
+
+  testing::WriteTestFile(tmp.Join("probe.json"), R"({"lights": [{"id": "room",
+      "type": "environment", "image": "room.exr"}]})");
+  EXPECT_EQ(
+      RunSft(known + " --out " + tmp.Join("p") + " --estimate-lights " + tmp.Join("probe.json"),
+             &out),
+      1);
+  EXPECT_THAT(out, HasSubstr("--estimate-lights: " + tmp.Join("probe.json") +
+                             ": lights[0] (\"room\"): an environment light"));
+  EXPECT_EQ(CountLines(out), 1) << out;
+  EXPECT_FALSE(fs::exists(tmp.Join("p")));
+  ASSERT_EQ(testing::SynthIcosphere(tmp.Join("lit"), "--cameras 1 --zooms 1 --res 8 --spp 2"), "");
+  EXPECT_EQ(RunSft("reconstruct --quiet --dataset " + tmp.Join("lit") + " --init " +
+                       tmp.Join("lit/gt/mesh.ply") + " --out " + tmp.Join("q") +
+                       " --estimate-lights " + tmp.Join("lamp.json"),
+                   &out),
+            1);
+  EXPECT_THAT(out, HasSubstr("estimate_lights: the dataset lists its lights"));
+  EXPECT_EQ(CountLines(out), 1) << out;
+  EXPECT_FALSE(fs::exists(tmp.Join("q")));
 }
 
 TEST(ReconstructCliTest, BadInputIsOneLine) {
