@@ -674,8 +674,8 @@ Status CheckViewsHaveLights(const Dataset& dataset) {
       return Status::Error(ScenePath(dataset) + ": " + IndexPath("views", i) +
                            ".lights: empty (unknown lighting" +
                            (dataset.lighting.empty() ? "" : ": \"" + dataset.lighting + "\"") +
-                           "); rendering needs every view's lights (estimating unknown lighting "
-                           "is not supported yet)");
+                           "); rendering needs every view's lights (sft reconstruct estimates "
+                           "unknown lighting, and sft eval renders a run's fitted lighting)");
     }
   }
   return Status::Ok();
