@@ -350,15 +350,10 @@ int RunReconstructMpi(const ReconstructCommandOptions& cli) {
   const BeforeStart before_start = [&](const std::string& path, const Dataset& dataset,
                                        const std::vector<StageOptions>& stages) {
     agreed = true;
-    // The workers read the dataset from its path and add the fitted map themselves; estimated
-    // lights are not sent to them.
-    if (FittedEnvironmentLight(dataset) >= 0 && dataset.views.front().lights.size() > 1) {
-      const Status refused =
-          Status::Error("--estimate-lights: not supported under mpirun yet (run on one machine)");
-      SFT_RETURN_IF_ERROR(MpiHandshake(*session, refused, path, 0, nullptr));
-    }
-    SFT_RETURN_IF_ERROR(
-        MpiHandshake(*session, Status::Ok(), path, FittedViews(dataset, stages), nullptr));
+    // The workers read the dataset from its path and add the estimated lights sent here; the
+    // fitted map comes with the first state.
+    SFT_RETURN_IF_ERROR(MpiHandshake(*session, Status::Ok(), path, FittedViews(dataset, stages),
+                                     nullptr, EstimatedLights(dataset)));
     g_terminating = false;
     std::signal(SIGTERM, OnTerminate);  // from now on a SIGTERM stops the run as a fault.
     runner = std::make_unique<MpiViewRunner>(*session, cli.mpi_timeout, &g_terminating);

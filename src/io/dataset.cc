@@ -639,33 +639,38 @@ Status ParseSceneJson(std::string text, const std::string& dir, Dataset* dataset
   }
 }
 
-Status ReadLightsFile(const std::string& file, std::vector<LightSpec>* lights) {
-  std::string text;
-  SFT_RETURN_IF_ERROR(ReadTextFile(file, &text));
+Status ParseLightsFileText(std::string text, const std::string& source,
+                           std::vector<LightSpec>* lights) {
   StripUtf8Bom(&text);
   try {
     json root;
     try {
       root = json::parse(text);
     } catch (const json::exception& e) {
-      return Status::Error(file + ": invalid JSON: " + StripJsonExceptionId(e.what()));
+      return Status::Error(source + ": invalid JSON: " + StripJsonExceptionId(e.what()));
     }
-    SceneParser parser(file);
+    SceneParser parser(source);
     parser.AllowAnyPath();
-    std::vector<LightSpec> result;
-    SFT_RETURN_IF_ERROR(parser.ParseLightsOnly(root, &result));
-    const std::string folder = std::filesystem::path(file).parent_path().string();
-    for (LightSpec& light : result) {
-      // Absolute, so that the light can join any dataset (LoadProbe joins onto its root).
-      if (light.type == LightType::kEnvironment) {
-        light.image = std::filesystem::absolute(JoinPath(folder, light.image)).string();
-      }
-    }
-    *lights = std::move(result);
-    return Status::Ok();
+    return parser.ParseLightsOnly(root, lights);
   } catch (const std::exception& e) {
-    return Status::Error(file + ": " + StripJsonExceptionId(e.what()));
+    return Status::Error(source + ": " + StripJsonExceptionId(e.what()));
   }
+}
+
+Status ReadLightsFile(const std::string& file, std::vector<LightSpec>* lights) {
+  std::string text;
+  SFT_RETURN_IF_ERROR(ReadTextFile(file, &text));
+  std::vector<LightSpec> result;
+  SFT_RETURN_IF_ERROR(ParseLightsFileText(std::move(text), file, &result));
+  const std::string folder = std::filesystem::path(file).parent_path().string();
+  for (LightSpec& light : result) {
+    // Absolute, so that the light can join any dataset (LoadProbe joins onto its root).
+    if (light.type == LightType::kEnvironment) {
+      light.image = std::filesystem::absolute(JoinPath(folder, light.image)).string();
+    }
+  }
+  *lights = std::move(result);
+  return Status::Ok();
 }
 
 Status CheckViewsHaveLights(const Dataset& dataset) {

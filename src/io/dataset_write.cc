@@ -190,15 +190,22 @@ Status WriteSceneJson(const Dataset& dataset, const std::string& dir) {
   }
 }
 
-Status WriteLightsFile(const std::string& file, const std::vector<LightSpec>& lights) {
+Status LightsFileText(const std::vector<LightSpec>& lights, std::string* text) {
   try {
     ojson root;
     root["lights"] = LightsJson(lights);
-    return WriteTextFile(file, root.dump(1, ' ', false, json::error_handler_t::replace) + "\n");
+    *text = root.dump(1, ' ', false, json::error_handler_t::replace) + "\n";
+    return Status::Ok();
   } catch (const std::exception& e) {
-    return Status::Error(file + ": cannot serialize lights (" +
+    return Status::Error("cannot serialize lights (" +
                          dataset_internal::StripJsonExceptionId(e.what()) + ")");
   }
+}
+
+Status WriteLightsFile(const std::string& file, const std::vector<LightSpec>& lights) {
+  std::string text;
+  SFT_RETURN_IF_ERROR(LightsFileText(lights, &text).Prefixed(file));
+  return WriteTextFile(file, text);
 }
 
 }  // namespace sft

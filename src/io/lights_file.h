@@ -24,6 +24,12 @@ Status ReadLightsFile(const std::string& file, std::vector<LightSpec>* lights);
 // written as stored.
 Status WriteLightsFile(const std::string& file, const std::vector<LightSpec>& lights);
 
+// The same in memory (an MPI handshake sends lights this way): the file's text, and its parse
+// (errors prefixed by `source`; probe paths kept as written).
+Status LightsFileText(const std::vector<LightSpec>& lights, std::string* text);
+Status ParseLightsFileText(std::string text, const std::string& source,
+                           std::vector<LightSpec>* lights);
+
 }  // namespace sft
 
 #endif  // SFT_IO_LIGHTS_FILE_H_

@@ -167,12 +167,19 @@ Status AddEstimatedLights(const std::vector<LightSpec>& lights, Dataset* dataset
   return Status::Ok();
 }
 
-Status WriteEstimatedLights(const std::string& run, const Dataset& dataset) {
+std::vector<LightSpec> EstimatedLights(const Dataset& dataset) {
+  // Every view lists them (the dataset's own lights, if it defines any, no view lists).
   std::vector<LightSpec> lights;
   const int fitted = FittedEnvironmentLight(dataset);
-  for (size_t l = 0; l < dataset.lights.size(); ++l) {
-    if (static_cast<int>(l) != fitted) lights.push_back(dataset.lights[l]);
+  if (fitted < 0 || dataset.views.empty()) return lights;
+  for (int l : dataset.views.front().lights) {
+    if (l != fitted) lights.push_back(dataset.lights.at(l));
   }
+  return lights;
+}
+
+Status WriteEstimatedLights(const std::string& run, const Dataset& dataset) {
+  const std::vector<LightSpec> lights = EstimatedLights(dataset);
   if (lights.empty()) return Status::Ok();
   return WriteLightsFile(JoinPath(run, kEstimatedLightsFile), lights);
 }

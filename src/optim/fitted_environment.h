@@ -71,9 +71,12 @@ Status AddFittedEnvironment(const Image& texels, LightFrame frame, Dataset* data
 // lights. Errors: a type other than point or directional, an id the dataset has already.
 Status AddEstimatedLights(const std::vector<LightSpec>& lights, Dataset* dataset);
 
-// Writes the estimated lights of `dataset` — every light but the fitted environment, when the
-// dataset has one — into run folder `run` as kEstimatedLightsFile; writes nothing when there are
-// none.
+// The estimated lights of a dataset PrepareUnknownLighting prepared: the lights its views list
+// beside the fitted environment (empty when it has none).
+std::vector<LightSpec> EstimatedLights(const Dataset& dataset);
+
+// Writes EstimatedLights(dataset) into run folder `run` as kEstimatedLightsFile; writes nothing
+// when there are none.
 Status WriteEstimatedLights(const std::string& run, const Dataset& dataset);
 
 // Writes the fitted map and its frame into run folder `run` (kFittedEnvironmentFile,

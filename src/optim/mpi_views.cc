@@ -22,6 +22,8 @@
 #include <unistd.h>
 #endif
 
+#include "src/io/lights_file.h"
+#include "src/optim/fitted_environment.h"
 #include "src/optim/mpi_wire.h"
 #include "src/optim/state_renderer.h"
 
@@ -60,7 +62,8 @@ Status MpiSession::Start(std::unique_ptr<MpiSession>*) {
 MpiSession::~MpiSession() = default;
 int MpiSession::DeadRank() const { return -1; }
 void MpiSession::Abort(int code) const { std::_Exit(code); }
-Status MpiHandshake(const MpiSession&, const Status& own, const std::string&, int, Dataset*) {
+Status MpiHandshake(const MpiSession&, const Status& own, const std::string&, int, Dataset*,
+                    const std::vector<LightSpec>&) {
   return own;
 }
 MpiViewRunner::MpiViewRunner(const MpiSession& session, double, const std::atomic<bool>*)
@@ -278,22 +281,35 @@ void MpiSession::Abort(int code) const {
 MpiSession::~MpiSession() { MPI_Finalize(); }
 
 Status MpiHandshake(const MpiSession& session, const Status& own, const std::string& dataset_path,
-                    int fitted_views, Dataset* dataset) {
-  // 1. Rank 0's status and the path.
+                    int fitted_views, Dataset* dataset,
+                    const std::vector<LightSpec>& estimated_lights) {
+  // 1. Rank 0's status, the path and the estimated lights.
+  std::string lights;
+  Status mine = own;
+  if (mine.ok() && !estimated_lights.empty()) {
+    mine = LightsFileText(estimated_lights, &lights).Prefixed("estimated lights");
+  }
   // Non-blocking: workers wait here without spinning while rank 0 prepares (e.g. carves a hull).
-  int64_t go = own.ok() ? 1 : 0;
+  int64_t go = mine.ok() ? 1 : 0;
   std::vector<MPI_Request> request(1);
   MPI_Ibcast(&go, 1, MPI_INT64_T, 0, MPI_COMM_WORLD, &request[0]);
   WaitIdle(&request);
   if (!go) {
-    return session.rank() == 0 ? own : Status::Error("rank 0 stopped before the run");
+    return session.rank() == 0 ? mine : Status::Error("rank 0 stopped before the run");
   }
   std::string path = dataset_path;
   BroadcastString(&path);
-  // 2. The workers load the dataset and its view setups (environment maps, memory check).
+  BroadcastString(&lights);
+  // 2. The workers load the dataset, add the estimated lights as rank 0 did (before the fitted
+  // map, which the first state brings), and set up the views (environment maps, memory check).
   std::string error;
   if (session.rank() != 0) {
     Status status = ReadDataset(path, dataset);
+    std::vector<LightSpec> added;
+    if (status.ok() && !lights.empty()) {
+      status = ParseLightsFileText(lights, "rank 0's estimated lights", &added);
+    }
+    if (status.ok()) status = AddEstimatedLights(added, dataset);
     DatasetViews views;
     if (status.ok()) status = MakeDatasetViews(*dataset, &views);
     if (!status.ok()) error = status.message();

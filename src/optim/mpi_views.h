@@ -89,11 +89,13 @@ class MpiSession {
 
 // The ranks' agreement before a run; every rank calls it once. Rank 0 passes `own` (its status
 // so far: an error stops every rank), the dataset path its workers load and the smallest number of
-// views any stage fits (more ranks than that is an error). Workers read the dataset from that
-// path into *dataset and report. Every rank returns the same verdict: OK, or one error line
-// naming the rank and its reason ("rank 1: ...").
+// views any stage fits (more ranks than that is an error), and the lights it estimates beside
+// unknown lighting (EstimatedLights of src/optim/fitted_environment.h). Workers read the dataset
+// from that path into *dataset, add those lights as rank 0 did, and report. Every rank returns
+// the same verdict: OK, or one error line naming the rank and its reason ("rank 1: ...").
 Status MpiHandshake(const MpiSession& session, const Status& own, const std::string& dataset_path,
-                    int fitted_views, Dataset* dataset);
+                    int fitted_views, Dataset* dataset,
+                    const std::vector<LightSpec>& estimated_lights = {});
 
 // Rank 0's ViewRunner. Stop() (or the destructor) releases the workers.
 //

@@ -130,6 +130,19 @@ TEST_F(ReconstructMpiTest, FittedEnvironmentIsBitIdenticalOnTwoRanks) {
   EXPECT_TRUE(fs::exists(tmp_.Join("ds_unlit_adam2/environment.exr")));
 }
 
+// A lamp estimated beside the fitted map (--estimate-lights): rank 0 sends it in the handshake,
+// rank 1 adds it before the map as rank 0 did, and the fitted lamp (lights.json) is one of the
+// identical files.
+TEST_F(ReconstructMpiTest, EstimatedLampIsBitIdenticalOnTwoRanks) {
+  MakeUnlitDataset();
+  testing::WriteTestFile(tmp_.Join("lamp.json"), R"({"lights": [{"id": "lamp", "type": "point",
+      "frame": "world", "position": [0.8, -0.6, 1.0], "intensity": [2, 2, 2]}]})");
+  ExpectSameAcrossRanks("lm", "ds_unlit", "--estimate-lights " + tmp_.Join("lamp.json"), "_lamp");
+  const std::string lights = testing::ReadTestFile(tmp_.Join("ds_unlit_lm_lamp2/lights.json"));
+  EXPECT_NE(lights.find("\"lamp\""), std::string::npos) << lights;
+  EXPECT_TRUE(fs::exists(tmp_.Join("ds_unlit_lm_lamp2/estimated_lights.json")));
+}
+
 // A camera-fixed fitted map (--environment-frame camera): every view turns it with its camera, on
 // whichever rank renders the view, and the run records its frame.
 TEST_F(ReconstructMpiTest, CameraFixedEnvironmentIsBitIdenticalOnTwoRanks) {
