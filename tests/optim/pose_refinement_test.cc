@@ -259,6 +259,13 @@ TEST(PoseFitTest, LightingThatRidesWithTheCameraIsRefused) {
   fit.options.fit_environment_rotation = true;
   EXPECT_THAT(testing::RunLightFit(fit, {}, {}, &r),
               HasSubstr("fit_environment_rotation: the lighting is unknown"));
+  // A saved state that turns the fitted map (a hand-edited or foreign checkpoint) is refused.
+  fit.options.fit_environment_rotation = false;
+  const Status turned =
+      Reconstruction::Create(fit.dataset, fit.mesh, fit.material, {}, fit.options, &r, {}, Image(),
+                             {}, {}, {Eigen::Vector3d(0.01, 0.0, 0.0)});
+  EXPECT_THAT(turned.message(),
+              HasSubstr("environment rotations: the fitted environment's rotation must be 0"));
 }
 
 }  // namespace
