@@ -120,10 +120,10 @@ Status ResumedStages(const ReconstructCommandOptions& cli, const RunState& state
                            "a resumed run keeps its stages and its fitted lighting");
     }
   }
-  SFT_RETURN_IF_ERROR(FlagKeys(cli, &overrides));
-  if (overrides.environment_given) {
+  if (cli.given.count("estimate_lights") > 0) {
     return Status::Error("--estimate-lights: a resumed run keeps its fitted lighting");
   }
+  SFT_RETURN_IF_ERROR(FlagKeys(cli, &overrides));
   if (overrides.holdout_given && overrides.holdout != state.holdout) {
     return Status::Error("--holdout " + std::to_string(overrides.holdout) + ": the run in " +
                          cli.resume + " was started with --holdout " +

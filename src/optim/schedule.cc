@@ -128,6 +128,8 @@ Status Schedule::Start(const Dataset& dataset, const std::string& out,
   SFT_RETURN_IF_ERROR(MakeDirectories(out));
   SFT_RETURN_IF_ERROR(WriteMesh(JoinPath(out, "initial_mesh.ply"), start.mesh));
   SFT_RETURN_IF_ERROR(WriteMesh(JoinPath(out, kBaselineMesh), start.mesh));
+  // Their start, once: the fitted values go to lights.json with every checkpoint.
+  SFT_RETURN_IF_ERROR(WriteEstimatedLights(out, dataset));
   *schedule = std::move(s);
   return Status::Ok();
 }
@@ -570,7 +572,6 @@ Status Schedule::Checkpoint() {
   if (!current_.environment.empty()) {
     const LightSpec& light = dataset_->lights.at(FittedEnvironmentLight(*dataset_));
     SFT_RETURN_IF_ERROR(WriteFittedEnvironment(out_, current_.environment, light.frame));
-    SFT_RETURN_IF_ERROR(WriteEstimatedLights(out_, *dataset_));
   }
   // Before state.json (the commit point): see src/optim/adam_checkpoint.h.
   if (reconstruction_ && !reconstruction_->adam_state().m.empty()) {

@@ -130,7 +130,7 @@ TEST(EstimatedLightsConfigTest, PreparationAndRunFolder) {
     EXPECT_EQ(view.lights, std::vector<int>({0, 1}));
     EXPECT_EQ(view.light_ids, std::vector<std::string>({"lamp", kFittedEnvironmentId}));
   }
-  // A checkpoint writes the lights as they started; a run folder gives them back.
+  // The run writes the lights as they started (Schedule::Start); a run folder gives them back.
   ASSERT_TRUE(MakeDirectories(tmp.Join("run")).ok());
   ASSERT_TRUE(WriteEstimatedLights(tmp.Join("run"), dataset).ok());
   ASSERT_TRUE(
@@ -145,7 +145,7 @@ TEST(EstimatedLightsConfigTest, PreparationAndRunFolder) {
   EXPECT_EQ(resumed.lights[0].position, kTrueLamp);
   EXPECT_EQ(resumed.lights[0].intensity, Eigen::Vector3d::Constant(6.0));
   EXPECT_EQ(resumed.views[1].lights, std::vector<int>({0, 1}));
-  // Without estimated lights a checkpoint writes no file.
+  // Without estimated lights no file is written.
   Dataset plain = known;
   testing::RemoveLights(&plain);
   ASSERT_TRUE(PrepareUnknownLighting("", EnvironmentEstimateOptions(), &plain, &note).ok());
