@@ -239,11 +239,10 @@ ViewSetup RenderCache::ScaledView(int v) const {
   ViewSetup view =
       ScaledViewSetup(*views_, view_indices_[v], options_.image_scale_log2, params_->LightScales(),
                       params_->LightPositions(), params_->LightDirections());
-  // The turned maps are the dataset's; a fitted map replaces its light's after them (its rotation
-  // is held at 0, so the Jacobian Use set stays right).
-  rotated_environments_.Use(view_indices_[v], &view);
-  UseFittedEnvironment(params_->layout(), fitted_environment_, view_indices_[v], &view);
-  if (params_->num_pose_views() > 0) ApplyPoseCorrection(params_->Pose(v), &view);
+  const PoseDelta pose = params_->num_pose_views() > 0 ? params_->Pose(v) : PoseDelta::Zero();
+  UseFittedLightingAndPose(rotated_environments_, params_->layout(), fitted_environment_,
+                           view_indices_[v], params_->num_pose_views() > 0 ? &pose : nullptr,
+                           &view);
   return view;
 }
 

@@ -51,9 +51,9 @@ void StateRenderer::Render(const RenderState& state, const ViewJob& job, ViewRes
   ViewSetup view =
       ScaledViewSetup(views_, state.view_indices[job.view], state.image_scale_log2,
                       state.light_scales, state.light_positions, state.light_directions);
-  rotated_environments_.Use(state.view_indices[job.view], &view);  // before the fitted map.
-  UseFittedEnvironment(state.layout, fitted_environment_, state.view_indices[job.view], &view);
-  if (!state.pose_corrections.empty()) ApplyPoseCorrection(state.pose_corrections[job.view], &view);
+  UseFittedLightingAndPose(
+      rotated_environments_, state.layout, fitted_environment_, state.view_indices[job.view],
+      state.pose_corrections.empty() ? nullptr : &state.pose_corrections[job.view], &view);
   RenderViewJob(*scene_, state.material, view, state.render, state.request, state.layout, job,
                 result);
 }

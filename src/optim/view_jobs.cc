@@ -109,11 +109,14 @@ const EnvironmentMap* FittedEnvironmentMaps::ForView(int dataset_view) const {
   return maps_[dataset_view].get();
 }
 
-void UseFittedEnvironment(const ParameterLayout& layout, const FittedEnvironmentMaps& fitted,
-                          int dataset_view, ViewSetup* view) {
+void UseFittedLightingAndPose(const RotatedEnvironmentMaps& rotated, const ParameterLayout& layout,
+                              const FittedEnvironmentMaps& fitted, int dataset_view,
+                              const PoseDelta* pose, ViewSetup* view) {
+  rotated.Use(dataset_view, view);
   if (layout.FitsEnvironment(view->environment_light_index)) {
     view->environment = fitted.ForView(dataset_view);
   }
+  if (pose != nullptr) ApplyPoseCorrection(*pose, view);
 }
 
 void RenderViewJob(const RenderScene& scene, const Material& material, const ViewSetup& view,

@@ -136,17 +136,20 @@ class RotatedEnvironmentMaps {
   std::vector<Eigen::Matrix3d> jacobians_;
 };
 
-// Makes dataset view `dataset_view`'s setup render with the fitted environment (the maps of the
-// state's texels) when its environment light is the one whose texels `layout` fits. Called after
-// RotatedEnvironmentMaps::Use: a fitted map's rotation is held at 0 (a pose fit still needs its
-// parameter for the chain), so only the dataset's start map would be turned, and the fitted map
-// replaces it.
-void UseFittedEnvironment(const ParameterLayout& layout, const FittedEnvironmentMaps& fitted,
-                          int dataset_view, ViewSetup* view);
+// Makes dataset view `dataset_view`'s setup (its ScaledViewSetup, with the fitted light scales and
+// places) render as the fit's state does, in the one order that is right:
+//   1. the dataset's probes turned by their fitted rotations (`rotated`);
+//   2. the fitted environment (the maps of the state's texels) in place of its light's map, when
+//      `layout` fits that light: a fitted map's rotation is held at 0 (a pose fit still needs its
+//      parameter for the chain), so step 1 only turned the start map, which this replaces;
+//   3. the view's pose correction (`pose`; null: none), which moves the camera of the lit scene.
+void UseFittedLightingAndPose(const RotatedEnvironmentMaps& rotated, const ParameterLayout& layout,
+                              const FittedEnvironmentMaps& fitted, int dataset_view,
+                              const PoseDelta* pose, ViewSetup* view);
 
-// Renders `job` of `view` (its ScaledViewSetup, UseFittedEnvironment) on `scene` with `material`
-// and the options, its rows or gradient in `layout`'s index space; the request's jacobian_rows
-// and adjoint_weights follow the job's pass.
+// Renders `job` of `view` (its ScaledViewSetup, UseFittedLightingAndPose) on `scene` with
+// `material` and the options, its rows or gradient in `layout`'s index space; the request's
+// jacobian_rows and adjoint_weights follow the job's pass.
 void RenderViewJob(const RenderScene& scene, const Material& material, const ViewSetup& view,
                    const RenderOptions& render, const DerivativeRequest& request,
                    const ParameterLayout& layout, const ViewJob& job, ViewResult* result);
