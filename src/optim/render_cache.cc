@@ -239,10 +239,10 @@ ViewSetup RenderCache::ScaledView(int v) const {
   ViewSetup view =
       ScaledViewSetup(*views_, view_indices_[v], options_.image_scale_log2, params_->LightScales(),
                       params_->LightPositions(), params_->LightDirections());
-  const PoseDelta pose = params_->num_pose_views() > 0 ? params_->Pose(v) : PoseDelta::Zero();
+  const bool poses = params_->num_pose_views() > 0;
+  const PoseDelta pose = poses ? params_->Pose(v) : PoseDelta::Zero();
   UseFittedLightingAndPose(rotated_environments_, params_->layout(), fitted_environment_,
-                           view_indices_[v], params_->num_pose_views() > 0 ? &pose : nullptr,
-                           &view);
+                           view_indices_[v], poses ? &pose : nullptr, &view);
   return view;
 }
 
