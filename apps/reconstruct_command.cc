@@ -2,6 +2,7 @@
 // images, stage by stage (src/optim/schedule.h; stages and keys in docs/reconstruct.md). This
 // file only configures the schedule, shows progress and writes the report. Ctrl-C stops after the
 // current solver iteration, writes a checkpoint and exits 130; `--resume OUT` continues from it.
+#include <algorithm>
 #include <atomic>
 #include <climits>
 #include <csignal>
@@ -21,6 +22,7 @@
 #include "src/io/dataset.h"
 #include "src/optim/fitted_environment.h"
 #include "src/optim/holdout.h"
+#include "src/optim/lamp_finder.h"
 #include "src/optim/mpi_views.h"
 #include "src/optim/run_outputs.h"
 #include "src/optim/schedule.h"
@@ -52,6 +54,7 @@ struct ReconstructCommandOptions {
   int holdout = 0;                // every K-th selected view is held out of the fit; 0 = off.
   std::string environment_frame;  // unknown lighting's fitted map: "world" or "camera".
   std::string estimate_lights;    // unknown lighting: a lights file estimated beside the map.
+  bool find_lamp = false;         // unknown lighting: look for a lamp in the map fitted alone.
   std::set<std::string> given;    // config keys whose flag was on the command line.
   std::string reference;          // ground-truth mesh: F1 and Chamfer after every outer iteration.
   double reference_tolerance = 0.005;  // F1 tolerance, fraction of the reference's diagonal.
@@ -80,7 +83,8 @@ Status FlagKeys(const ReconstructCommandOptions& cli, ScheduleConfig* config) {
                               {"effects", cli.effects},
                               {"holdout", cli.holdout},
                               {"environment_frame", cli.environment_frame},
-                              {"estimate_lights", cli.estimate_lights}};
+                              {"estimate_lights", cli.estimate_lights},
+                              {"find_lamp", cli.find_lamp}};
   for (const auto& [key, value] : all.items()) {
     if (cli.given.count(key) == 0) continue;
     const Status status = MergeScheduleConfig({{key, value}}, "flag", config);
@@ -89,6 +93,7 @@ Status FlagKeys(const ReconstructCommandOptions& cli, ScheduleConfig* config) {
       if (message.rfind("outer_iterations", 0) == 0) message.replace(0, 16, "outer");
       if (message.rfind("environment_frame", 0) == 0) message.replace(0, 17, "environment-frame");
       if (message.rfind("estimate_lights", 0) == 0) message.replace(0, 15, "estimate-lights");
+      if (message.rfind("find_lamp", 0) == 0) message.replace(0, 9, "find-lamp");
       return Status::Error("--" + message);
     }
   }
@@ -116,12 +121,17 @@ Status ResumedStages(const ReconstructCommandOptions& cli, const RunState& state
                            "(only flat keys may change)");
     }
     if (overrides.environment_given) {
-      return Status::Error(cli.config + ": environment_stage/environment_size/estimate_lights: " +
+      return Status::Error(cli.config +
+                           ": environment_stage/environment_size/estimate_lights/find_lamp: " +
                            "a resumed run keeps its stages and its fitted lighting");
     }
   }
-  if (cli.given.count("estimate_lights") > 0) {
-    return Status::Error("--estimate-lights: a resumed run keeps its fitted lighting");
+  for (const char* key : {"estimate_lights", "find_lamp"}) {
+    if (cli.given.count(key) > 0) {
+      std::string flag = std::string("--") + key;
+      std::replace(flag.begin(), flag.end(), '_', '-');
+      return Status::Error(flag + ": a resumed run keeps its fitted lighting");
+    }
   }
   SFT_RETURN_IF_ERROR(FlagKeys(cli, &overrides));
   if (overrides.holdout_given && overrides.holdout != state.holdout) {
@@ -173,6 +183,32 @@ Status UnknownLighting(const std::string& run, const EnvironmentEstimateOptions&
   return CheckViewsHaveLights(*dataset);
 }
 
+// --find-lamp: the environment stage `environment` fits the map alone first; a lamp in its
+// brightest lobe's direction (src/optim/lamp_finder.h) joins the dataset's lights before the run
+// starts, said in one line.
+Status FindLampForRun(const ReconstructCommandOptions& cli,
+                      const EnvironmentEstimateOptions& options, const StageOptions& environment,
+                      const ScheduleStart& start, Dataset* dataset) {
+  Progress progress(
+      "find lamp",
+      static_cast<int64_t>(environment.fit.outer_iterations) * environment.fit.solver.steps,
+      !cli.quiet);
+  LampSearch search;
+  SFT_RETURN_IF_ERROR(FindLamp(
+      *dataset, start.mesh, start.material, environment.fit, options.lamp_distance,
+      [&](const IterationRecord& record) {
+        if (!record.full) progress.Advance();
+        return !g_interrupted.load();
+      },
+      &search));
+  progress.Finish();
+  if (!cli.quiet) {
+    std::printf("%s\n", search.Describe().c_str());
+    std::fflush(stdout);
+  }
+  return search.found ? AddEstimatedLights({search.lamp}, dataset) : Status::Ok();
+}
+
 // Settles folders, stages and the schedule (fresh or resumed). Returns with *schedule null after
 // --print-schedule.
 Status PrepareSchedule(ReconstructCommandOptions* cli, Dataset* dataset,
@@ -210,6 +246,9 @@ Status PrepareSchedule(ReconstructCommandOptions* cli, Dataset* dataset,
   SFT_RETURN_IF_ERROR(ChooseStart(*dataset, cli->init, &start));
   ScheduleConfig config;
   SFT_RETURN_IF_ERROR(FreshStages(*cli, start, &config, &stages));
+  if (config.environment.find_lamp && !config.environment_stage) {
+    return Status::Error("find_lamp: needs the environment stage (environment_stage is false)");
+  }
   if (LightingUnknown(*dataset) && config.environment_stage) {
     StageOptions environment;
     SFT_RETURN_IF_ERROR(EnvironmentStage(config, stages.front(), &environment));
@@ -232,6 +271,9 @@ Status PrepareSchedule(ReconstructCommandOptions* cli, Dataset* dataset,
   SFT_RETURN_IF_ERROR(LoadStartMesh(*dataset, start, InitialMeshOptions(), &state.mesh, held_out));
   SFT_RETURN_IF_ERROR(LoadMaterial(cli->material.empty() ? kInitialMaterial : cli->material,
                                    state.mesh, &state.material));
+  if (config.environment.find_lamp) {
+    SFT_RETURN_IF_ERROR(FindLampForRun(*cli, config.environment, stages.front(), state, dataset));
+  }
   const nlohmann::json run_info = {
       {"dataset", cli->dataset},
       {"start", start.Describe()},
@@ -449,6 +491,10 @@ CommandRunner SetupReconstructCommand(CLI::App* app) {
                            "format) of point or directional lights whose place is roughly known, "
                            "fitted beside the environment"),
            "estimate_lights");
+  key_flag(app->add_flag("--find-lamp", opts->find_lamp,
+                         "Unknown lighting, no lamp given: fit the environment alone first and "
+                         "start a point lamp in its brightest direction, fitted beside the map"),
+           "find_lamp");
   app->add_option("--reference", opts->reference,
                   "Ground-truth mesh: F1 and Chamfer after every outer iteration (metrics.json)");
   app->add_option("--reference-tolerance", opts->reference_tolerance,

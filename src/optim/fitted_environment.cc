@@ -21,6 +21,14 @@ bool EnvironmentEstimateOptions::Check(std::string* why) const {
     *why = "assumed_albedo: must be in (0, 1]";
     return false;
   }
+  if (find_lamp && !lights.empty()) {
+    *why = "find_lamp: looks for a lamp when none is given; drop it or estimate_lights";
+    return false;
+  }
+  if (!(lamp_distance >= 0.5 && lamp_distance <= 1000.0)) {
+    *why = "lamp_distance: must be in [0.5, 1000] (half bounding-box diagonals)";
+    return false;
+  }
   for (size_t k = 0; k < lights.size(); ++k) {
     const std::string name =
         "estimate_lights: lights[" + std::to_string(k) + "] (\"" + lights[k].id + "\")";
@@ -156,6 +164,24 @@ Status AddEstimatedLights(const std::vector<LightSpec>& lights, Dataset* dataset
       }
     }
   }
+  // The map stays the last light (the order the MPI workers rebuild): take it out, add the
+  // lights, put it back.
+  const int fitted = FittedEnvironmentLight(*dataset);
+  LightSpec map;
+  if (fitted >= 0) {
+    if (fitted + 1 != static_cast<int>(dataset->lights.size())) {
+      return Status::Error("estimate_lights: the fitted environment is not the last light");
+    }
+    map = std::move(dataset->lights.back());
+    dataset->lights.pop_back();
+    for (ViewSpec& view : dataset->views) {
+      if (view.lights.empty() || view.lights.back() != fitted) {
+        return Status::Error("estimate_lights: a view lists the fitted environment out of order");
+      }
+      view.lights.pop_back();
+      view.light_ids.pop_back();
+    }
+  }
   for (const LightSpec& light : lights) {
     const int index = static_cast<int>(dataset->lights.size());
     dataset->lights.push_back(light);
@@ -164,6 +190,7 @@ Status AddEstimatedLights(const std::vector<LightSpec>& lights, Dataset* dataset
       view.lights.push_back(index);
     }
   }
+  if (fitted >= 0) return AddFittedEnvironment(map.pixels, map.frame, dataset);
   return Status::Ok();
 }
 
@@ -215,6 +242,11 @@ Status PrepareUnknownLighting(const std::string& run, const EnvironmentEstimateO
                               Dataset* dataset, std::string* note) {
   note->clear();
   if (!LightingUnknown(*dataset)) {
+    if (options.find_lamp) {
+      return Status::Error(
+          "find_lamp: the dataset lists its lights (its lighting is known); a lamp is looked for "
+          "under unknown lighting only");
+    }
     if (options.lights.empty()) return Status::Ok();
     return Status::Error(
         "estimate_lights: the dataset lists its lights (its lighting is known); estimated lights "

@@ -50,6 +50,14 @@ struct EnvironmentEstimateOptions {
   // Point and directional lights estimated beside the map (scene.json's light format; ids unique,
   // not kFittedEnvironmentId); empty = the map alone. Their specs are the fit's start.
   std::vector<LightSpec> lights;
+  // No lights given, one lamp looked for (src/optim/lamp_finder.h): the map is fitted alone
+  // first, and a point lamp starts in its brightest lobe's direction. Excludes `lights`.
+  bool find_lamp = false;
+  // The found lamp's start distance from the object's centre, in half bounding-box diagonals,
+  // [0.5, 1000]: the map shows a lamp's direction, not its distance; the fit corrects a start
+  // from half to twice the true distance (docs/design-notes.md, "How far off a lamp's guess may
+  // be"), so 4 covers lamps 2 to 8 half diagonals away.
+  double lamp_distance = 4.0;
 
   bool Check(std::string* why) const;
 };
@@ -68,7 +76,9 @@ Status InitialEnvironment(const Dataset& dataset, const EnvironmentEstimateOptio
 Status AddFittedEnvironment(const Image& texels, LightFrame frame, Dataset* dataset);
 
 // Adds estimated lights (EnvironmentEstimateOptions::lights) to `dataset` and to every view's
-// lights. Errors: a type other than point or directional, an id the dataset has already.
+// lights, before the fitted environment when it has one already (the map stays last, with its
+// texels and frame). Errors: a type other than point or directional, an id the dataset has
+// already.
 Status AddEstimatedLights(const std::vector<LightSpec>& lights, Dataset* dataset);
 
 // The estimated lights of a dataset PrepareUnknownLighting prepared: the lights its views list

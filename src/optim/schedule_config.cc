@@ -286,6 +286,10 @@ Status MergeScheduleConfig(const json& config, const std::string& source, Schedu
       }
       const std::string file = value.get<std::string>();
       EnvironmentEstimateOptions estimate = out->environment;
+      if (estimate.find_lamp) {
+        return Status::Error(source + ": estimate_lights: find_lamp is on (it looks for a lamp " +
+                             "when none is given); give one or the other");
+      }
       SFT_RETURN_IF_ERROR(
           ReadLightsFile(file, &estimate.lights).Prefixed(source + ": estimate_lights"));
       std::string why;
@@ -293,6 +297,21 @@ Status MergeScheduleConfig(const json& config, const std::string& source, Schedu
         return Status::Error(source + ": estimate_lights: " + file + ": " +
                              why.substr(why.find(": ") + 2));
       }
+      out->environment = estimate;
+      out->environment_given = true;
+    } else if (name == "find_lamp" || name == "lamp_distance") {
+      EnvironmentEstimateOptions estimate = out->environment;
+      if (name == "find_lamp" && value.is_boolean()) {
+        estimate.find_lamp = value.get<bool>();
+      } else if (name == "lamp_distance" && value.is_number()) {
+        estimate.lamp_distance = value.get<double>();
+      } else {
+        return Status::Error(source + ": " + name +
+                             (name == "find_lamp" ? ": expected true or false"
+                                                  : ": expected a number in [0.5, 1000]"));
+      }
+      std::string why;
+      if (!estimate.Check(&why)) return Status::Error(source + ": " + why);
       out->environment = estimate;
       out->environment_given = true;
     } else if (name == "environment_stage") {
@@ -336,7 +355,12 @@ Status EnvironmentStage(const ScheduleConfig& config, const StageOptions& first,
   stage->fit.cache.pyramid_levels = first.fit.cache.pyramid_levels;
   SFT_RETURN_IF_ERROR(ApplyStageConfig(config.flat, "flat keys", stage));
   SFT_RETURN_IF_ERROR(ApplyStageConfig(json::parse(kEnvironmentStageRole), where, stage));
-  // Estimated lights are lighting too: the stage fits their intensity and place with the map.
+  // Estimated lights are lighting too: the stage fits their intensity and place with the map;
+  // so is the lamp find_lamp starts (a point light).
+  if (config.environment.find_lamp) {
+    stage->fit.fit_lights = true;
+    stage->fit.fit_light_positions = true;
+  }
   for (const LightSpec& light : config.environment.lights) {
     stage->fit.fit_lights = true;
     if (light.type == LightType::kPoint) stage->fit.fit_light_positions = true;

@@ -9,7 +9,10 @@
 //   - "environment_size": [W, H] and "environment_stage": unknown lighting's fitted map and the
 //     automatic first stage that fits it alone (src/optim/fitted_environment.h);
 //   - "estimate_lights": the path of a lights file whose point and directional lights unknown
-//     lighting estimates beside the map (read when the config is merged; errors name that file).
+//     lighting estimates beside the map (read when the config is merged; errors name that file);
+//   - "find_lamp": true, with no lights given: the map is fitted alone first and a point lamp
+//     starts in its brightest lobe's direction, "lamp_distance" half diagonals from the object
+//     (src/optim/lamp_finder.h).
 // A stage object holds any flat key plus "name", and the stage-only keys "texel_resolution",
 // "remesh", "remesh_edge_pixels", "resample", "resample_fold_fraction", "material_model" and
 // "texture_size" (the effect planner's keys, "effects": "auto" and "pin", are flat keys: config.h).
@@ -36,15 +39,16 @@ struct ScheduleConfig {
   bool holdout_given = false;  // "holdout" was given (a resumed run must not change it).
   // Unknown lighting: the fitted map's size ("environment_size": [W, H]), the frame it is fixed
   // in ("environment_frame": "world" or "camera") and the lights estimated beside it
-  // ("estimate_lights": the path of a lights file; src/optim/fitted_environment.h).
+  // ("estimate_lights": the path of a lights file; or "find_lamp" and "lamp_distance";
+  // src/optim/fitted_environment.h).
   EnvironmentEstimateOptions environment;
   bool environment_frame_given = false;  // "environment_frame" given (a resume must not change it).
   // "environment_stage": false = no automatic environment stage; an object = stage keys over
   // the built-in stage's (EnvironmentStage).
   bool environment_stage = true;
   nlohmann::json environment_stage_keys = nlohmann::json::object();
-  // environment_size, environment_stage or estimate_lights was given (a resumed run keeps its
-  // map, its lights and its stages).
+  // environment_size, environment_stage, estimate_lights, find_lamp or lamp_distance was given
+  // (a resumed run keeps its map, its lights and its stages).
   bool environment_given = false;
 };
 
@@ -66,7 +70,7 @@ Status ResolveStages(const ScheduleConfig& config, bool carved_start,
 // first stage. Its keys: the built-in ones and first's scale < the flat keys < its role
 // (phases texture, fit_albedo/fit_roughness/fit_specular false, fit_environment true; with
 // estimated lights also fit_lights and fit_light_positions or fit_light_directions) <
-// config.environment_stage_keys.
+// config.environment_stage_keys; find_lamp sets fit_lights and fit_light_positions too.
 Status EnvironmentStage(const ScheduleConfig& config, const StageOptions& first,
                         StageOptions* stage);
 
