@@ -22,7 +22,7 @@ bool EnvironmentEstimateOptions::Check(std::string* why) const {
     return false;
   }
   if (find_lamp && !lights.empty()) {
-    *why = "find_lamp: looks for a lamp when none is given; drop it or estimate_lights";
+    *why = "find_lamp: looks for a lamp when none is given; give it or estimate_lights, not both";
     return false;
   }
   if (!(lamp_distance >= 0.5 && lamp_distance <= 1000.0)) {

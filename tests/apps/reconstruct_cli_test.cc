@@ -314,6 +314,68 @@ TEST(ReconstructCliTest, EstimatedLampBesideTheFittedEnvironment) {
   EXPECT_FALSE(fs::exists(tmp.Join("q")));
 }
 
+// --find-lamp with no lamp given, on a capture lit by its camera's flash (0.15 to the side of the
+// lens): the camera-fixed map fitted alone has its lobe towards the camera, so the lamp starts on
+// the camera's side of the object (measured 1° off the flash's direction from the object) and the
+// run fits it; the run folder keeps its start. A given lamp, known lighting, or a resume refuse
+// the flag in one line.
+TEST(ReconstructCliTest, FindLampWithNoGuess) {
+  testing::TempDir tmp;
+  ASSERT_EQ(testing::SynthIcosphere(tmp.Join("ds"), "--cameras 6 --zooms 1 --res 32 --spp 16"), "");
+  Dataset truth;
+  ASSERT_TRUE(ReadDataset(tmp.Join("ds"), &truth).ok());
+  const Eigen::Vector3d flash = truth.lights.at(0).position;
+  nlohmann::json scene = nlohmann::json::parse(testing::ReadTestFile(tmp.Join("ds/scene.json")));
+  scene["lights"] = nlohmann::json::array();
+  for (nlohmann::json& view : scene["views"]) view["lights"] = nlohmann::json::array();
+  testing::WriteTestFile(tmp.Join("ds/scene.json"), scene.dump(1));
+  testing::WriteTestFile(tmp.Join("small.json"), R"({"environment_size": [8, 4]})");
+  const std::string base = "reconstruct --dataset " + tmp.Join("ds") + " --init " +
+                           tmp.Join("ds/gt/mesh.ply") +
+                           " --outer 1 --steps 8 --spp 8 --no-report --environment-frame camera "
+                           "--find-lamp --config " +
+                           tmp.Join("small.json");
+  std::string out;
+  ASSERT_EQ(RunSft(base + " --out " + tmp.Join("o"), &out), 0) << out;
+  EXPECT_THAT(out, HasSubstr("find_lamp: the map fitted alone has a lobe")) << out;
+  std::vector<LightSpec> start;
+  ASSERT_TRUE(ReadLightsFile(tmp.Join("o/estimated_lights.json"), &start).ok());
+  ASSERT_EQ(start.size(), 1u);
+  EXPECT_EQ(start[0].id, "found_lamp");
+  EXPECT_EQ(start[0].frame, LightFrame::kCamera);
+  // The object's centre (the origin) in the cameras: on the optical axis at the same distance.
+  const Eigen::Vector3d centre = truth.views[0].cam_from_world * Eigen::Vector3d::Zero();
+  const double cosine =
+      (start[0].position - centre).normalized().dot((flash - centre).normalized());
+  EXPECT_GT(cosine, std::cos(0.3)) << start[0].position.transpose();
+  const nlohmann::json lights =
+      nlohmann::json::parse(testing::ReadTestFile(tmp.Join("o/lights.json")));
+  ASSERT_EQ(lights["lights"].size(), 2u) << lights.dump(1);
+  EXPECT_EQ(lights["lights"][0]["id"], "found_lamp");
+  EXPECT_EQ(lights["lights"][0]["position"].size(), 3u) << "the environment stage fits its place";
+
+  EXPECT_EQ(RunSft("reconstruct --quiet --resume " + tmp.Join("o") + " --find-lamp", &out), 1);
+  EXPECT_THAT(out, HasSubstr("--find-lamp: a resumed run keeps its fitted lighting"));
+  EXPECT_EQ(CountLines(out), 1) << out;
+  testing::WriteTestFile(tmp.Join("lamp.json"), R"({"lights": [{"id": "lamp", "type": "point",
+      "position": [0, 0, 2], "intensity": [1, 1, 1]}]})");
+  EXPECT_EQ(RunSft(base + " --quiet --out " + tmp.Join("p") + " --estimate-lights " +
+                       tmp.Join("lamp.json"),
+                   &out),
+            1);
+  EXPECT_THAT(out, HasSubstr("--find-lamp: looks for a lamp when none is given"));
+  EXPECT_EQ(CountLines(out), 1) << out;
+  EXPECT_FALSE(fs::exists(tmp.Join("p")));
+  ASSERT_EQ(testing::SynthIcosphere(tmp.Join("lit"), "--cameras 1 --zooms 1 --res 8 --spp 2"), "");
+  EXPECT_EQ(RunSft("reconstruct --quiet --dataset " + tmp.Join("lit") + " --init " +
+                       tmp.Join("lit/gt/mesh.ply") + " --out " + tmp.Join("q") + " --find-lamp",
+                   &out),
+            1);
+  EXPECT_THAT(out, HasSubstr("find_lamp: the dataset lists its lights"));
+  EXPECT_EQ(CountLines(out), 1) << out;
+  EXPECT_FALSE(fs::exists(tmp.Join("q")));
+}
+
 TEST(ReconstructCliTest, BadInputIsOneLine) {
   testing::TempDir tmp;
   ASSERT_EQ(testing::SynthIcosphere(tmp.Join("ds"), "--cameras 1 --zooms 1 --res 8 --spp 2"), "");
