@@ -4,6 +4,7 @@
 #include <cstdio>
 
 #include "src/eval/held_out_eval.h"
+#include "src/eval/lighting_report.h"
 #include "src/eval/line_chart.h"
 #include "src/eval/reconstruction_eval.h"
 #include "src/eval/report.h"
@@ -265,6 +266,7 @@ Status WriteReconstructReport(const std::string& out, const Dataset& dataset,
   AddReferenceCharts(outer_records, &html);
   SFT_RETURN_IF_ERROR(AddStages(stage_records, &html));
   AddEffectPlans(outer_records, &html);
+  SFT_RETURN_IF_ERROR(AddFittedLighting(out, dataset, &html));
   if (!model.viewer.export_dir.empty()) {
     SFT_RETURN_IF_ERROR(AddModelViewer(model.viewer, dataset, &html));
   } else if (!model.missing.empty()) {

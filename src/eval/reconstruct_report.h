@@ -1,7 +1,8 @@
 // OUT/report.html of `sft reconstruct`: the run's summary, the cost and mean-PSNR curves against
 // wall time, F1 and Chamfer against wall time (when the outer records carry them: --reference),
 // the stages with the mesh's normals after each, and target | render | |difference| for up to
-// four views at the final state, the 3D view of the textured result (model_viewer.h), the held-out
+// four views at the final state, the fitted lighting when the dataset's was unknown
+// (lighting_report.h), the 3D view of the textured result (model_viewer.h), the held-out
 // views, and up to two views relit by the studio lights (src/eval/studio_lights.h).
 #ifndef SFT_EVAL_RECONSTRUCT_REPORT_H_
 #define SFT_EVAL_RECONSTRUCT_REPORT_H_

@@ -332,12 +332,18 @@ TEST(ReconstructCliTest, FindLampWithNoGuess) {
   testing::WriteTestFile(tmp.Join("small.json"), R"({"environment_size": [8, 4]})");
   const std::string base = "reconstruct --dataset " + tmp.Join("ds") + " --init " +
                            tmp.Join("ds/gt/mesh.ply") +
-                           " --outer 1 --steps 8 --spp 8 --no-report --environment-frame camera "
+                           " --outer 1 --steps 8 --spp 8 --environment-frame camera "
                            "--find-lamp --config " +
                            tmp.Join("small.json");
   std::string out;
   ASSERT_EQ(RunSft(base + " --out " + tmp.Join("o"), &out), 0) << out;
   EXPECT_THAT(out, HasSubstr("find_lamp: the map fitted alone has a lobe")) << out;
+  // The report shows the fitted map and the lamp's start and fitted place.
+  const std::string report = testing::ReadTestFile(tmp.Join("o/report.html"));
+  EXPECT_THAT(report, HasSubstr("Fitted lighting"));
+  EXPECT_THAT(report, HasSubstr("found_lamp (point, camera frame)"));
+  EXPECT_THAT(report, HasSubstr("report_files/environment.png"));
+  EXPECT_TRUE(fs::exists(tmp.Join("o/report_files/environment.png")));
   std::vector<LightSpec> start;
   ASSERT_TRUE(ReadLightsFile(tmp.Join("o/estimated_lights.json"), &start).ok());
   ASSERT_EQ(start.size(), 1u);
