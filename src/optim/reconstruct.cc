@@ -362,7 +362,7 @@ Status Reconstruction::RunOuter(int outer,
     for (int v = 0; active.exposure && v < params_.num_gain_views(); ++v) {
       gain_curvature.push_back(cache_->GainCurvature(v));
     }
-    std::vector<Eigen::Vector2d> pose_curvature;
+    std::vector<Eigen::Matrix<double, 6, 1>> pose_curvature;
     if (active.poses && params_.num_pose_views() > 0) {
       Eigen::Vector3d lo, hi;
       MeshBounds(rest, &lo, &hi);

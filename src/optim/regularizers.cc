@@ -84,7 +84,7 @@ void AddRegularizers(const TriMesh& rest, const ActiveParameters& active,
                      const RegularizerOptions& options, const ParameterBounds& bounds,
                      const Material& material, SceneParameters* params, ceres::Problem* problem,
                      const std::vector<Eigen::Vector3d>& gain_curvature,
-                     const std::vector<Eigen::Vector2d>& pose_curvature) {
+                     const std::vector<Eigen::Matrix<double, 6, 1>>& pose_curvature) {
   const ParameterLayout& layout = params->layout();
   if (active.vertices && options.laplacian_weight > 0.0) {
     VertexLaplacianOptions laplacian;
@@ -159,8 +159,8 @@ void AddRegularizers(const TriMesh& rest, const ActiveParameters& active,
     for (int v = 0; v < params->num_pose_views(); ++v) {
       if (!params->PoseFitted(v)) continue;
       double* block = params->data() + params->PoseIndex(v, 0);
-      const Eigen::Vector2d w = (options.pose_prior * pose_curvature[v]).cwiseSqrt();
-      problem->AddResidualBlock(new PosePriorCost(w[0], w[1]), nullptr, block);
+      const Eigen::Matrix<double, 6, 1> w = (options.pose_prior * pose_curvature[v]).cwiseSqrt();
+      problem->AddResidualBlock(new PosePriorCost(w), nullptr, block);
       SetBlockBounds(params->PoseIndex(v, 0), 6, bounds, params, problem);
     }
   }

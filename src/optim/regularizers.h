@@ -80,13 +80,13 @@ struct RegularizerOptions {
 // positions the Laplacian measures displacements from and the proximal term is anchored at (and
 // whose connectivity they use). `gain_curvature` holds E_v per fitted view for the exposure prior
 // (RenderCache::GainCurvature); needed only when `active.exposure`. `pose_curvature` holds the
-// rotation's and translation's curvature per fitted view for the pose prior
+// curvature along each of the six pose-correction components per fitted view for the pose prior
 // (RenderCache::PoseCurvature); needed only when `active.poses`.
 void AddRegularizers(const TriMesh& rest, const ActiveParameters& active,
                      const RegularizerOptions& options, const ParameterBounds& bounds,
                      const Material& material, SceneParameters* params, ceres::Problem* problem,
                      const std::vector<Eigen::Vector3d>& gain_curvature = {},
-                     const std::vector<Eigen::Vector2d>& pose_curvature = {});
+                     const std::vector<Eigen::Matrix<double, 6, 1>>& pose_curvature = {});
 
 }  // namespace sft
 

@@ -477,13 +477,22 @@ Eigen::Vector3d RenderCache::GainCurvature(int v) const {
   return sum;
 }
 
-Eigen::Vector2d RenderCache::PoseCurvature(int v, const Eigen::Vector3d& object_centre) const {
-  double energy = 0.0;
+Eigen::Matrix<double, 6, 1> RenderCache::PoseCurvature(int v,
+                                                       const Eigen::Vector3d& object_centre) const {
+  const ViewSetup& view = views_->views[view_indices_[v]];
+  const Camera camera = DownscaledCamera(view.camera, options_.image_scale_log2);
+  const double f = camera.Focal().mean();
+  const Eigen::Vector2d principal = camera.Principal();
+  double energy = 0.0;         // Σ sw² |∇T|² 4^-l: per squared level-0 pixel of shift.
+  double radial_energy = 0.0;  // Σ sw² |∇T|² r_l²: per unit of roll.
   for (int l = 0; l < num_levels(v); ++l) {
     const LevelCache& level = *levels_[v][l];
     const std::vector<uint8_t>& active = targets_[v].active[l];
     const int w = level.target.width, h = level.target.height;
     const double level_scale = std::ldexp(1.0, -2 * l);  // 4^-l: level pixels per level-0 pixel.
+    // The principal point in level-l pixel indices (pixel x's centre is at x + 0.5 in image
+    // coordinates, and a level-l pixel covers 2^l level-0 pixels).
+    const Eigen::Vector2d c_l = principal / std::ldexp(1.0, l) - Eigen::Vector2d::Constant(0.5);
     for (int y = 1; y + 1 < h; ++y) {
       for (int x = 1; x + 1 < w; ++x) {
         const int p = y * w + x;
@@ -498,14 +507,15 @@ Eigen::Vector2d RenderCache::PoseCurvature(int v, const Eigen::Vector3d& object_
         }
         const double sw = level.SqrtWeight(p);
         energy += sw * sw * g2 * level_scale;
+        radial_energy += sw * sw * g2 * (Eigen::Vector2d(x, y) - c_l).squaredNorm();
       }
     }
   }
-  const ViewSetup& view = views_->views[view_indices_[v]];
-  const Camera camera = DownscaledCamera(view.camera, options_.image_scale_log2);
-  const double f = camera.Focal().mean();
-  const double z = std::max((view.cam_from_world * object_centre).z(), 1e-9);
-  return Eigen::Vector2d(energy * f * f, energy * f * f / (z * z));
+  const double z2 = std::pow(std::max((view.cam_from_world * object_centre).z(), 1e-9), 2);
+  const double pan = energy * f * f;
+  Eigen::Matrix<double, 6, 1> curvature;
+  curvature << pan, pan, radial_energy, pan / z2, pan / z2, radial_energy / z2;
+  return curvature;
 }
 
 double RenderCache::ImageCost() const {

@@ -178,13 +178,16 @@ class RenderCache : public ceres::EvaluationCallback {
   // c, Σ_l Σ_p w_l w_lp T_lpc² over the active pixels of every level (the exposure prior's scale,
   // cost_functions/exposure_prior.h). Depends on the targets only.
   Eigen::Vector3d GainCurvature(int v) const;
-  // The image term's curvature in view v's pose correction, approximately (for the pose prior,
-  // cost_functions/pose_prior.h): G = Σ_l Σ_p w_l² w_lp² Σ_c |∇T_lpc|² 4^-l, the targets' gradient
-  // energy per squared level-0 pixel of image shift (central differences over the active pixels
-  // whose neighbours are active), times f² for the rotation (a turn of 1 rad slides the image by
-  // about f pixels) and (f/z)² for the translation, with f the focal length in the fit's pixels
-  // and z the depth of `object_centre` (world) in the view. Depends on the targets only.
-  Eigen::Vector2d PoseCurvature(int v, const Eigen::Vector3d& object_centre) const;
+  // The image term's curvature along each component of view v's pose correction (ω then τ, camera
+  // frame), approximately (for the pose prior, cost_functions/pose_prior.h): the targets' gradient
+  // energy Σ_l Σ_p w_l² w_lp² Σ_c |∇T_lpc|² (central differences over the active pixels whose
+  // neighbours are active) times the squared image motion, in level-l pixels, per unit of the
+  // component: f_l² for a pan or tilt (a turn of 1 rad slides the image by about f pixels), r_l²
+  // for the roll (a pixel r from the principal point moves by r), (f_l/z)² for a sideways shift
+  // and (r_l/z)² for a move along the optical axis (the image scales about the principal point by
+  // 1/z), with f_l and r_l in level-l pixels at the fit's scale and z the depth of
+  // `object_centre` (world) in the view. Depends on the targets only.
+  Eigen::Matrix<double, 6, 1> PoseCurvature(int v, const Eigen::Vector3d& object_centre) const;
   // The part of ImageCost from view v.
   double ViewImageCost(int v) const;
   // Mean squared error of level 0 over its active pixels and RGB, per view, at the last render.
