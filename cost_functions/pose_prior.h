@@ -16,10 +16,10 @@
 // energy times the squared image motion per unit of the component: f² for a pan or tilt, r² for
 // the roll about the optical axis, (f/z)² for a sideways shift and (r/z)² for a move along the
 // axis, f the focal length and r a pixel's distance from the principal point in pixels, z the
-// object's depth). A correction the photographs determine
-// well (one that slides the image) then moves by about a fraction pose_prior of its size, while
-// one they hardly see (a turn about the object with the matching shift, which moves the image
-// little under world-fixed lights) is held near the dataset's pose instead of wandering.
+// object's depth). A correction the photographs determine well (one that slides the image) then
+// moves by about a fraction pose_prior of its size, while one they hardly see (a turn about the
+// object with the matching shift, which moves the image little under world-fixed lights) is held
+// near the dataset's pose instead of wandering.
 #ifndef SFT_COST_FUNCTIONS_POSE_PRIOR_H_
 #define SFT_COST_FUNCTIONS_POSE_PRIOR_H_
 

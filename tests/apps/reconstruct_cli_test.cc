@@ -316,7 +316,7 @@ TEST(ReconstructCliTest, EstimatedLampBesideTheFittedEnvironment) {
 
 // --find-lamp with no lamp given, on a capture lit by its camera's flash (0.15 to the side of the
 // lens): the camera-fixed map fitted alone has its lobe towards the camera, so the lamp starts on
-// the camera's side of the object (measured 1° off the flash's direction from the object) and the
+// the camera's side of the object (measured 3.9° off the flash's direction from the object) and the
 // run fits it; the run folder keeps its start. A given lamp, known lighting, or a resume refuse
 // the flag in one line.
 TEST(ReconstructCliTest, FindLampWithNoGuess) {
@@ -380,6 +380,16 @@ TEST(ReconstructCliTest, FindLampWithNoGuess) {
   EXPECT_THAT(out, HasSubstr("find_lamp: the dataset lists its lights"));
   EXPECT_EQ(CountLines(out), 1) << out;
   EXPECT_FALSE(fs::exists(tmp.Join("q")));
+  // The search is the environment stage run once: without that stage there is none.
+  testing::WriteTestFile(tmp.Join("no_stage.json"), R"({"environment_stage": false})");
+  EXPECT_EQ(RunSft("reconstruct --quiet --dataset " + tmp.Join("ds") + " --init " +
+                       tmp.Join("ds/gt/mesh.ply") + " --out " + tmp.Join("s") +
+                       " --find-lamp --config " + tmp.Join("no_stage.json"),
+                   &out),
+            1);
+  EXPECT_THAT(out, HasSubstr("find_lamp: needs the environment stage"));
+  EXPECT_EQ(CountLines(out), 1) << out;
+  EXPECT_FALSE(fs::exists(tmp.Join("s")));
 }
 
 TEST(ReconstructCliTest, BadInputIsOneLine) {
