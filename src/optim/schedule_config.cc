@@ -19,26 +19,35 @@ using json = nlohmann::json;
 // The built-in stage lists (docs/reconstruct.md, "Built-in schedules").
 // refine: from a given mesh, one stage of the fit's defaults.
 const char kRefineSchedule[] = R"([{"name": "refine"}])";
-// large_steps: from a given mesh, material stages (LM: albedo, roughness, specular weight)
-// alternating with geometry stages (Adam on the large-steps parameterisation, a new seed and 8
-// views per step, the specular lobe off and silhouette edges on in the step, one pyramid level) at
-// a step size that halves, half scale first. Measured on the glossy dragon and the README bunny
-// (docs/design-notes.md, "Large steps for Adam", "The convergence aids one by one").
+// large_steps: from a given mesh, material and geometry stages alternating, half scale first.
+// Material: one LM stage (albedo, roughness, specular weight), then Adam on independent gradient
+// paths (16 views per step), whose first stage restarts the lobe (roughness 0.5, specular 0.2)
+// that LM leaves near its floor. Geometry: Adam on the large-steps parameterisation (a new seed
+// and 8 views per step, one pyramid level, 64 spp), the specular lobe in the rendered residual
+// but out of the adjoint pass, silhouette edges on, at a step size that halves. Measured on the
+// glossy dragon over 3 seeds and on the README bunny (docs/design-notes.md, "Large steps for
+// Adam", "The warp's floor is the material's").
 const char kLargeStepsSchedule[] = R"([
   {"name": "material", "phases": "texture", "image_scale": 0.5, "pyramid_levels": 3,
    "outer_iterations": 1, "steps": 5},
+  {"name": "material_adam", "phases": "texture", "solver": "adam", "image_scale": 0.5,
+   "pyramid_levels": 3, "outer_iterations": 1, "steps": 60, "independent_gradient": true,
+   "adam_views_per_step": 16, "restart_roughness": 0.5, "restart_specular": 0.2},
   {"name": "shape_half", "phases": "geometry", "solver": "adam", "image_scale": 0.5,
    "pyramid_levels": 1, "outer_iterations": 2, "steps": 25, "adam_lr_vertices": 0.002},
-  {"name": "material_half", "phases": "texture", "image_scale": 0.5, "pyramid_levels": 3,
-   "outer_iterations": 1, "steps": 5},
+  {"name": "material_half", "phases": "texture", "solver": "adam", "image_scale": 0.5,
+   "pyramid_levels": 3, "outer_iterations": 1, "steps": 40, "independent_gradient": true,
+   "adam_views_per_step": 16},
   {"name": "shape_full", "phases": "geometry", "solver": "adam", "image_scale": 1,
    "pyramid_levels": 1, "outer_iterations": 2, "steps": 25, "adam_lr_vertices": 0.001},
-  {"name": "material_full", "phases": "texture", "image_scale": 1, "pyramid_levels": 3,
-   "outer_iterations": 1, "steps": 5},
+  {"name": "material_full", "phases": "texture", "solver": "adam", "image_scale": 1,
+   "pyramid_levels": 3, "outer_iterations": 1, "steps": 40, "independent_gradient": true,
+   "adam_views_per_step": 16},
   {"name": "shape_full2", "phases": "geometry", "solver": "adam", "image_scale": 1,
    "pyramid_levels": 1, "outer_iterations": 2, "steps": 25, "adam_lr_vertices": 0.0005},
-  {"name": "material_full2", "phases": "texture", "image_scale": 1, "pyramid_levels": 3,
-   "outer_iterations": 1, "steps": 5},
+  {"name": "material_full2", "phases": "texture", "solver": "adam", "image_scale": 1,
+   "pyramid_levels": 3, "outer_iterations": 1, "steps": 40, "independent_gradient": true,
+   "adam_views_per_step": 16},
   {"name": "shape_full3", "phases": "geometry", "solver": "adam", "image_scale": 1,
    "pyramid_levels": 1, "outer_iterations": 2, "steps": 25, "adam_lr_vertices": 0.00025},
   {"name": "material_final", "phases": "texture", "solver": "adam", "image_scale": 1,
@@ -48,8 +57,11 @@ const char kLargeStepsSchedule[] = R"([
 // Keys of every large_steps and hull stage.
 const char kLargeStepsStageKeys[] = R"({"image_loss": "relative", "fit_specular": true,
   "adam_large_steps": 25, "adam_uniform": true, "adam_resample": true, "adam_views_per_step": 8})";
-// Keys of their geometry stages.
-const char kLargeStepsGeometryKeys[] = R"({"pin": {"specular": false, "primary_edges": true}})";
+// Keys of the large_steps geometry stages: the lobe rendered (pinned on) but left out of the step.
+const char kLargeStepsGeometryKeys[] = R"({"pin": {"specular": true, "primary_edges": true},
+  "gradient_specular": false, "spp": 64})";
+// Keys of the hull geometry stages: the lobe pinned off in both passes.
+const char kHullGeometryKeys[] = R"({"pin": {"specular": false, "primary_edges": true}})";
 // hull: from a carved hull, the report's shape with the stages of large_steps: material and
 // geometry alternating at a growing image scale (1/4, 1/2, 1), adaptive remeshing before the half
 // and full scales, resampling before the full scale, and the same closing material stage.
@@ -388,7 +400,9 @@ Status ResolveStages(const ScheduleConfig& config, bool carved_start,
       for (json& stage : list) {
         const json own = stage;  // a stage's own keys win over the list's.
         stage.update(json::parse(kLargeStepsStageKeys));
-        if (stage["phases"] == "geometry") stage.update(json::parse(kLargeStepsGeometryKeys));
+        if (stage["phases"] == "geometry") {
+          stage.update(json::parse(name == "hull" ? kHullGeometryKeys : kLargeStepsGeometryKeys));
+        }
         stage.update(own);
       }
     } else {

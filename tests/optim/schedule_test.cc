@@ -128,13 +128,9 @@ TEST(ScheduleConfigTest, TableShowsEachStagesViews) {
   EXPECT_EQ(lines[2].find("2 of 4: 1,3"), column) << table;
 }
 
-// The shipped glossy-refine schedule (data/example/glossy_refine.json, docs/reconstruct.md) parses
-// and alternates LM texture stages with Adam large-steps geometry stages that do not simulate the
-// specular lobe, with the step size falling from stage to stage, and ends with an Adam texture
-// stage on independent gradient paths.
-TEST(ScheduleConfigTest, ShippedGlossyRefineScheduleParses) {
+void ExpectGlossyRefineList(const std::string& path) {
   ScheduleConfig config;
-  ASSERT_TRUE(ReadScheduleConfig(testing::DataDir() + "/example/glossy_refine.json", &config).ok());
+  ASSERT_TRUE(ReadScheduleConfig(path, &config).ok());
   std::vector<StageOptions> stages;
   ASSERT_TRUE(ResolveStages(config, /*carved_start=*/false, &stages).ok());
   ASSERT_GE(stages.size(), 5u);
@@ -153,10 +149,23 @@ TEST(ScheduleConfigTest, ShippedGlossyRefineScheduleParses) {
     EXPECT_EQ(stage.fit.solver.adam.large_steps_lambda, 25.0);
     EXPECT_TRUE(stage.fit.solver.adam.resample);
     EXPECT_FALSE(stage.fit.cache.independent_gradient);
+    ASSERT_EQ(stage.fit.planner.pins.count("specular"), 1u);
+    EXPECT_FALSE(stage.fit.planner.pins.at("specular"));
     EXPECT_LT(stage.fit.solver.adam.learning_rate_vertices, last_lr);
     last_lr = stage.fit.solver.adam.learning_rate_vertices;
   }
   EXPECT_EQ(stages.back().fit.phases, PhaseSchedule::kTexture);
+}
+
+// The shipped glossy-refine schedules (data/example/glossy_refine.json and the faster list
+// large_steps_fast.json, docs/reconstruct.md) parse and alternate LM texture stages with Adam
+// large-steps geometry stages that do not simulate the specular lobe, with the step size falling
+// from stage to stage, and end with an Adam texture stage on independent gradient paths.
+TEST(ScheduleConfigTest, ShippedGlossyRefineSchedulesParse) {
+  for (const char* file : {"glossy_refine.json", "large_steps_fast.json"}) {
+    SCOPED_TRACE(file);
+    ExpectGlossyRefineList(testing::DataDir() + "/example/" + file);
+  }
 }
 
 // A step's progress work: pixels × spp, and for an Adam minibatch its share of the fitted views.
@@ -176,28 +185,49 @@ TEST(ScheduleConfigTest, StepWorkCountsTheMinibatchShare) {
 TEST(ScheduleConfigTest, BuiltInListsFollowTheStart) {
   ScheduleConfig config;
   std::vector<StageOptions> stages;
-  // A given mesh: the large-steps list, LM material stages alternating with Adam geometry stages
-  // on large steps whose step size falls, ending with an Adam material stage on independent
-  // gradient paths.
+  // A given mesh: the large-steps list. One LM material stage, then Adam material stages on
+  // independent gradient paths (the first restarts the lobe) alternating with Adam geometry stages
+  // on large steps whose step size falls; the geometry stages render the lobe into the residual
+  // at 64 spp and keep it out of the step.
   ASSERT_TRUE(ResolveStages(config, /*carved_start=*/false, &stages).ok());
-  ASSERT_GE(stages.size(), 5u);
+  ASSERT_GE(stages.size(), 6u);
   EXPECT_EQ(stages[0].fit.phases, PhaseSchedule::kTexture);
-  EXPECT_EQ(stages[1].fit.phases, PhaseSchedule::kGeometry);
-  EXPECT_EQ(stages[1].fit.solver.kind, SolverKind::kAdam);
-  EXPECT_EQ(stages[1].fit.solver.adam.large_steps_lambda, 25.0);
-  EXPECT_TRUE(stages[1].fit.solver.adam.resample);
-  EXPECT_EQ(stages[1].fit.planner.pins.count("specular"), 1u);
-  EXPECT_EQ(stages[0].fit.planner.pins.count("specular"), 0u);  // material stages fit the lobe.
-  EXPECT_TRUE(stages[0].fit.fit_specular);
   EXPECT_EQ(stages[0].fit.solver.kind, SolverKind::kLevenbergMarquardt);
-  EXPECT_FALSE(stages[1].fit.cache.independent_gradient);
-  EXPECT_EQ(stages.back().fit.phases, PhaseSchedule::kTexture);
-  EXPECT_EQ(stages.back().fit.solver.kind, SolverKind::kAdam);
-  EXPECT_TRUE(stages.back().fit.cache.independent_gradient);
-  EXPECT_EQ(stages.back().fit.solver.adam.views_per_step, 16);
-  EXPECT_EQ(stages.back().restart_roughness, 0.5);  // the LM stages leave it at its floor.
-  EXPECT_EQ(stages.back().restart_specular, 0.2);
+  EXPECT_TRUE(stages[0].fit.fit_specular);
+  EXPECT_EQ(stages[0].fit.planner.pins.count("specular"), 0u);  // material stages fit the lobe.
   EXPECT_EQ(stages[0].restart_roughness, 0.0);
+  EXPECT_EQ(stages[1].fit.phases, PhaseSchedule::kTexture);
+  EXPECT_EQ(stages[1].fit.solver.kind, SolverKind::kAdam);
+  EXPECT_TRUE(stages[1].fit.cache.independent_gradient);
+  EXPECT_EQ(stages[1].restart_roughness, 0.5);  // the LM stage leaves it at its floor.
+  EXPECT_EQ(stages[1].restart_specular, 0.2);
+  double last_lr = 1e9;
+  int geometry_stages = 0;
+  for (size_t k = 2; k < stages.size(); ++k) {
+    const StageOptions& stage = stages[k];
+    SCOPED_TRACE(stage.name);
+    EXPECT_EQ(stage.fit.solver.kind, SolverKind::kAdam);
+    if (stage.fit.phases == PhaseSchedule::kTexture) {
+      EXPECT_TRUE(stage.fit.cache.independent_gradient);
+      EXPECT_EQ(stage.fit.solver.adam.views_per_step, 16);
+      continue;
+    }
+    ++geometry_stages;
+    EXPECT_EQ(stage.fit.phases, PhaseSchedule::kGeometry);
+    EXPECT_EQ(stage.fit.solver.adam.large_steps_lambda, 25.0);
+    EXPECT_TRUE(stage.fit.solver.adam.resample);
+    EXPECT_FALSE(stage.fit.cache.independent_gradient);
+    ASSERT_EQ(stage.fit.planner.pins.count("specular"), 1u);
+    EXPECT_TRUE(stage.fit.planner.pins.at("specular"));  // in the residual...
+    EXPECT_FALSE(stage.fit.cache.gradient_specular);     // ...out of the step.
+    EXPECT_EQ(stage.fit.cache.render.spp, 64);
+    EXPECT_LT(stage.fit.solver.adam.learning_rate_vertices, last_lr);
+    last_lr = stage.fit.solver.adam.learning_rate_vertices;
+  }
+  EXPECT_EQ(geometry_stages, 4);
+  EXPECT_EQ(stages.back().fit.phases, PhaseSchedule::kTexture);
+  EXPECT_EQ(stages.back().restart_roughness, 0.5);
+  EXPECT_EQ(stages.back().restart_specular, 0.2);
   // Flat keys that describe one stage's loop pick the one-stage refine list.
   for (const char* key : {"phases", "solver", "outer_iterations", "steps"}) {
     SCOPED_TRACE(key);
@@ -231,6 +261,7 @@ TEST(ScheduleConfigTest, BuiltInListsFollowTheStart) {
     if (stage.fit.phases == PhaseSchedule::kGeometry) {
       EXPECT_EQ(stage.fit.solver.kind, SolverKind::kAdam) << stage.name;
       EXPECT_EQ(stage.fit.solver.adam.large_steps_lambda, 25.0) << stage.name;
+      EXPECT_FALSE(stage.fit.planner.pins.at("specular")) << stage.name;  // pinned off.
     }
   }
   EXPECT_TRUE(stages.back().fit.cache.independent_gradient);
