@@ -62,10 +62,11 @@ const char kLargeStepsGeometryKeys[] = R"({"pin": {"specular": true, "primary_ed
   "gradient_specular": false, "spp": 64})";
 // Keys of the hull geometry stages: the lobe pinned off in both passes.
 const char kHullGeometryKeys[] = R"({"pin": {"specular": false, "primary_edges": true}})";
-// hull: from a carved hull, the report's shape with the stages of large_steps: material and
-// geometry alternating at a growing image scale (1/4, 1/2, 1), adaptive remeshing before the half
-// and full scales, resampling before the full scale, and the same closing material stage.
-// Measured on the glossy dragon (docs/design-notes.md, "The hull list on Adam").
+// hull: from a carved hull, the report's shape: material (LM) and geometry (Adam, large steps,
+// the lobe pinned off) alternating at a growing image scale (1/4, 1/2, 1), adaptive remeshing
+// before the half and full scales, resampling before the full scale, and the closing material
+// stage of large_steps. Measured on the glossy dragon (docs/design-notes.md, "The hull list on
+// Adam").
 const char kHullSchedule[] = R"([
   {"name": "material_quarter", "phases": "texture", "image_scale": 0.25, "pyramid_levels": 2,
    "outer_iterations": 1, "steps": 5},
