@@ -146,11 +146,7 @@ TEST_F(CompareCommandTest, CsvAndReportNameEveryRunWithFiniteNumbers) {
   EXPECT_EQ(html.find("nan"), std::string::npos);
   EXPECT_EQ(html.find("inf<"), std::string::npos);
   // Three charts: cost, Chamfer and F1 against wall time.
-  int charts = 0;
-  for (size_t at = html.find("<svg"); at != std::string::npos; at = html.find("<svg", at + 1)) {
-    ++charts;
-  }
-  EXPECT_EQ(charts, 3);
+  EXPECT_EQ(testing::CountOccurrences(html, "<svg"), 3);
 }
 
 // Bad inputs: a folder without metrics.json, a metrics.json of something else, labels that do not

@@ -36,12 +36,6 @@ int ViewPsnrCount(const nlohmann::json& metrics) {
   return count;
 }
 
-int Occurrences(const std::string& text, const std::string& part) {
-  int count = 0;
-  for (size_t at = text.find(part); at != std::string::npos; at = text.find(part, at + 1)) ++count;
-  return count;
-}
-
 TEST(ReconstructHoldoutTest, HeldOutViewsAreKeptOutAndScored) {
   testing::TempDir tmp;
   ASSERT_EQ(
@@ -137,13 +131,14 @@ TEST(ReconstructHoldoutTest, PrintScheduleShowsTheFittedViews) {
   ASSERT_EQ(RunSft(base + " --holdout 2", &out), 0) << out;  // the hull list: a carved start.
   const int stages = CountLines(out) - 2;                    // the header, the held-out line.
   ASSERT_GE(stages, 4) << out;
-  EXPECT_EQ(Occurrences(out, "  2 of 4: 1,3\n"), stages) << out;
+  EXPECT_EQ(testing::CountOccurrences(out, "  2 of 4: 1,3\n"), stages) << out;
   EXPECT_THAT(out, HasSubstr("held out (--holdout 2): 2 of 4: 0,2\n"));
   // A stage's own views lose the held-out ones; without --holdout, every stage fits all views.
   testing::WriteTestFile(tmp.Join("cfg.json"),
                          R"({"stages": [{"name": "a"}, {"name": "b", "views": [0, 1, 3]}]})");
   ASSERT_EQ(RunSft(base + " --holdout 2 --config " + tmp.Join("cfg.json"), &out), 0) << out;
-  EXPECT_EQ(Occurrences(out, "  2 of 4: 1,3\n"), 2) << out;  // b's {0, 1, 3} loses view 0.
+  EXPECT_EQ(testing::CountOccurrences(out, "  2 of 4: 1,3\n"), 2)
+      << out;  // b's {0, 1, 3} loses view 0.
   ASSERT_EQ(RunSft(base + " --config " + tmp.Join("cfg.json"), &out), 0) << out;
   EXPECT_THAT(out, HasSubstr("  all 4\n"));
   EXPECT_THAT(out, HasSubstr("  3 of 4: 0,1,3\n"));

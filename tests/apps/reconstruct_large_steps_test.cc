@@ -22,12 +22,6 @@ nlohmann::json ReadJson(const std::string& path) {
   return nlohmann::json::parse(testing::ReadTestFile(path));
 }
 
-int CountOf(const std::string& text, const std::string& what) {
-  int count = 0;
-  for (size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++count;
-  return count;
-}
-
 TEST(ReconstructLargeStepsTest, EveryStageRunsWithTheLobeInTheGeometryResidual) {
   testing::TempDir tmp;
   ASSERT_EQ(testing::SynthIcosphere(
@@ -39,17 +33,18 @@ TEST(ReconstructLargeStepsTest, EveryStageRunsWithTheLobeInTheGeometryResidual) 
   std::string out;
   // "schedule": "large_steps" keeps the list although --outer and --steps describe one stage's
   // loop (with "auto" they would pick the one-stage refine list); the flags shrink every stage.
-  ASSERT_EQ(RunSft("reconstruct --dataset " + tmp.Join("ds") + " --init " +
-                       tmp.Join("ds/gt/mesh.ply") + " --out " + tmp.Join("r") +
-                       " --config " + tmp.Join("c.json") + " --outer 1 --steps 2 "
-                       "--bounces 1 --no-report",
-                   &out),
-            0)
+  ASSERT_EQ(
+      RunSft("reconstruct --dataset " + tmp.Join("ds") + " --init " + tmp.Join("ds/gt/mesh.ply") +
+                 " --out " + tmp.Join("r") + " --config " + tmp.Join("c.json") +
+                 " --outer 1 --steps 2 "
+                 "--bounces 1 --no-report",
+             &out),
+      0)
       << out;
   EXPECT_THAT(out, HasSubstr("stage 1/10 material:"));
   EXPECT_THAT(out, HasSubstr("stage 2/10 material_adam:"));
   EXPECT_THAT(out, HasSubstr("stage 10/10 material_final:"));
-  EXPECT_EQ(CountOf(out, "restart: roughness 0.5, specular 0.2"), 2) << out;
+  EXPECT_EQ(testing::CountOccurrences(out, "restart: roughness 0.5, specular 0.2"), 2) << out;
 
   const nlohmann::json state = ReadJson(tmp.Join("r/state.json"));
   EXPECT_TRUE(state["finished"].get<bool>());

@@ -208,12 +208,7 @@ TEST_F(ReconstructMpiTest, KilledRankEndsTheRunResumably) {
               HasSubstr("sft reconstruct: error: rank 1 stopped answering (died or was "
                         "killed); state written to " +
                         out + " (continue with --resume " + out + ", with any number of ranks)"));
-  size_t errors = 0;
-  for (size_t at = output.find("sft reconstruct: error"); at != std::string::npos;
-       at = output.find("sft reconstruct: error", at + 1)) {
-    ++errors;
-  }
-  EXPECT_EQ(errors, 1u) << output;
+  EXPECT_EQ(testing::CountOccurrences(output, "sft reconstruct: error"), 1) << output;
   const std::string state = testing::ReadTestFile(out + "/state.json");
   ASSERT_FALSE(state.empty()) << output;
   EXPECT_THAT(state, HasSubstr("\"finished\": false"));

@@ -59,6 +59,12 @@ int RunSft(const std::string& args, std::string* output) {
   return RunCommand(SftBinary() + " " + args, output);
 }
 
+int CountOccurrences(const std::string& text, const std::string& part) {
+  int count = 0;
+  for (size_t at = text.find(part); at != std::string::npos; at = text.find(part, at + 1)) ++count;
+  return count;
+}
+
 int CountLines(const std::string& text) {
   int lines = 0;
   for (char c : text) lines += c == '\n';

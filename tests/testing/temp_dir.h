@@ -37,6 +37,8 @@ void WriteTestFile(const std::string& path, const std::string& contents);
 int RunSft(const std::string& args, std::string* output = nullptr);
 // Lines of `text`, counting a last line without its newline.
 int CountLines(const std::string& text);
+// How often `part` (not empty) occurs in `text`, overlapping occurrences included.
+int CountOccurrences(const std::string& text, const std::string& part);
 // Runs a shell command, returns its exit code; stdout+stderr captured into *output if non-null.
 int RunCommand(const std::string& command, std::string* output = nullptr);
 
