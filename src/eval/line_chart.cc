@@ -109,10 +109,14 @@ std::string LineChartSvg(const LineChart& chart) {
                                   ? HtmlEscape(series.color)
                                   : kColors[s % (sizeof(kColors) / sizeof(kColors[0]))];
     const std::string fill = series.hollow_markers ? "none" : color;
-    std::string points, dots;
+    std::vector<std::string> lines(1);  // each a polyline's points.
+    std::string dots;
     for (size_t i = 0; i < std::min(series.x.size(), series.y.size()); ++i) {
+      const bool breaks =
+          std::find(series.breaks.begin(), series.breaks.end(), i) != series.breaks.end();
+      if (breaks && !lines.back().empty()) lines.emplace_back();
       if (!usable(series.x[i], series.y[i])) continue;
-      points += Num(px(series.x[i])) + "," + Num(py(series.y[i])) + " ";
+      lines.back() += Num(px(series.x[i])) + "," + Num(py(series.y[i])) + " ";
       if (series.marker_radius <= 0.0) continue;
       dots += "<circle cx=\"" + Num(px(series.x[i])) + "\" cy=\"" + Num(py(series.y[i])) +
               "\" r=\"" + Num(series.marker_radius) + "\" fill=\"" + fill + "\" stroke=\"" + color +
@@ -120,7 +124,8 @@ std::string LineChartSvg(const LineChart& chart) {
       if (i < series.tips.size()) dots += "<title>" + HtmlEscape(series.tips[i]) + "</title>";
       dots += "</circle>\n";
     }
-    if (series.line) {
+    for (const std::string& points : lines) {
+      if (!series.line || points.empty()) continue;
       svg += "<polyline fill=\"none\" stroke=\"" + color + "\" stroke-width=\"1.5\" points=\"" +
              points + "\"/>\n";
     }

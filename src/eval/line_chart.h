@@ -18,6 +18,9 @@ struct LineSeries {
   bool hollow_markers = false;  // rings instead of filled dots (to mark points over others).
   std::string color{};          // CSS colour; "" = the palette's colour of the series' position.
   std::vector<std::string> tips{};  // optional tooltip per point (on its dot).
+  // Indices of points that start a new line: the point is not joined to the one before it (a
+  // series interrupted by another, e.g. one phase's records between the other phase's stages).
+  std::vector<size_t> breaks{};
 };
 
 struct LineChart {

@@ -249,8 +249,19 @@ Status WriteReconstructReport(const std::string& out, const Dataset& dataset,
   psnr.y_label = "PSNR (dB)";
   for (const std::string phase : {"texture", "geometry"}) {
     LineSeries c{phase, {}, {}}, p{phase, {}, {}};
+    // A new line wherever the other phase's records came between: a line across them would show
+    // a trend no iterate had.
+    bool interrupted = false;
     for (const IterationRecord& r : records) {
-      if (r.phase != phase) continue;
+      if (r.phase != phase) {
+        interrupted = !c.x.empty();
+        continue;
+      }
+      if (interrupted) {
+        c.breaks.push_back(c.x.size());
+        p.breaks.push_back(p.x.size());
+        interrupted = false;
+      }
       c.x.push_back(r.seconds);
       c.y.push_back(r.cost);
       p.x.push_back(r.seconds);

@@ -4,17 +4,18 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "tests/testing/temp_dir.h"
+
 namespace sft {
 namespace {
 
+using testing::CountOccurrences;
 using ::testing::HasSubstr;
 using ::testing::Not;
-
-int Count(const std::string& text, const std::string& needle) {
-  int n = 0;
-  for (size_t p = text.find(needle); p != std::string::npos; p = text.find(needle, p + 1)) ++n;
-  return n;
-}
 
 TEST(LineChartTest, ScatterSeriesDrawDotsWithTooltips) {
   LineChart chart;
@@ -30,16 +31,42 @@ TEST(LineChartTest, ScatterSeriesDrawDotsWithTooltips) {
   ring.color = "#d62728";
   chart.series = {dots, ring};
   const std::string svg = LineChartSvg(chart);
-  EXPECT_EQ(Count(svg, "<polyline"), 0);
-  EXPECT_EQ(Count(svg, "<circle"), 3 + 1 + 2);  // dots, ring, two legend marks.
+  EXPECT_EQ(CountOccurrences(svg, "<polyline"), 0);
+  EXPECT_EQ(CountOccurrences(svg, "<circle"), 3 + 1 + 2);  // dots, ring, two legend marks.
   EXPECT_THAT(svg, HasSubstr("<title>a&lt;1&gt;</title>"));
   EXPECT_THAT(svg, HasSubstr("r=\"7.0\" fill=\"none\" stroke=\"#d62728\""));
   // A plain line chart keeps its polyline and draws no dots.
   LineChart plain;
   plain.series = {LineSeries{"cost", {1, 2}, {3, 4}}};
   const std::string line_svg = LineChartSvg(plain);
-  EXPECT_EQ(Count(line_svg, "<polyline"), 1);
+  EXPECT_EQ(CountOccurrences(line_svg, "<polyline"), 1);
   EXPECT_THAT(line_svg, Not(HasSubstr("<circle")));
+}
+
+// A break starts a new polyline at its point: the points before and after it are not joined. A
+// break at the first point, or one whose point is not drawn, adds no empty line.
+TEST(LineChartTest, BreaksStartNewLines) {
+  LineChart chart;
+  LineSeries phase{"texture", {1, 2, 5, 6, 9}, {1, 2, 3, 4, 5}};
+  phase.breaks = {0, 2, 4};
+  chart.series = {phase};
+  const std::string svg = LineChartSvg(chart);
+  EXPECT_EQ(CountOccurrences(svg, "<polyline"), 3);
+  // Two points, two points, one point: each line's points are its own.
+  std::vector<int> sizes;
+  for (size_t at = svg.find("points=\""); at != std::string::npos;
+       at = svg.find("points=\"", at + 1)) {
+    const size_t end = svg.find('"', at + 8);
+    sizes.push_back(CountOccurrences(svg.substr(at + 8, end - at - 8), ","));
+  }
+  EXPECT_EQ(sizes, (std::vector<int>{2, 2, 1}));
+  LineChart joined = chart;
+  joined.series[0].breaks.clear();
+  const std::string one = LineChartSvg(joined);
+  EXPECT_EQ(CountOccurrences(one, "<polyline"), 1);
+  LineChart skipped = chart;
+  skipped.series[0].y[2] = std::nan("");  // the break's own point is not drawn.
+  EXPECT_EQ(CountOccurrences(LineChartSvg(skipped), "<polyline"), 3);
 }
 
 // With a margin, the extreme points sit inside the frame instead of on it.
