@@ -32,6 +32,46 @@ double MeanPsnr(const IterationRecord& r) {
   return r.view_psnr.empty() ? 0.0 : sum / r.view_psnr.size();
 }
 
+// Cost and mean PSNR of every iteration against wall time, one series per phase.
+void AddProgressCharts(const std::vector<IterationRecord>& records, HtmlReport* html) {
+  LineChart cost;
+  cost.title = "objective against wall time";
+  cost.x_label = "seconds";
+  cost.y_label = "cost ½Σr²";
+  cost.log_y = true;
+  LineChart psnr;
+  psnr.title = "mean PSNR of the fitted views against wall time";
+  psnr.x_label = "seconds";
+  psnr.y_label = "PSNR (dB)";
+  for (const std::string phase : {"texture", "geometry"}) {
+    LineSeries c{phase, {}, {}}, p{phase, {}, {}};
+    // A new line wherever the other phase's records came between: a line across them would show
+    // a trend no iterate had.
+    bool interrupted = false;
+    for (const IterationRecord& r : records) {
+      if (r.phase != phase) {
+        interrupted = !c.x.empty();
+        continue;
+      }
+      if (interrupted) {
+        c.breaks.push_back(c.x.size());
+        p.breaks.push_back(p.x.size());
+        interrupted = false;
+      }
+      c.x.push_back(r.seconds);
+      c.y.push_back(r.cost);
+      p.x.push_back(r.seconds);
+      p.y.push_back(MeanPsnr(r));
+    }
+    if (!c.x.empty()) {
+      cost.series.push_back(c);
+      psnr.series.push_back(p);
+    }
+  }
+  html->AddSvg(LineChartSvg(cost));
+  html->AddSvg(LineChartSvg(psnr));
+}
+
 // F1 and Chamfer of the outer records against wall time (nothing without --reference).
 void AddReferenceCharts(const nlohmann::json& outer, HtmlReport* html) {
   LineSeries f1{"F1", {}, {}}, chamfer{"Chamfer", {}, {}};
@@ -238,42 +278,7 @@ Status WriteReconstructReport(const std::string& out, const Dataset& dataset,
                         {"final mean PSNR (dB, peak 1, level 0 over the active pixels)",
                          last ? FormatNumber(MeanPsnr(*last)) : "n/a"},
                         {"wall time (s)", last ? FormatNumber(last->seconds) : "n/a"}});
-  LineChart cost;
-  cost.title = "objective against wall time";
-  cost.x_label = "seconds";
-  cost.y_label = "cost ½Σr²";
-  cost.log_y = true;
-  LineChart psnr;
-  psnr.title = "mean PSNR of the fitted views against wall time";
-  psnr.x_label = "seconds";
-  psnr.y_label = "PSNR (dB)";
-  for (const std::string phase : {"texture", "geometry"}) {
-    LineSeries c{phase, {}, {}}, p{phase, {}, {}};
-    // A new line wherever the other phase's records came between: a line across them would show
-    // a trend no iterate had.
-    bool interrupted = false;
-    for (const IterationRecord& r : records) {
-      if (r.phase != phase) {
-        interrupted = !c.x.empty();
-        continue;
-      }
-      if (interrupted) {
-        c.breaks.push_back(c.x.size());
-        p.breaks.push_back(p.x.size());
-        interrupted = false;
-      }
-      c.x.push_back(r.seconds);
-      c.y.push_back(r.cost);
-      p.x.push_back(r.seconds);
-      p.y.push_back(MeanPsnr(r));
-    }
-    if (!c.x.empty()) {
-      cost.series.push_back(c);
-      psnr.series.push_back(p);
-    }
-  }
-  html.AddSvg(LineChartSvg(cost));
-  html.AddSvg(LineChartSvg(psnr));
+  AddProgressCharts(records, &html);
   AddReferenceCharts(outer_records, &html);
   SFT_RETURN_IF_ERROR(AddStages(stage_records, &html));
   AddEffectPlans(outer_records, &html);

@@ -25,8 +25,8 @@ const char kRefineSchedule[] = R"([{"name": "refine"}])";
 // that LM leaves near its floor. Geometry: Adam on the large-steps parameterisation (a new seed
 // and 8 views per step, one pyramid level, 64 spp), the specular lobe in the rendered residual
 // but out of the adjoint pass, silhouette edges on, at a step size that halves. Measured on the
-// glossy dragon over 3 seeds and on the README bunny (docs/design-notes.md, "Large steps for
-// Adam", "The warp's floor is the material's").
+// glossy dragon over 3 seeds (docs/design-notes.md, "Large steps for Adam", "The warp's floor is
+// the material's", "The warp's material stages on Adam").
 const char kLargeStepsSchedule[] = R"([
   {"name": "material", "phases": "texture", "image_scale": 0.5, "pyramid_levels": 3,
    "outer_iterations": 1, "steps": 5},

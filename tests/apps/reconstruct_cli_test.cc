@@ -24,6 +24,17 @@ using testing::RunSft;
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 
+// A refused run: exit 1 and one line holding `message`; with `out`, nothing written there.
+void ExpectRefused(const std::string& args, const std::string& message,
+                   const std::string& out = "") {
+  SCOPED_TRACE(args);
+  std::string output;
+  EXPECT_EQ(RunSft(args, &output), 1) << output;
+  EXPECT_THAT(output, HasSubstr(message));
+  EXPECT_EQ(CountLines(output), 1) << output;
+  if (!out.empty()) EXPECT_FALSE(fs::exists(out));
+}
+
 // Geometry and texture from a perturbed sphere: the run writes every output, the cost drops,
 // eval scores it, a resumed run continues from the checkpoint, render re-renders it.
 TEST(ReconstructCliTest, ReconstructEvalResume) {
@@ -224,12 +235,9 @@ TEST(ReconstructCliTest, UnknownLightingStartsWithTheEnvironmentStage) {
       1);
   EXPECT_THAT(out, HasSubstr("environment_stage/environment_size"));
   // The run fitted a world-fixed map; a resume keeps that frame (the same frame is accepted).
-  EXPECT_EQ(
-      RunSft("reconstruct --quiet --resume " + tmp.Join("o") + " --environment-frame camera", &out),
-      1);
-  EXPECT_THAT(out, HasSubstr("environment_frame camera: the run in " + tmp.Join("o") +
-                             " fits a world-fixed environment"));
-  EXPECT_EQ(CountLines(out), 1) << out;
+  ExpectRefused(
+      "reconstruct --quiet --resume " + tmp.Join("o") + " --environment-frame camera",
+      "environment_frame camera: the run in " + tmp.Join("o") + " fits a world-fixed environment");
   ASSERT_EQ(RunSft("reconstruct --quiet --no-report --resume " + tmp.Join("o") +
                        " --environment-frame world",
                    &out),
@@ -283,35 +291,24 @@ TEST(ReconstructCliTest, EstimatedLampBesideTheFittedEnvironment) {
                    &out),
             0)
       << out;
-  EXPECT_EQ(RunSft("reconstruct --quiet --resume " + tmp.Join("o") + " --estimate-lights " +
-                       tmp.Join("lamp.json"),
-                   &out),
-            1);
-  EXPECT_THAT(out, HasSubstr("--estimate-lights: a resumed run keeps its fitted lighting"));
-  EXPECT_EQ(CountLines(out), 1) << out;
+  ExpectRefused("reconstruct --quiet --resume " + tmp.Join("o") + " --estimate-lights " +
+                    tmp.Join("lamp.json"),
+                "--estimate-lights: a resumed run keeps its fitted lighting");
   ASSERT_EQ(
       RunSft("reconstruct --quiet --no-report --resume " + tmp.Join("o") + " --outer 2", &out), 0)
       << out;
 
   testing::WriteTestFile(tmp.Join("probe.json"), R"({"lights": [{"id": "room",
       "type": "environment", "image": "room.exr"}]})");
-  EXPECT_EQ(
-      RunSft(known + " --out " + tmp.Join("p") + " --estimate-lights " + tmp.Join("probe.json"),
-             &out),
-      1);
-  EXPECT_THAT(out, HasSubstr("--estimate-lights: " + tmp.Join("probe.json") +
-                             ": lights[0] (\"room\"): an environment light"));
-  EXPECT_EQ(CountLines(out), 1) << out;
-  EXPECT_FALSE(fs::exists(tmp.Join("p")));
+  ExpectRefused(known + " --out " + tmp.Join("p") + " --estimate-lights " + tmp.Join("probe.json"),
+                "--estimate-lights: " + tmp.Join("probe.json") +
+                    ": lights[0] (\"room\"): an environment light",
+                tmp.Join("p"));
   ASSERT_EQ(testing::SynthIcosphere(tmp.Join("lit"), "--cameras 1 --zooms 1 --res 8 --spp 2"), "");
-  EXPECT_EQ(RunSft("reconstruct --quiet --dataset " + tmp.Join("lit") + " --init " +
-                       tmp.Join("lit/gt/mesh.ply") + " --out " + tmp.Join("q") +
-                       " --estimate-lights " + tmp.Join("lamp.json"),
-                   &out),
-            1);
-  EXPECT_THAT(out, HasSubstr("estimate_lights: the dataset lists its lights"));
-  EXPECT_EQ(CountLines(out), 1) << out;
-  EXPECT_FALSE(fs::exists(tmp.Join("q")));
+  ExpectRefused("reconstruct --quiet --dataset " + tmp.Join("lit") + " --init " +
+                    tmp.Join("lit/gt/mesh.ply") + " --out " + tmp.Join("q") +
+                    " --estimate-lights " + tmp.Join("lamp.json"),
+                "estimate_lights: the dataset lists its lights", tmp.Join("q"));
 }
 
 // --find-lamp with no lamp given, on a capture lit by its camera's flash (0.15 to the side of the
@@ -360,36 +357,23 @@ TEST(ReconstructCliTest, FindLampWithNoGuess) {
   EXPECT_EQ(lights["lights"][0]["id"], "found_lamp");
   EXPECT_EQ(lights["lights"][0]["position"].size(), 3u) << "the environment stage fits its place";
 
-  EXPECT_EQ(RunSft("reconstruct --quiet --resume " + tmp.Join("o") + " --find-lamp", &out), 1);
-  EXPECT_THAT(out, HasSubstr("--find-lamp: a resumed run keeps its fitted lighting"));
-  EXPECT_EQ(CountLines(out), 1) << out;
+  ExpectRefused("reconstruct --quiet --resume " + tmp.Join("o") + " --find-lamp",
+                "--find-lamp: a resumed run keeps its fitted lighting");
   testing::WriteTestFile(tmp.Join("lamp.json"), R"({"lights": [{"id": "lamp", "type": "point",
       "position": [0, 0, 2], "intensity": [1, 1, 1]}]})");
-  EXPECT_EQ(RunSft(base + " --quiet --out " + tmp.Join("p") + " --estimate-lights " +
-                       tmp.Join("lamp.json"),
-                   &out),
-            1);
-  EXPECT_THAT(out, HasSubstr("--find-lamp: looks for a lamp when none is given"));
-  EXPECT_EQ(CountLines(out), 1) << out;
-  EXPECT_FALSE(fs::exists(tmp.Join("p")));
+  ExpectRefused(
+      base + " --quiet --out " + tmp.Join("p") + " --estimate-lights " + tmp.Join("lamp.json"),
+      "--find-lamp: looks for a lamp when none is given", tmp.Join("p"));
   ASSERT_EQ(testing::SynthIcosphere(tmp.Join("lit"), "--cameras 1 --zooms 1 --res 8 --spp 2"), "");
-  EXPECT_EQ(RunSft("reconstruct --quiet --dataset " + tmp.Join("lit") + " --init " +
-                       tmp.Join("lit/gt/mesh.ply") + " --out " + tmp.Join("q") + " --find-lamp",
-                   &out),
-            1);
-  EXPECT_THAT(out, HasSubstr("find_lamp: the dataset lists its lights"));
-  EXPECT_EQ(CountLines(out), 1) << out;
-  EXPECT_FALSE(fs::exists(tmp.Join("q")));
+  ExpectRefused("reconstruct --quiet --dataset " + tmp.Join("lit") + " --init " +
+                    tmp.Join("lit/gt/mesh.ply") + " --out " + tmp.Join("q") + " --find-lamp",
+                "find_lamp: the dataset lists its lights", tmp.Join("q"));
   // The search is the environment stage run once: without that stage there is none.
   testing::WriteTestFile(tmp.Join("no_stage.json"), R"({"environment_stage": false})");
-  EXPECT_EQ(RunSft("reconstruct --quiet --dataset " + tmp.Join("ds") + " --init " +
-                       tmp.Join("ds/gt/mesh.ply") + " --out " + tmp.Join("s") +
-                       " --find-lamp --config " + tmp.Join("no_stage.json"),
-                   &out),
-            1);
-  EXPECT_THAT(out, HasSubstr("find_lamp: needs the environment stage"));
-  EXPECT_EQ(CountLines(out), 1) << out;
-  EXPECT_FALSE(fs::exists(tmp.Join("s")));
+  ExpectRefused("reconstruct --quiet --dataset " + tmp.Join("ds") + " --init " +
+                    tmp.Join("ds/gt/mesh.ply") + " --out " + tmp.Join("s") +
+                    " --find-lamp --config " + tmp.Join("no_stage.json"),
+                "find_lamp: needs the environment stage", tmp.Join("s"));
 }
 
 TEST(ReconstructCliTest, BadInputIsOneLine) {
@@ -398,14 +382,10 @@ TEST(ReconstructCliTest, BadInputIsOneLine) {
   const std::string base =
       "reconstruct --quiet --dataset " + tmp.Join("ds") + " --init " + tmp.Join("ds/gt/mesh.ply");
   std::string out;
-  EXPECT_EQ(RunSft(base + " --out " + tmp.Join("ds"), &out), 1);
-  EXPECT_THAT(out, HasSubstr("--out"));
-  EXPECT_EQ(CountLines(out), 1) << out;
+  ExpectRefused(base + " --out " + tmp.Join("ds"), "--out");
   testing::WriteTestFile(tmp.Join("cfg.json"), "{\"stepz\": 3}");
-  EXPECT_EQ(RunSft(base + " --out " + tmp.Join("o") + " --config " + tmp.Join("cfg.json"), &out),
-            1);
-  EXPECT_THAT(out, HasSubstr("stepz: unknown key"));
-  EXPECT_EQ(CountLines(out), 1) << out;
+  ExpectRefused(base + " --out " + tmp.Join("o") + " --config " + tmp.Join("cfg.json"),
+                "stepz: unknown key");
   EXPECT_EQ(RunSft(base + " --out " + tmp.Join("o") + " --steps 0", &out), 1);
   EXPECT_THAT(out, HasSubstr("--steps"));
   EXPECT_EQ(RunSft(base + " --out " + tmp.Join("o") + " --solver newton", &out), 1);
@@ -418,9 +398,7 @@ TEST(ReconstructCliTest, BadInputIsOneLine) {
   testing::WriteTestFile(tmp.Join("old/state.json"),
                          "{\"format\": \"sft-reconstruct-state/1\", \"dataset\": \"" +
                              tmp.Join("ds") + "\", \"config\": {}, \"outer_done\": 1}");
-  EXPECT_EQ(RunSft("reconstruct --quiet --resume " + tmp.Join("old"), &out), 1);
-  EXPECT_THAT(out, HasSubstr("sft-reconstruct-state/1"));
-  EXPECT_EQ(CountLines(out), 1) << out;
+  ExpectRefused("reconstruct --quiet --resume " + tmp.Join("old"), "sft-reconstruct-state/1");
 }
 
 }  // namespace
