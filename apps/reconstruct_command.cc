@@ -323,11 +323,15 @@ Status RunReconstruct(const ReconstructCommandOptions& cli_in, const BeforeStart
   SFT_RETURN_IF_ERROR(PrepareSchedule(&cli, &dataset, before_start, &schedule));
   if (!schedule) return Status::Ok();  // --print-schedule.
   if (extra_metrics) schedule->SetExtraMetrics(extra_metrics);
-  Progress progress("reconstruct", schedule->RemainingWork(), !cli.quiet);
+  // The ETA prices LM and Adam steps, texture and geometry phases, each at its own rate.
+  Progress progress("reconstruct", schedule->RemainingWorkByKind(), !cli.quiet);
   ScheduleCallbacks callbacks;
   callbacks.on_iteration = [&](const IterationRecord& record) {
     progress.SetDetail(record.stage);
-    if (!record.full) progress.Advance(schedule->CurrentStepWork());  // not a step.
+    if (!record.full) {  // not a step.
+      progress.Advance(schedule->CurrentStepWork(),
+                       Schedule::WorkKindOf(schedule->CurrentStage(), record.phase));
+    }
     return !g_interrupted.load() && !(stop && stop());
   };
   callbacks.on_event = [&](const std::string& line) { progress.Note(line); };

@@ -2,29 +2,71 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
+#include <numeric>
 
 namespace sft {
+
+double RemainingSeconds(const std::vector<WorkKind>& kinds) {
+  int64_t done = 0;
+  double seconds = 0.0;
+  for (const WorkKind& kind : kinds) {
+    done += kind.done;
+    seconds += kind.seconds;
+  }
+  if (done <= 0) return 0.0;
+  const double overall_rate = seconds / static_cast<double>(done);
+  double remaining = 0.0;
+  for (const WorkKind& kind : kinds) {
+    const double rate =
+        kind.done > 0 ? kind.seconds / static_cast<double>(kind.done) : overall_rate;
+    remaining += static_cast<double>(std::max<int64_t>(0, kind.total - kind.done)) * rate;
+  }
+  return remaining;
+}
 
 Progress::Progress(std::string label, int64_t total, bool enabled)
     : label_(std::move(label)),
       total_(total > 0 ? total : 1),
       enabled_(enabled),
       start_(std::chrono::steady_clock::now()),
-      last_print_(start_) {}
+      last_print_(start_),
+      last_advance_(start_) {}
+
+Progress::Progress(std::string label, const std::vector<int64_t>& totals, bool enabled)
+    : Progress(std::move(label), std::accumulate(totals.begin(), totals.end(), int64_t{0}),
+               enabled) {
+  if (totals.size() > 1) {
+    kinds_.resize(totals.size());
+    for (size_t k = 0; k < totals.size(); ++k) kinds_[k].total = totals[k];
+  }
+}
 
 double Progress::ElapsedSeconds() const {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
 }
 
-void Progress::Advance(int64_t units) {
+void Progress::Advance(int64_t units, int kind) {
   done_ += units;
-  if (!enabled_) return;
+  if (kinds_.empty() && !enabled_) return;  // kinds_ is fixed at construction.
   const auto now = std::chrono::steady_clock::now();
   std::lock_guard<std::mutex> lock(mutex_);
+  if (!kinds_.empty()) {
+    WorkKind& k = kinds_[std::clamp(kind, 0, static_cast<int>(kinds_.size()) - 1)];
+    k.done += units;
+    k.seconds += std::chrono::duration<double>(now - last_advance_).count();
+    last_advance_ = now;
+  }
+  if (!enabled_) return;
   if (now - last_print_ < std::chrono::milliseconds(250)) return;
   last_print_ = now;
   Print(false);
+}
+
+std::vector<WorkKind> Progress::kinds() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return kinds_;
 }
 
 void Progress::Finish() {
@@ -61,7 +103,9 @@ void Progress::Print(bool final_line) {
   last_printed_ = done;
   const double elapsed = ElapsedSeconds();
   const double fraction = static_cast<double>(done) / static_cast<double>(total_);
-  const double eta = fraction > 0 ? elapsed * (1.0 - fraction) / fraction : 0.0;
+  const double eta = !kinds_.empty() ? RemainingSeconds(kinds_)
+                     : fraction > 0  ? elapsed * (1.0 - fraction) / fraction
+                                     : 0.0;
   // A carriage return keeps one line on a terminal; a log file gets one line per update.
   const bool tty = isatty(fileno(stderr));
   const std::string label = detail_.empty() ? label_ : label_ + " [" + detail_ + "]";

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <numeric>
 
 #include "src/core/file_util.h"
 #include "src/image/image_io.h"
@@ -90,24 +91,42 @@ int Schedule::WorkViews() const {
 
 int64_t Schedule::CurrentStepWork() const { return StepWork(CurrentStage(), WorkViews()); }
 
-int64_t Schedule::RemainingWork() const {
-  int64_t work = 0;
+int Schedule::WorkKindOf(const StageOptions& stage, const std::string& phase) {
+  return (stage.fit.solver.kind == SolverKind::kAdam ? 2 : 0) + (phase == "geometry" ? 1 : 0);
+}
+
+std::vector<int64_t> Schedule::RemainingWorkByKind() const {
+  std::vector<int64_t> work(kNumWorkKinds, 0);
   for (size_t s = progress_.stage; s < stages_.size(); ++s) {
     const StageOptions& stage = stages_[s];
-    const int phases = stage.fit.phases == PhaseSchedule::kAlternate ? 2 : 1;
     const int outers = stage.fit.outer_iterations -
                        (static_cast<int>(s) == progress_.stage ? progress_.stage_outer_done : 0);
-    work += static_cast<int64_t>(outers) * phases * stage.fit.solver.steps *
-            StepWork(stage, WorkViews());
+    const int64_t phase_work =
+        static_cast<int64_t>(outers) * stage.fit.solver.steps * StepWork(stage, WorkViews());
+    const bool texture = stage.fit.phases != PhaseSchedule::kGeometry;
+    const bool geometry = stage.fit.phases != PhaseSchedule::kTexture;
+    if (texture) work[WorkKindOf(stage, "texture")] += phase_work;
+    if (geometry) work[WorkKindOf(stage, "geometry")] += phase_work;
   }
   return work;
 }
 
-int64_t Schedule::TotalWork(const std::vector<StageOptions>& stages, int dataset_views) {
+int64_t Schedule::RemainingWork() const {
+  const std::vector<int64_t> work = RemainingWorkByKind();
+  return std::accumulate(work.begin(), work.end(), int64_t{0});
+}
+
+std::vector<int64_t> Schedule::TotalWorkByKind(const std::vector<StageOptions>& stages,
+                                               int dataset_views) {
   Schedule fresh;
   fresh.stages_ = stages;
   fresh.work_views_ = dataset_views;
-  return fresh.RemainingWork();
+  return fresh.RemainingWorkByKind();
+}
+
+int64_t Schedule::TotalWork(const std::vector<StageOptions>& stages, int dataset_views) {
+  const std::vector<int64_t> work = TotalWorkByKind(stages, dataset_views);
+  return std::accumulate(work.begin(), work.end(), int64_t{0});
 }
 
 Status Schedule::Start(const Dataset& dataset, const std::string& out,

@@ -154,8 +154,18 @@ class Schedule {
   static int64_t StepWork(const StageOptions& stage, int dataset_views = 0);
   // StepWork of the current stage for this run's dataset.
   int64_t CurrentStepWork() const;
-  // The work of a whole run of `stages` in the same units (RemainingWork of a fresh run).
+  // RemainingWork split by the kind of step (WorkKindOf), kNumWorkKinds entries: LM and Adam
+  // steps, texture and geometry phases cost differently per unit of StepWork (a Progress prices
+  // each kind at its own measured rate).
+  static constexpr int kNumWorkKinds = 4;
+  std::vector<int64_t> RemainingWorkByKind() const;
+  // The kind of a step of `stage`'s phase `phase` ("texture" | "geometry").
+  static int WorkKindOf(const StageOptions& stage, const std::string& phase);
+  // The work of a whole run of `stages` in the same units (RemainingWork of a fresh run), and
+  // split by kind (RemainingWorkByKind of a fresh run).
   static int64_t TotalWork(const std::vector<StageOptions>& stages, int dataset_views = 0);
+  static std::vector<int64_t> TotalWorkByKind(const std::vector<StageOptions>& stages,
+                                              int dataset_views = 0);
 
  private:
   Schedule() = default;

@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <set>
 #include <sstream>
 
 #include "src/geometry/material.h"
@@ -180,6 +181,41 @@ TEST(ScheduleConfigTest, StepWorkCountsTheMinibatchShare) {
   EXPECT_EQ(Schedule::StepWork(adam, 4), 1000);  // a batch of all views.
   adam.fit.cache.image_scale_log2 = 1;
   EXPECT_EQ(Schedule::StepWork(adam, 64), 31);  // a quarter of the pixels: 31.25, rounded.
+}
+
+// The progress work split by kind of step: an alternating LM stage gives each phase its steps, an
+// Adam texture stage its minibatch share, and the kinds add up to the total.
+TEST(ScheduleConfigTest, WorkIsSplitByKindOfStep) {
+  ScheduleConfig config;
+  ASSERT_TRUE(MergeScheduleConfig(json::parse(R"({"stages": [
+      {"name": "both", "phases": "alternate", "outer_iterations": 2, "steps": 3},
+      {"name": "adam", "phases": "texture", "solver": "adam", "steps": 10,
+       "adam_views_per_step": 8, "outer_iterations": 1},
+      {"name": "shape", "phases": "geometry", "solver": "adam", "steps": 4,
+       "adam_views_per_step": 8, "outer_iterations": 1, "image_scale": 0.5}]})"),
+                                  "test", &config)
+                  .ok());
+  std::vector<StageOptions> stages;
+  ASSERT_TRUE(ResolveStages(config, /*carved_start=*/false, &stages).ok());
+  const std::vector<int64_t> work = Schedule::TotalWorkByKind(stages, 64);
+  ASSERT_EQ(work.size(), static_cast<size_t>(Schedule::kNumWorkKinds));
+  const int lm_texture = Schedule::WorkKindOf(stages[0], "texture");
+  const int lm_geometry = Schedule::WorkKindOf(stages[0], "geometry");
+  const int adam_texture = Schedule::WorkKindOf(stages[1], "texture");
+  const int adam_geometry = Schedule::WorkKindOf(stages[2], "geometry");
+  EXPECT_EQ(std::set<int>({lm_texture, lm_geometry, adam_texture, adam_geometry}).size(), 4u);
+  // A full-scale step at the default 16 spp is 1000 units; an Adam step of 8 of 64 views 125, at
+  // half scale a quarter of that (31).
+  const int spp = stages[0].fit.cache.render.spp;
+  const int64_t full = Schedule::StepWork(stages[0], 64);
+  EXPECT_EQ(full, std::llround(1000.0 * spp / 16.0));
+  EXPECT_EQ(work[lm_texture], 2 * 3 * full);
+  EXPECT_EQ(work[lm_geometry], 2 * 3 * full);
+  EXPECT_EQ(work[adam_texture], 10 * Schedule::StepWork(stages[1], 64));
+  EXPECT_EQ(work[adam_geometry], 4 * Schedule::StepWork(stages[2], 64));
+  EXPECT_LT(Schedule::StepWork(stages[2], 64), Schedule::StepWork(stages[1], 64));
+  EXPECT_EQ(Schedule::TotalWork(stages, 64),
+            work[lm_texture] + work[lm_geometry] + work[adam_texture] + work[adam_geometry]);
 }
 
 TEST(ScheduleConfigTest, BuiltInListsFollowTheStart) {
@@ -403,16 +439,26 @@ TEST_F(ScheduleRunTest, StagesRunInOrderWithCheckpoints) {
   ScheduleCallbacks callbacks;
   callbacks.on_event = [&](const std::string& line) { events.push_back(line); };
   const int64_t work = schedule->RemainingWork();
+  const std::vector<int64_t> work_by_kind = schedule->RemainingWorkByKind();
   int64_t done = 0;
+  std::vector<int64_t> done_by_kind(Schedule::kNumWorkKinds, 0);
   callbacks.on_iteration = [&](const IterationRecord& r) {
     done += schedule->CurrentStepWork();
+    done_by_kind[Schedule::WorkKindOf(schedule->CurrentStage(), r.phase)] +=
+        schedule->CurrentStepWork();
     return true;
   };
   ASSERT_TRUE(schedule->Run(callbacks).ok());
   EXPECT_TRUE(schedule->finished());
-  // The weights add up to at most the ETA's total (a solve may stop early when it converges).
+  // The weights add up to at most the ETA's total (a solve may stop early when it converges),
+  // kind by kind as the progress line prices them; nothing is left once the run is finished.
   EXPECT_LE(done, work);
   EXPECT_GT(done, work / 2);
+  for (int k = 0; k < Schedule::kNumWorkKinds; ++k) {
+    EXPECT_LE(done_by_kind[k], work_by_kind[k]) << "kind " << k;
+    EXPECT_EQ(done_by_kind[k] == 0, work_by_kind[k] == 0) << "kind " << k;
+  }
+  EXPECT_EQ(schedule->RemainingWork(), 0);
   // One line per stage start, one per texel-resolution change (the second stage doubles it),
   // and the effect planner's (the default "effects": "auto"): the convex icosphere does not
   // shadow itself, so the first plan drops shadows and later plans change nothing.
