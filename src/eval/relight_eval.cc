@@ -69,7 +69,7 @@ Status SideCondition(const Dataset& dataset, const Eigen::Vector3d& centre, Reli
 
 // A folder name for condition k: "NN_name" with unsafe characters replaced.
 std::string ConditionFolder(size_t k, const std::string& name) {
-  char prefix[16];
+  char prefix[32];  // room for any size_t.
   std::snprintf(prefix, sizeof(prefix), "%02zu_", k);
   std::string safe = name;
   for (char& ch : safe) {

@@ -32,7 +32,9 @@ void ExpectRefused(const std::string& args, const std::string& message,
   EXPECT_EQ(RunSft(args, &output), 1) << output;
   EXPECT_THAT(output, HasSubstr(message));
   EXPECT_EQ(CountLines(output), 1) << output;
-  if (!out.empty()) EXPECT_FALSE(fs::exists(out));
+  if (!out.empty()) {
+    EXPECT_FALSE(fs::exists(out));
+  }
 }
 
 // Geometry and texture from a perturbed sphere: the run writes every output, the cost drops,

@@ -128,7 +128,9 @@ TEST_F(SweepCommandTest, InterruptedAndKilledSweepsContinue) {
     EXPECT_GT(trajectory[k]["chamfer"].get<double>(), 0.0);
     EXPECT_GT(trajectory[k]["f1"].get<double>(), 0.0);
     EXPECT_EQ(trajectory[k]["chamfer"], metrics["outer"][k]["chamfer"]);
-    if (k > 0) EXPECT_GE(trajectory[k]["seconds"], trajectory[k - 1]["seconds"]);
+    if (k > 0) {
+      EXPECT_GE(trajectory[k]["seconds"], trajectory[k - 1]["seconds"]);
+    }
   }
   // spp 16 and bounces 2 are the configuration's own values: the default cell.
   EXPECT_TRUE(cells.at("02_bounces2_spp16")["default"].get<bool>());

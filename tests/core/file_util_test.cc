@@ -42,7 +42,7 @@ TEST(FileUtilTest, OutputDirectoryNeverOverlapsInputs) {
   auto check = [&](const std::string& out) { return CheckOutputDirectory(out, inputs, "--out"); };
   EXPECT_TRUE(check((root / "out").string()).ok());
   EXPECT_TRUE(check((root / "new/deeper/out").string()).ok());
-  for (const std::string bad :
+  for (const std::string& bad :
        {(root / "ds").string(), (root / "ds/").string(), (root / "./ds/").string(),
         (root / "link").string(), (root / "link/").string(), (root / "ds/images").string(),
         (root / "ds/new").string(), root.string(), (root / "out/../ds").string(), std::string()}) {

@@ -42,7 +42,9 @@ TEST(EffectPlanTest, SwitchesMapOntoRenderOptionsAndBudgets) {
     const EffectPlan without = plan.Without(name);
     EXPECT_FALSE(without.IsOn(name)) << name;
     for (const std::string& other : PlannerSwitches()) {
-      if (other != name) EXPECT_TRUE(without.IsOn(other)) << name << " turned off " << other;
+      if (other != name) {
+        EXPECT_TRUE(without.IsOn(other)) << name << " turned off " << other;
+      }
     }
   }
   EXPECT_EQ(plan.Without("bounces").bounces, 1);

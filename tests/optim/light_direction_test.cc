@@ -124,7 +124,9 @@ double FitDirection(const std::string& dataset_dir, bool material_too) {
   EXPECT_TRUE(ReadLightScales(lights, dataset, &scales, &positions, &read).ok());
   EXPECT_TRUE(positions.empty());
   EXPECT_EQ(read.size(), 1u);
-  if (read.size() == 1) EXPECT_LT((read[0] - fitted[0].normalized()).norm(), 1e-12);
+  if (read.size() == 1) {
+    EXPECT_LT((read[0] - fitted[0].normalized()).norm(), 1e-12);
+  }
   EXPECT_TRUE(ApplyLightsFile(lights, &dataset).ok());
   EXPECT_LT((dataset.lights[0].direction - fitted[0].normalized()).norm(), 1e-12);
   return after;

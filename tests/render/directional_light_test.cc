@@ -101,7 +101,9 @@ TEST(DirectionalLightTest, OccluderCastsAShadowOfItsOwnSizeShiftedByHeightTimesT
     for (int i = 0; i < res; ++i) {
       const double x = pixel * (i + 0.5 - 0.5 * res), y = -pixel * (j + 0.5 - 0.5 * res);
       const double value = image.at(i, j, 0);
-      if (x < -1.0) EXPECT_NEAR(value, lit, 1e-6 * lit) << i << ", " << j;  // far from both.
+      if (x < -1.0) {  // far from both.
+        EXPECT_NEAR(value, lit, 1e-6 * lit) << i << ", " << j;
+      }
       if (x < 0.3) continue;
       const double shadow = (1.0 - value / lit) * pixel * pixel;
       area += shadow;

@@ -166,7 +166,9 @@ TEST(EdgeTreeTest, OneCutServesEveryDrawAtItsPoint) {
     const int j = tree.Sample(cut, u, &p_cut);
     EXPECT_EQ(j, tree.Sample(x, n, u, &p_single));
     EXPECT_EQ(p_cut, p_single);
-    if (j >= 0) EXPECT_EQ(tree.Probability(cut, j), p_cut);
+    if (j >= 0) {
+      EXPECT_EQ(tree.Probability(cut, j), p_cut);
+    }
   }
   ExpectConsistent(tree, x, n);
 }

@@ -105,9 +105,15 @@ void LightDerivativeCheck::ExpectMatches(const char* name, double pixel_toleranc
   std::printf("%s: pixel error %.2e, block error %.4f, sum error %.4f (fd sum %.5g)\n", name,
               r.pixel_error, r.block_error, r.sum_error, r.fd_sum);
   ASSERT_GT(std::abs(r.fd_sum), 0.0) << name << ": the perturbation does not change the image";
-  if (pixel_tolerance > 0) EXPECT_LT(r.pixel_error, pixel_tolerance) << name;
-  if (block_tolerance > 0) EXPECT_LT(r.block_error, block_tolerance) << name;
-  if (sum_tolerance > 0) EXPECT_LT(r.sum_error, sum_tolerance) << name;
+  if (pixel_tolerance > 0) {
+    EXPECT_LT(r.pixel_error, pixel_tolerance) << name;
+  }
+  if (block_tolerance > 0) {
+    EXPECT_LT(r.block_error, block_tolerance) << name;
+  }
+  if (sum_tolerance > 0) {
+    EXPECT_LT(r.sum_error, sum_tolerance) << name;
+  }
   EXPECT_NEAR(r.adjoint, r.weighted, 1e-5 * r.weighted_abs + 1e-12) << name;
   if (!shadows) return;
   for (const bool secondary : {false, true}) {
@@ -117,7 +123,9 @@ void LightDerivativeCheck::ExpectMatches(const char* name, double pixel_toleranc
     std::printf("%s without %s: block error %.4f, sum error %.4f\n", name,
                 secondary ? "secondary edges" : "shadow edges", without.block_error,
                 without.sum_error);
-    if (!secondary) EXPECT_GT(without.block_error, 2.0 * r.block_error) << name;
+    if (!secondary) {
+      EXPECT_GT(without.block_error, 2.0 * r.block_error) << name;
+    }
   }
 }
 
