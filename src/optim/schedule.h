@@ -159,7 +159,8 @@ class Schedule {
   // each kind at its own measured rate).
   static constexpr int kNumWorkKinds = 4;
   std::vector<int64_t> RemainingWorkByKind() const;
-  // The kind of a step of `stage`'s phase `phase` ("texture" | "geometry").
+  // The kind of a step of `stage`'s phase `phase` ("texture" | "geometry"): Ceres' solvers (LM,
+  // dogleg, L-BFGS: 0 texture, 1 geometry) or Adam (2, 3).
   static int WorkKindOf(const StageOptions& stage, const std::string& phase);
   // The work of a whole run of `stages` in the same units (RemainingWork of a fresh run), and
   // split by kind (RemainingWorkByKind of a fresh run).
