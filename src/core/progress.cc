@@ -9,18 +9,18 @@
 namespace sft {
 
 double RemainingSeconds(const std::vector<WorkKind>& kinds) {
-  int64_t done = 0;
+  int64_t timed = 0;
   double seconds = 0.0;
   for (const WorkKind& kind : kinds) {
-    done += kind.done;
+    timed += kind.timed;
     seconds += kind.seconds;
   }
-  if (done <= 0) return 0.0;
-  const double overall_rate = seconds / static_cast<double>(done);
+  if (timed <= 0) return 0.0;
+  const double overall_rate = seconds / static_cast<double>(timed);
   double remaining = 0.0;
   for (const WorkKind& kind : kinds) {
     const double rate =
-        kind.done > 0 ? kind.seconds / static_cast<double>(kind.done) : overall_rate;
+        kind.timed > 0 ? kind.seconds / static_cast<double>(kind.timed) : overall_rate;
     remaining += static_cast<double>(std::max<int64_t>(0, kind.total - kind.done)) * rate;
   }
   return remaining;
@@ -54,8 +54,11 @@ void Progress::Advance(int64_t units, int kind) {
   std::lock_guard<std::mutex> lock(mutex_);
   if (!kinds_.empty()) {
     WorkKind& k = kinds_[std::clamp(kind, 0, static_cast<int>(kinds_.size()) - 1)];
+    if (k.done > 0) {  // not the kind's first step (WorkKind).
+      k.timed += units;
+      k.seconds += std::chrono::duration<double>(now - last_advance_).count();
+    }
     k.done += units;
-    k.seconds += std::chrono::duration<double>(now - last_advance_).count();
     last_advance_ = now;
   }
   if (!enabled_) return;
@@ -103,9 +106,11 @@ void Progress::Print(bool final_line) {
   last_printed_ = done;
   const double elapsed = ElapsedSeconds();
   const double fraction = static_cast<double>(done) / static_cast<double>(total_);
-  const double eta = !kinds_.empty() ? RemainingSeconds(kinds_)
-                     : fraction > 0  ? elapsed * (1.0 - fraction) / fraction
-                                     : 0.0;
+  bool timed = false;
+  for (const WorkKind& kind : kinds_) timed = timed || kind.timed > 0;
+  const double eta = timed          ? RemainingSeconds(kinds_)
+                     : fraction > 0 ? elapsed * (1.0 - fraction) / fraction
+                                    : 0.0;
   // A carriage return keeps one line on a terminal; a log file gets one line per update.
   const bool tty = isatty(fileno(stderr));
   const std::string label = detail_.empty() ? label_ : label_ + " [" + detail_ + "]";

@@ -17,16 +17,20 @@
 
 namespace sft {
 
-// One kind of work: its units in all, the units done, and the wall seconds spent on them.
+// One kind of work: its units in all, the units done, and of those the units whose wall time is
+// measured (`timed`, taking `seconds`). A kind's first step is done but not timed: it carries the
+// set-up of whatever started it (a run's loading, a stage's first renders), which the remaining
+// steps of the kind do not repeat.
 struct WorkKind {
   int64_t total = 0;
   int64_t done = 0;
+  int64_t timed = 0;
   double seconds = 0.0;
 };
 
 // Seconds left: each kind's remaining units (total − done, at least 0) at its own rate
-// (seconds / done), or, for a kind with nothing done yet, at the rate over all kinds done so
-// far. 0 when nothing is done anywhere (no rate to extrapolate).
+// (seconds / timed), or, for a kind with nothing timed yet, at the rate over all kinds' timed
+// units. 0 when nothing is timed anywhere (no rate to extrapolate).
 double RemainingSeconds(const std::vector<WorkKind>& kinds);
 
 class Progress {
@@ -35,7 +39,9 @@ class Progress {
   // `enabled` is false (tests, --quiet).
   Progress(std::string label, int64_t total, bool enabled = true);
   // Work of `totals.size()` kinds (units of kind k: totals[k]); Advance names the kind. The
-  // wall time between two Advance calls is the advancing kind's (RemainingSeconds prices it).
+  // wall time between two Advance calls is the advancing kind's, except for its first Advance
+  // (WorkKind); RemainingSeconds prices the rest, and until some kind has been timed the ETA is
+  // the single-rate one.
   Progress(std::string label, const std::vector<int64_t>& totals, bool enabled = true);
   // `kind` in [0, number of kinds); 0 for single-kind progress.
   void Advance(int64_t units = 1, int kind = 0);
