@@ -1,5 +1,6 @@
 #include "src/core/progress.h"
 
+#include <glog/logging.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -53,7 +54,8 @@ void Progress::Advance(int64_t units, int kind) {
   const auto now = std::chrono::steady_clock::now();
   std::lock_guard<std::mutex> lock(mutex_);
   if (!kinds_.empty()) {
-    WorkKind& k = kinds_[std::clamp(kind, 0, static_cast<int>(kinds_.size()) - 1)];
+    CHECK(kind >= 0 && kind < static_cast<int>(kinds_.size())) << "no work kind " << kind;
+    WorkKind& k = kinds_[kind];
     if (k.done > 0) {  // not the kind's first step (WorkKind).
       k.timed += units;
       k.seconds += std::chrono::duration<double>(now - last_advance_).count();

@@ -43,7 +43,7 @@ class Progress {
   // (WorkKind); RemainingSeconds prices the rest, and until some kind has been timed the ETA is
   // the single-rate one.
   Progress(std::string label, const std::vector<int64_t>& totals, bool enabled = true);
-  // `kind` in [0, number of kinds); 0 for single-kind progress.
+  // `kind` in [0, number of kinds) (CHECKed); 0 for single-kind progress.
   void Advance(int64_t units = 1, int kind = 0);
   void Finish();
   double ElapsedSeconds() const;
