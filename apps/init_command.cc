@@ -97,6 +97,7 @@ nlohmann::ordered_json Summary(const std::string& mesh_path, const std::string& 
       {"voxel_size", r.box.voxel_size},
       {"voxels", {r.box.dims.x(), r.box.dims.y(), r.box.dims.z()}},
       {"min_views", r.min_views},
+      {"outlier_views", r.outlier_views},
       {"inside_voxels", r.inside_voxels},
       {"extracted_triangles", r.extracted_triangles},
       {"components", r.cleanup.components},
@@ -213,6 +214,13 @@ CommandRunner SetupInitCommand(CLI::App* app) {
                       std::to_string(InitialMeshOptions::kMinFaces) + ", " +
                       std::to_string(InitialMeshOptions::kMaxFaces) + "]")
       ->capture_default_str();
+  app->add_option("--outlier-views", opts->mesh.hull.outlier_views,
+                  "Views whose 'outside' a point may overrule: a point is carved away only when "
+                  "more than this many of the views that see it put it outside their masks (0: "
+                  "the exact visual hull; 1-2 keep what one or two wrong masks cut away), [0, " +
+                      std::to_string(VisualHullOptions::kMaxOutlierViews) + "]")
+      ->capture_default_str()
+      ->check(CLI::Range(0, VisualHullOptions::kMaxOutlierViews));
   app->add_option("--points", opts->points,
                   "Sparse points (PLY, world frame) to check the hull against (default: "
                   "scene.json's sparse_points, else sparse/points3D.ply if present)");

@@ -101,6 +101,7 @@ Status MakeInitialMesh(const std::vector<CarvingView>& views, const InitialMeshO
   report->carve_seconds = SecondsSince(start);
   report->box = hull.box;
   report->min_views = hull.min_views;
+  report->outlier_views = options.hull.outlier_views;
   report->inside_voxels = hull.inside_voxels;
   CheckSparsePoints(hull, sparse_points, report);
 

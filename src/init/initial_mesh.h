@@ -44,6 +44,7 @@ constexpr double kInsidePointVoxels = 2.0;
 struct InitialMeshReport {
   VoxelBox box;           // the carving grid.
   int min_views = 0;      // views that must see a voxel.
+  int outlier_views = 0;  // views whose "outside" a voxel may overrule (VisualHullOptions).
   int inside_voxels = 0;  // voxels inside the hull.
   int extracted_triangles = 0;
   SurfaceCleanupReport cleanup;

@@ -9,6 +9,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <exception>
@@ -36,12 +37,15 @@ float SampleMap(const std::vector<float>& map, int width, int height, const Eige
   return top + fy * (bottom - top);
 }
 
-// The field value at `p` (see the header): max over the views that see p of the scaled distance,
-// clamped to [-band, band]; +band when fewer than `min_views` views see p. Stops early once the
-// value reaches +band (a maximum cannot come down again).
+// The field value at `p` (see the header): the (outliers+1)-th largest over the views that see p
+// of the scaled distance (the maximum when outliers is 0), clamped to [-band, band]; +band when
+// fewer than `min_views` views see p. Stops early once that value reaches +band (it cannot come
+// down again).
 float FieldAt(const std::vector<CarvingView>& views, const Eigen::Vector3d& p, double band,
-              int min_views) {
-  double value = -band;
+              int min_views, int outliers) {
+  // top[0] >= top[1] >= … >= top[outliers]: the largest values so far.
+  std::array<double, VisualHullOptions::kMaxOutlierViews + 1> top;
+  top.fill(-band);
   int seen = 0;
   for (const CarvingView& view : views) {
     const Eigen::Vector3d p_in_cam = view.cam_from_world * p;
@@ -54,25 +58,28 @@ float FieldAt(const std::vector<CarvingView>& views, const Eigen::Vector3d& p, d
       continue;
     }
     ++seen;
-    const double d = SampleMap(view.distance, camera.width, camera.height, px) * p_in_cam.z() *
-                     view.world_per_pixel_at_unit_depth;
-    value = std::max(value, d);
-    if (value >= band) return static_cast<float>(band);
+    double d = SampleMap(view.distance, camera.width, camera.height, px) * p_in_cam.z() *
+               view.world_per_pixel_at_unit_depth;
+    for (int i = 0; i <= outliers && d > top[outliers]; ++i) {
+      if (d > top[i]) std::swap(d, top[i]);
+    }
+    if (top[outliers] >= band) return static_cast<float>(band);
   }
   if (seen < min_views) return static_cast<float>(band);
-  return static_cast<float>(std::clamp(value, -band, band));
+  return static_cast<float>(std::clamp(top[outliers], -band, band));
 }
 
 // Evaluates the field over `box` in parallel over z slices, advancing `progress` once per slice.
 std::vector<float> EvaluateField(const std::vector<CarvingView>& views, const VoxelBox& box,
-                                 double band, int min_views, Progress* progress) {
+                                 double band, int min_views, int outliers, Progress* progress) {
   const int nx = box.dims.x(), ny = box.dims.y(), nz = box.dims.z();
   std::vector<float> field(static_cast<size_t>(box.NumVoxels()));
   tbb::parallel_for(tbb::blocked_range<int>(0, nz, 1), [&](const tbb::blocked_range<int>& r) {
     for (int k = r.begin(); k < r.end(); ++k) {
       for (int j = 0; j < ny; ++j) {
         float* row = field.data() + (static_cast<size_t>(k) * ny + j) * nx;
-        for (int i = 0; i < nx; ++i) row[i] = FieldAt(views, box.Centre(i, j, k), band, min_views);
+        for (int i = 0; i < nx; ++i)
+          row[i] = FieldAt(views, box.Centre(i, j, k), band, min_views, outliers);
       }
       if (progress != nullptr) progress->Advance();
     }
@@ -89,7 +96,8 @@ bool FindCarvingBox(const std::vector<CarvingView>& views, const VisualHullOptio
   coarse.lo = Eigen::Vector3d::Constant(-options.bounds);
   coarse.dims = Eigen::Vector3i::Constant(kCoarseResolution);
   const double band = kBandVoxels * coarse.voxel_size;
-  const std::vector<float> field = EvaluateField(views, coarse, band, min_views, progress);
+  const std::vector<float> field =
+      EvaluateField(views, coarse, band, min_views, options.outlier_views, progress);
   const double touch = 0.5 * std::sqrt(3.0) * coarse.voxel_size;
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
   Eigen::Vector3d hi = -lo;
@@ -133,6 +141,11 @@ bool VisualHullOptions::Check(std::string* why) const {
   }
   if (!(bounds > 0 && bounds < 1e6)) {
     *why = "bounds: must be in (0, 1e6)";
+    return false;
+  }
+  if (outlier_views < 0 || outlier_views > kMaxOutlierViews) {
+    *why = "outlier_views: must be in [0, " + std::to_string(kMaxOutlierViews) + "], got " +
+           std::to_string(outlier_views);
     return false;
   }
   return true;
@@ -198,8 +211,11 @@ Status CarveVisualHull(const std::vector<CarvingView>& views, const VisualHullOp
   if (!options.Check(&why)) return Status::Error(why);
   if (views.empty()) return Status::Error("no views to carve with");
   const int num_views = static_cast<int>(views.size());
-  const int min_views = std::clamp(
-      static_cast<int>(std::ceil(options.min_view_fraction * num_views - 1e-9)), 2, num_views);
+  // Overruling t views leaves a point to the others, so at least t + 2 must see it.
+  const int min_views =
+      std::clamp(std::max(static_cast<int>(std::ceil(options.min_view_fraction * num_views - 1e-9)),
+                          options.outlier_views + 2),
+                 2, num_views);
   VoxelBox box;
   if (!FindCarvingBox(views, options, min_views, progress, &box)) {
     return Status::Error("the visual hull is empty: no point of [-" +
@@ -211,7 +227,7 @@ Status CarveVisualHull(const std::vector<CarvingView>& views, const VisualHullOp
   hull->box = box;
   hull->band = kBandVoxels * box.voxel_size;
   hull->min_views = min_views;
-  hull->field = EvaluateField(views, box, hull->band, min_views, progress);
+  hull->field = EvaluateField(views, box, hull->band, min_views, options.outlier_views, progress);
   // The progress total counts `resolution` fine slices; the box may have fewer along z.
   if (progress != nullptr) progress->Advance(options.resolution - box.dims.z());
   hull->inside_voxels = static_cast<int>(

@@ -14,7 +14,10 @@
 //
 // Who carves. A view that does not see p says nothing about it. A point seen by fewer than
 // `min_views` views is outside: a single cone is unbounded, so a point that only one or two views
-// see is not evidence of the object (e.g. the far corners of the box).
+// see is not evidence of the object (e.g. the far corners of the box). With `outlier_views` t > 0
+// the field is the (t+1)-th largest value instead of the maximum: the t views that put p farthest
+// outside are overruled (a robust visual hull; its zero level set is where all but t of the
+// seeing views agree).
 //
 // The carving box. A coarse pass (kCoarseResolution³ voxels) evaluates the same field over the
 // generous box [-bounds, bounds]³ (datasets are normalised: the object is centred with a
@@ -40,11 +43,19 @@ namespace sft {
 struct VisualHullOptions {
   // Voxels along the longest side of the carving box, [16, 1024].
   int resolution = 128;
-  // A point must be seen by at least this fraction of the views (rounded up, at least 2, at most
-  // all views) to be part of the hull, (0, 1].
+  // A point must be seen by at least this fraction of the views (rounded up, at least 2 and at
+  // least outlier_views + 2, at most all views) to be part of the hull, (0, 1].
   double min_view_fraction = 0.25;
   // Half side of the generous box [-bounds, bounds]³ that is carved (scene units), > 0.
   double bounds = 1.0;
+  // Views whose verdict "outside" a point may overrule, [0, kMaxOutlierViews]: a point stays in
+  // the hull unless more than this many of the views that see it put it outside their masks. 0 is
+  // the exact visual hull; 1 or 2 keep object parts that one or two wrong masks cut away (a
+  // shadow thresholded as background, a GrabCut miss), at the price of what only that many views
+  // would have carved.
+  int outlier_views = 0;
+
+  static constexpr int kMaxOutlierViews = 8;
 
   static constexpr int kMinResolution = 16;
   static constexpr int kMaxResolution = 1024;

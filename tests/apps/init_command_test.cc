@@ -135,6 +135,20 @@ TEST(InitCommandTest, SparsePointsAreCountedAgainstTheHull) {
   EXPECT_EQ(summary["points_outside_hull"], 2);
   EXPECT_EQ(summary["points_outside_box"], 1);
   EXPECT_EQ(summary["points_inside_hull"], 1);
+  EXPECT_EQ(summary["outlier_views"], 0);
+  // Overruling one view: reported, and a point needs the overruled view plus two that agree.
+  ASSERT_EQ(
+      RunSft("init --quiet --overwrite --dataset " + d + " --out " + tmp.Join("o") +
+                 " --resolution 48 --faces 300 --outlier-views 1 --points " + tmp.Join("p.ply"),
+             &out),
+      0)
+      << out;
+  const nlohmann::json overruled = nlohmann::json::parse(out.substr(out.find('{')));
+  EXPECT_EQ(overruled["outlier_views"], 1);
+  EXPECT_GE(overruled["min_views"], 3);
+  // It never carves more (a superset in a box at least as large, so voxels at least as large): no
+  // point is outside that the exact hull has inside.
+  EXPECT_LE(overruled["points_outside_hull"], summary["points_outside_hull"]);
 }
 
 TEST(InitCommandTest, ErrorsAreOneLine) {
@@ -149,6 +163,7 @@ TEST(InitCommandTest, ErrorsAreOneLine) {
       {"--resolution 8", "--resolution: must be in [16, 1024], got 8"},
       {"--resolution 2000", "--resolution: must be in [16, 1024], got 2000"},
       {"--faces 50", "--faces: must be in [100, 50000000], got 50"},
+      {"--outlier-views 9", "--outlier-views: Value 9 not in range 0 to 8"},
       {"--points " + tmp.Join("missing.ply"), "missing.ply"},
   };
   for (const Case& c : cases) {
