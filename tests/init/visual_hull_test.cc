@@ -59,6 +59,21 @@ std::vector<CarvingView> SphereViews(int n, int res) {
   return views;
 }
 
+// The hull's surface as a closed mesh (OpenVDB extraction and the clean-up).
+TriMesh HullMesh(const VisualHull& hull, SurfaceCleanupReport* report) {
+  std::vector<Eigen::Vector3d> points;
+  std::vector<Eigen::Vector3i> triangles;
+  EXPECT_TRUE(ExtractHullSurface(hull, &points, &triangles).ok());
+  TriMesh mesh;
+  EXPECT_TRUE(BuildClosedSurface(points, triangles, &mesh, report).ok());
+  return mesh;
+}
+
+double HullVolume(const VisualHull& hull) {
+  SurfaceCleanupReport report;
+  return EnclosedVolume(HullMesh(hull, &report));
+}
+
 TEST(VisualHullTest, SphereFromManyViewsIsTheSphere) {
   const std::vector<CarvingView> views = SphereViews(60, 160);
   VisualHullOptions options;
@@ -70,12 +85,8 @@ TEST(VisualHullTest, SphereFromManyViewsIsTheSphere) {
   // The box hugs the sphere: its side is the diameter plus at most ~3 coarse voxels.
   EXPECT_GT(h * hull.box.dims.maxCoeff(), 2 * kRadius);
   EXPECT_LT(h * hull.box.dims.maxCoeff(), 2 * kRadius + 4 * (2.0 / kCoarseResolution));
-  std::vector<Eigen::Vector3d> points;
-  std::vector<Eigen::Vector3i> triangles;
-  ASSERT_TRUE(ExtractHullSurface(hull, &points, &triangles).ok());
-  TriMesh mesh;
   SurfaceCleanupReport report;
-  ASSERT_TRUE(BuildClosedSurface(points, triangles, &mesh, &report).ok());
+  const TriMesh mesh = HullMesh(hull, &report);
   EXPECT_EQ(report.components, 1);
   double max_error = 0, sum_error = 0;
   for (auto vh : mesh.vertices()) {
@@ -96,17 +107,6 @@ TEST(VisualHullTest, SphereFromManyViewsIsTheSphere) {
   EXPECT_LT(SampleHull(hull, Eigen::Vector3d::Zero()), -2 * h);
   EXPECT_GT(SampleHull(hull, Eigen::Vector3d(kRadius + 3 * h, 0, 0)), h);
   EXPECT_NEAR(SampleHull(hull, Eigen::Vector3d(0, kRadius, 0)), 0.0, 0.5 * h);
-}
-
-// The enclosed volume of a hull's surface.
-double HullVolume(const VisualHull& hull) {
-  std::vector<Eigen::Vector3d> points;
-  std::vector<Eigen::Vector3i> triangles;
-  EXPECT_TRUE(ExtractHullSurface(hull, &points, &triangles).ok());
-  TriMesh mesh;
-  SurfaceCleanupReport report;
-  EXPECT_TRUE(BuildClosedSurface(points, triangles, &mesh, &report).ok());
-  return EnclosedVolume(mesh);
 }
 
 // One wrong mask (a disc through the sphere's middle cut away, as a shadow thresholded to
