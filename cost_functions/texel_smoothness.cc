@@ -92,9 +92,14 @@ int AddTexelSmoothness(const std::vector<TexelPair>& pairs, int channels,
         << "AddTexelSmoothness: pair (" << p.a << ", " << p.b << ") out of range";
     const double w = p.cross_face ? options.weight * options.cross_face_weight : options.weight;
     if (w == 0.0) continue;
-    ceres::CostFunction* cost =
-        channels == 3 ? static_cast<ceres::CostFunction*>(new TexelDifferenceCost<3>(w))
-                      : new TexelDifferenceCost<1>(w);
+    ceres::CostFunction* cost = nullptr;
+    if (options.log_ratio) {
+      cost = channels == 3 ? static_cast<ceres::CostFunction*>(new TexelLogRatioCost<3>(w))
+                           : new TexelLogRatioCost<1>(w);
+    } else {
+      cost = channels == 3 ? static_cast<ceres::CostFunction*>(new TexelDifferenceCost<3>(w))
+                           : new TexelDifferenceCost<1>(w);
+    }
     problem->AddResidualBlock(cost, nullptr, texel_blocks[p.a], texel_blocks[p.b]);
     ++added;
   }

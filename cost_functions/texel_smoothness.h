@@ -8,6 +8,19 @@
 // Jacobians: ∂r/∂t_a = w·I_C, ∂r/∂t_b = −w·I_C (exact: the residual is linear).
 // Evaluate never returns false. Derivative terms it does not have: none.
 //
+// The log-ratio form (TexelSmoothnessOptions::log_ratio; TexelLogRatioCost):
+//
+//   r = w · kLogRatioReference · (log(t_a + kLogRatioEpsilon) − log(t_b + kLogRatioEpsilon))
+//
+// with ∂r/∂t_a = w·kLogRatioReference / (t_a + ε)·I_C and ∂r/∂t_b the negative at t_b (exact).
+// It is invariant when every texel is scaled by one factor (up to ε), so a fit that can trade the
+// albedo's scale against another parameter's (a fitted light's scale: the images see only the
+// product) is not pulled towards a dark albedo by the prior. The linear form shrinks with the
+// scale squared and drives that trade without bound (docs/design-notes.md, "The video road's
+// albedo on the true mesh"). At t = kLogRatioReference both forms have the same Jacobian; darker
+// texels are tied more strongly, brighter ones less (differences are relative). Bounds keep t ≥ 0,
+// so the log stays finite. Evaluate never returns false.
+//
 // Which texels are neighbours (TexelNeighbourPairs), in the layout of src/geometry/mesh_colors.h
 // (texel (i, j) of a face, i + j ≤ r, owns the points with (floor(rα), floor(rβ)) = (i, j)):
 //   * within a face, the three grid neighbours (i, j)–(i+1, j), (i, j)–(i, j+1) and
@@ -36,6 +49,7 @@
 #include <ceres/problem.h>
 #include <ceres/sized_cost_function.h>
 
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -69,6 +83,39 @@ class TexelDifferenceCost : public ceres::SizedCostFunction<kChannels, kChannels
   double weight_;
 };
 
+// The log-ratio form's reference value (where it matches the linear form) and offset.
+constexpr double kLogRatioReference = 0.5;
+constexpr double kLogRatioEpsilon = 1e-3;
+
+// The cost function of one pair in the log-ratio form (see the top comment).
+template <int kChannels>
+class TexelLogRatioCost : public ceres::SizedCostFunction<kChannels, kChannels, kChannels> {
+ public:
+  explicit TexelLogRatioCost(double weight) : scale_(weight * kLogRatioReference) {}
+
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    for (int c = 0; c < kChannels; ++c) {
+      residuals[c] = scale_ * (std::log(parameters[0][c] + kLogRatioEpsilon) -
+                               std::log(parameters[1][c] + kLogRatioEpsilon));
+    }
+    if (jacobians == nullptr) return true;
+    for (int block = 0; block < 2; ++block) {
+      if (jacobians[block] == nullptr) continue;
+      const double sign = block == 0 ? 1.0 : -1.0;
+      for (int e = 0; e < kChannels * kChannels; ++e) jacobians[block][e] = 0.0;
+      for (int c = 0; c < kChannels; ++c) {
+        jacobians[block][c * (kChannels + 1)] =
+            sign * scale_ / (parameters[block][c] + kLogRatioEpsilon);
+      }
+    }
+    return true;
+  }
+
+ private:
+  double scale_;  // w · kLogRatioReference.
+};
+
 // Two neighbouring texels, as global mesh-colors texel indices.
 struct TexelPair {
   int a = -1;
@@ -85,14 +132,17 @@ struct TexelSmoothnessOptions {
   double weight = 1.0;
   // Multiplies w for cross-face pairs; finite, ≥ 0 (1 = the same smoothness across edges).
   double cross_face_weight = 1.0;
+  // The log-ratio form instead of the difference (top comment): for values whose overall scale
+  // another fitted parameter can take over.
+  bool log_ratio = false;
 
   bool Check(std::string* why) const;
 };
 
-// Adds one TexelDifferenceCost<channels> block per pair to `problem` (which takes ownership).
-// `texel_blocks[k]` is texel k's parameter block of `channels` doubles; channels is 1 or 3 and
-// pairs index into texel_blocks (CHECK). Pairs with zero weight are skipped. Returns the number of
-// blocks added.
+// Adds one TexelDifferenceCost<channels> (TexelLogRatioCost<channels> with log_ratio) block per
+// pair to `problem` (which takes ownership). `texel_blocks[k]` is texel k's parameter block of
+// `channels` doubles; channels is 1 or 3 and pairs index into texel_blocks (CHECK). Pairs with zero
+// weight are skipped. Returns the number of blocks added.
 int AddTexelSmoothness(const std::vector<TexelPair>& pairs, int channels,
                        const TexelSmoothnessOptions& options,
                        const std::vector<double*>& texel_blocks, ceres::Problem* problem);

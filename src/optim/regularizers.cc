@@ -30,12 +30,13 @@ void SetBlockBounds(int first, int size, const ParameterBounds& bounds, ScenePar
 // Smoothness over the texel pairs `pairs` of one attribute (mesh colors or a UV texture) whose
 // texel k is the block at offset + channels·k.
 void AddSmoothness(const std::vector<TexelPair>& pairs, int num_texels, int channels, int offset,
-                   double weight, const ParameterBounds& bounds, SceneParameters* params,
-                   ceres::Problem* problem) {
+                   double weight, bool log_ratio, const ParameterBounds& bounds,
+                   SceneParameters* params, ceres::Problem* problem) {
   std::vector<double*> blocks(num_texels);
   for (int k = 0; k < num_texels; ++k) blocks[k] = params->data() + offset + channels * k;
   TexelSmoothnessOptions options;
   options.weight = std::sqrt(weight);
+  options.log_ratio = log_ratio;
   AddTexelSmoothness(pairs, channels, options, blocks, problem);
   // Texels no render touches (mesh colors' i + j = r) enter the problem here: give every texel
   // the bounds.
@@ -120,13 +121,17 @@ void AddRegularizers(const TriMesh& rest, const ActiveParameters& active,
         ComputeUvTexelCharts(faces, material.uv.corner_uvs, texture.width(), texture.height()));
   };
   if (active.albedo && options.albedo_smoothness > 0.0) {
+    // Fitted light scales or a fitted environment can take over the albedo's scale (the images
+    // see their product): then the prior ties log albedo, which that trade leaves unchanged.
+    const bool scale_free = active.lights || active.environment;
     AddSmoothness(pairs(material.albedo, material.uv.albedo), material.NumAlbedoTexels(), 3,
-                  layout.AlbedoOffset(), options.albedo_smoothness, bounds, params, problem);
+                  layout.AlbedoOffset(), options.albedo_smoothness, scale_free, bounds, params,
+                  problem);
   }
   if (active.roughness && options.roughness_smoothness > 0.0) {
     AddSmoothness(pairs(material.roughness, material.uv.roughness), material.NumRoughnessTexels(),
-                  1, layout.RoughnessOffset(), options.roughness_smoothness, bounds, params,
-                  problem);
+                  1, layout.RoughnessOffset(), options.roughness_smoothness, /*log_ratio=*/false,
+                  bounds, params, problem);
   }
   if (active.environment && params->has_environment() && options.environment_smoothness > 0.0) {
     const int num_texels = layout.num_environment_texels;

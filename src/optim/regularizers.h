@@ -50,7 +50,10 @@ struct RegularizerOptions {
   // (dimensionless); range [0, 1e6] (Check); 0 = plain Tikhonov damping. The paper uses 19 to 49,
   // Mitsuba 3's shape-optimisation tutorial 25.
   double proximal_lambda = 25.0;
-  double albedo_smoothness = 0.0;     // weight of albedo differences of neighbouring texels, ≥ 0.
+  // Weight of albedo differences of neighbouring texels, ≥ 0; of their log ratios when the phase
+  // also fits light scales or the environment, which can take over the albedo's scale
+  // (cost_functions/texel_smoothness.h, the log-ratio form).
+  double albedo_smoothness = 0.0;
   double roughness_smoothness = 0.0;  // the same for roughness, ≥ 0.
   // Relative weight λ of the exposure gains' prior towards 1 (cost_functions/exposure_prior.h:
   // ½·λ·E_vc·(g_vc − 1)² per gain, E_vc the view's photograph energy, the image term's curvature
