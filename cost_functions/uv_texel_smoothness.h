@@ -5,7 +5,9 @@
 //
 //   r = w · (t_a − t_b)
 //
-// the residual of texel_smoothness.h, evaluated by the same cost function (TexelDifferenceCost<C>).
+// the residual of texel_smoothness.h, evaluated by the same cost function (TexelDifferenceCost<C>;
+// for albedo in a phase that also fits light scales or the environment, its log-ratio form,
+// TexelLogRatioCost<C>, whose Jacobians are w·0.5/(t + ε)).
 // Parameter blocks: [t_a, t_b], each C doubles (texel k's channel values, k = y·W + x as in
 // src/geometry/uv_texture.h). Jacobians: ∂r/∂t_a = w·I_C, ∂r/∂t_b = −w·I_C (exact: the residual
 // is linear). Evaluate never returns false. Derivative terms it does not have: none.
