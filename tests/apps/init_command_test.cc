@@ -136,7 +136,9 @@ TEST(InitCommandTest, SparsePointsAreCountedAgainstTheHull) {
   EXPECT_EQ(summary["points_outside_box"], 1);
   EXPECT_EQ(summary["points_inside_hull"], 1);
   EXPECT_EQ(summary["outlier_views"], 0);
-  // Overruling one view: reported, and a point needs the overruled view plus two that agree.
+  // Overruling one view: reported in the JSON (the rule that at least t + 2 views must see a point
+  // is asserted in tests/init/visual_hull_test.cc, where the view fraction does not already
+  // require 3 of these 12 views).
   ASSERT_EQ(
       RunSft("init --quiet --overwrite --dataset " + d + " --out " + tmp.Join("o") +
                  " --resolution 48 --faces 300 --outlier-views 1 --points " + tmp.Join("p.ply"),
@@ -145,7 +147,6 @@ TEST(InitCommandTest, SparsePointsAreCountedAgainstTheHull) {
       << out;
   const nlohmann::json overruled = nlohmann::json::parse(out.substr(out.find('{')));
   EXPECT_EQ(overruled["outlier_views"], 1);
-  EXPECT_GE(overruled["min_views"], 3);
   // It never carves more (a superset in a box at least as large, so voxels at least as large): no
   // point is outside that the exact hull has inside.
   EXPECT_LE(overruled["points_outside_hull"], summary["points_outside_hull"]);
