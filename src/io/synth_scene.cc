@@ -45,6 +45,26 @@ Eigen::Vector3d GroundAlbedo(double x, double y, const GroundOptions& options) {
   return (0.04 + 0.9 * t) * tint;
 }
 
+// Four rectangles, 2 faces each, normal +z, that fill the square of half side `outer` around
+// the square of half side `inner` (both centred on `centre`'s x, y, at height z). Their edges meet
+// the inner grid's boundary in T-junctions, which leave no gap: the grid's boundary vertices lie
+// on the rectangles' edges.
+void AddFloorRing(const Eigen::Vector3d& centre, double z, double inner, double outer,
+                  TriMesh* mesh) {
+  auto add_rect = [&](double x0, double y0, double x1, double y1) {
+    const auto a = mesh->add_vertex(TriMesh::Point(centre.x() + x0, centre.y() + y0, z));
+    const auto b = mesh->add_vertex(TriMesh::Point(centre.x() + x1, centre.y() + y0, z));
+    const auto c = mesh->add_vertex(TriMesh::Point(centre.x() + x1, centre.y() + y1, z));
+    const auto d = mesh->add_vertex(TriMesh::Point(centre.x() + x0, centre.y() + y1, z));
+    mesh->add_face(a, b, c);
+    mesh->add_face(a, c, d);
+  };
+  add_rect(-outer, -outer, outer, -inner);  // below
+  add_rect(-outer, inner, outer, outer);    // above
+  add_rect(-outer, -inner, -inner, inner);  // left
+  add_rect(inner, -inner, outer, inner);    // right
+}
+
 }  // namespace
 
 bool GroundOptions::Check(std::string* why) const {
@@ -62,6 +82,10 @@ bool GroundOptions::Check(std::string* why) const {
   }
   if (!(feature > 0 && feature <= 1)) {
     *why = "--ground-feature: must be in (0, 1]";
+    return false;
+  }
+  if (!(floor_half_size == 0 || (floor_half_size > half_size && floor_half_size <= 1e3))) {
+    *why = "--ground-floor: must be 0 or in (--ground-size, 1000]";
     return false;
   }
   return true;
@@ -98,8 +122,12 @@ Status AddGroundPlane(const TriMesh& object, const Material& object_material,
       mesh->add_face(a, c, d);
     }
   }
+  const int plane_faces = static_cast<int>(mesh->n_faces());
+  if (options.floor_half_size > 0)
+    AddFloorRing(centre, z, half, options.floor_half_size * diagonal, mesh);
   const int total_faces = static_cast<int>(mesh->n_faces());
-  if (total_faces != object_faces + 2 * n * n) {
+  const int floor_faces = options.floor_half_size > 0 ? 8 : 0;
+  if (total_faces != object_faces + 2 * n * n + floor_faces) {
     return Status::Error("--ground: could not add the plane's faces to the mesh");
   }
 
@@ -119,7 +147,14 @@ Status AddGroundPlane(const TriMesh& object, const Material& object_material,
             material->albedo.values().begin());
   std::copy(object_material.roughness.values().begin(), object_material.roughness.values().end(),
             material->roughness.values().begin());
-  for (int f = object_faces; f < total_faces; ++f) {
+  const Eigen::Vector3d kFloorAlbedo(0.35, 0.3, 0.25);
+  for (int f = plane_faces; f < total_faces; ++f) {
+    for (int k = 0; k < MeshColors::TexelsPerFace(r); ++k) {
+      double* t = material->albedo.texel(f * MeshColors::TexelsPerFace(r) + k);
+      for (int c = 0; c < 3; ++c) t[c] = kFloorAlbedo[c];
+    }
+  }
+  for (int f = object_faces; f < plane_faces; ++f) {
     Eigen::Vector3d p[3];
     int k = 0;
     for (auto fv : mesh->fv_range(mesh->face_handle(f))) {

@@ -26,13 +26,20 @@ struct GroundOptions {
   int cells = 96;          // grid cells per side (2 triangles each), [1, 1024].
   double feature = 0.01;   // finest noise wavelength, in diagonals, (0, 1]; coarser octaves ×3.
   uint64_t seed = 7;       // noise seed.
+  // Half the side of a plain floor around the textured plane, in object-box diagonals; 0 = none,
+  // else in (half_size, 1e3]. A finite plane under a far-field probe lets the probe's light below
+  // the horizon reach the object past the plane's edge; a floor many diagonals wide is the
+  // support `--probe-ground` models (docs/dataset.md).
+  double floor_half_size = 0.0;
 
   bool Check(std::string* why) const;
 };
 
 // Appends a square ground plane (normal +z, at the object's lowest z minus `gap`, centred under the
 // object's bounding-box centre) to `object`, and a high-frequency procedural albedo (four octaves
-// of value noise mapped to a warm/cool palette, roughness 0.8) to the material. `mesh` and
+// of value noise mapped to a warm/cool palette, roughness 0.8) to the material. With
+// `floor_half_size`, four rectangles (8 faces, a uniform grey-brown albedo) extend the plane to a
+// square floor of that half side. `mesh` and
 // `material` receive the merged scene; The object keeps faces [0, object.n_faces()).
 Status AddGroundPlane(const TriMesh& object, const Material& object_material,
                       const GroundOptions& options, TriMesh* mesh, Material* material);
