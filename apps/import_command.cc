@@ -19,7 +19,12 @@ void PrintMasksAndProbe(const char* command, const ColmapImportReport& report) {
     std::fprintf(stderr, "%s: support plane: %d sparse points on or beyond it left out\n", command,
                  n.plane.off_object);
   }
-  if (report.probe_ground_requested) {
+  if (report.probe_ground_requested && report.probe_ground && report.probe_ground_radius > 0) {
+    std::fprintf(stderr,
+                 "%s: probe ground: the support, a disc of radius %.2f object diagonals on the "
+                 "plane, hides the probe where it blocks the view\n",
+                 command, report.probe_ground_radius);
+  } else if (report.probe_ground_requested) {
     std::fprintf(stderr, "%s: %s\n", command,
                  report.probe_ground
                      ? "probe ground: the support plane hides the probe below its horizon"

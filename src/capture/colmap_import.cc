@@ -20,6 +20,11 @@
 
 namespace sft {
 namespace {
+
+// The support disc's radius: this quantile of its points' distances from its centre (a few stray
+// points on the plane's far side of the room do not make a table a floor).
+constexpr double kSupportDiscQuantile = 0.99;
+
 namespace fs = std::filesystem;
 
 // Camera "c<ID>" for every COLMAP camera that a registered image uses.
@@ -321,7 +326,22 @@ Status ImportInto(const ColmapImportOptions& opts, const std::string& root,
   SFT_RETURN_IF_ERROR(AddProbeLight(opts, root, &dataset));
   // --probe-ground: the support plane's normal (a direction: the normalisation has no rotation).
   const bool probe_ground = opts.normalization.plane.hides_probe && !opts.probe.empty();
-  if (probe_ground && norm.plane.found) dataset.lights[0].ground_normal = norm.plane.normal;
+  if (probe_ground && norm.plane.found) {
+    LightSpec& probe = dataset.lights[0];
+    probe.ground_normal = norm.plane.normal;
+    // The support as a disc (in the normalised world): past a table's edge the probe still lights
+    // the object from below the horizon.
+    std::vector<Eigen::Vector3d> model_points;
+    for (const ColmapPoint3D& point : model.points) model_points.push_back(point.xyz);
+    Eigen::Vector3d centre;
+    double radius = 0;
+    if (SupportDisc(norm.plane, model_points, norm.centre, kSupportDiscQuantile, &centre,
+                    &radius)) {
+      probe.ground_point = (centre - norm.centre) / norm.diagonal;
+      probe.ground_radius = radius / norm.diagonal;
+      report->probe_ground_radius = probe.ground_radius;
+    }
+  }
   report->probe_ground_requested = probe_ground;
   report->probe_ground = probe_ground && norm.plane.found;
 

@@ -58,6 +58,9 @@ struct ColmapImportReport {
   // whether a support plane was found to hide the probe's lower part.
   bool probe_ground_requested = false;
   bool probe_ground = false;
+  // The support disc's radius in the normalised world (object-box diagonals); 0 = an infinite
+  // floor (no point on the plane to measure it by).
+  double probe_ground_radius = 0;
   double seconds = 0;  // wall time.
 };
 

@@ -132,4 +132,23 @@ SupportPlane FindSupportPlane(const std::vector<Eigen::Vector3d>& points,
   return plane;
 }
 
+bool SupportDisc(const SupportPlane& plane, const std::vector<Eigen::Vector3d>& points,
+                 const Eigen::Vector3d& object_centre, double quantile, Eigen::Vector3d* centre,
+                 double* radius) {
+  if (!plane.found) return false;
+  *centre = object_centre - plane.SignedDistance(object_centre) * plane.normal;
+  std::vector<double> distances;
+  for (const Eigen::Vector3d& p : points) {
+    if (std::abs(plane.SignedDistance(p)) > plane.band) continue;
+    const Eigen::Vector3d d = p - *centre;
+    distances.push_back((d - d.dot(plane.normal) * plane.normal).norm());
+  }
+  if (distances.empty()) return false;
+  const size_t k = std::min(distances.size() - 1,
+                            static_cast<size_t>(std::clamp(quantile, 0.0, 1.0) * distances.size()));
+  std::nth_element(distances.begin(), distances.begin() + k, distances.end());
+  *radius = distances[k];
+  return *radius > 0;
+}
+
 }  // namespace sft

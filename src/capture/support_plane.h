@@ -59,6 +59,15 @@ SupportPlane FindSupportPlane(const std::vector<Eigen::Vector3d>& points,
                               const std::vector<Eigen::Vector3d>& camera_centres,
                               const SupportPlaneOptions& options);
 
+// The support as a disc for `--probe-ground`: its centre is `object_centre` projected onto the
+// plane, its radius the `quantile` of the in-plane distances from that centre of the points
+// within the plane's band (the support's texture as far as SfM triangulated it). A table top
+// ends where its points end; a floor's points spread as far as the views see it. False when the
+// plane was not found or holds no point.
+bool SupportDisc(const SupportPlane& plane, const std::vector<Eigen::Vector3d>& points,
+                 const Eigen::Vector3d& object_centre, double quantile, Eigen::Vector3d* centre,
+                 double* radius);
+
 }  // namespace sft
 
 #endif  // SFT_CAPTURE_SUPPORT_PLANE_H_

@@ -63,8 +63,9 @@ constexpr Keys kSimilarityKeys = {"scale", "rotation", "translation"};
 constexpr Keys kCameraKeys = {"id", "model", "width", "height", "params"};
 constexpr Keys kPointLightKeys = {"id", "type", "frame", "position", "intensity"};
 constexpr Keys kDirectionalLightKeys = {"id", "type", "frame", "direction", "irradiance"};
-constexpr Keys kEnvironmentLightKeys = {"id",    "type",         "frame", "image", "world_from_env",
-                                        "scale", "ground_normal"};
+constexpr Keys kEnvironmentLightKeys = {
+    "id",    "type",          "frame",         "image",       "world_from_env",
+    "scale", "ground_normal", "ground_radius", "ground_point"};
 constexpr Keys kViewKeys = {"image", "mask", "camera", "lights", "cam_from_world"};
 constexpr Keys kPoseKeys = {"rotation", "translation"};
 
@@ -392,7 +393,27 @@ class SceneParser {
         light->ground_normal /= norm;
       }
     }
-    return Status::Ok();
+    return ParseGroundDisc(entry, path, light);
+  }
+
+  // "ground_radius" and "ground_point": both or neither, and only with "ground_normal".
+  Status ParseGroundDisc(const json& entry, const std::string& path, LightSpec* light) const {
+    const json* radius = Find(entry, "ground_radius");
+    const json* point = Find(entry, "ground_point");
+    if (radius == nullptr && point == nullptr) return Status::Ok();
+    const std::string radius_path = Field(path, "ground_radius");
+    if (radius == nullptr || point == nullptr) {
+      return Error(radius == nullptr ? radius_path : Field(path, "ground_point"),
+                   "ground_radius and ground_point go together");
+    }
+    if (light->ground_normal.isZero()) {
+      return Error(radius_path, "needs ground_normal (the disc's plane)");
+    }
+    SFT_RETURN_IF_ERROR(Number(*radius, radius_path, &light->ground_radius));
+    if (!(light->ground_radius > 0) || !std::isfinite(light->ground_radius)) {
+      return Error(radius_path, "must be positive and finite");
+    }
+    return Vector3(*point, Field(path, "ground_point"), &light->ground_point);
   }
 
   Status ParseLights(const json& root, Dataset* dataset, bool required = false) const {

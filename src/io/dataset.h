@@ -68,6 +68,12 @@ struct LightSpec {
   // unit world direction of "up"; directions d with d·ground_normal < 0 carry no radiance, as if an
   // infinite black floor lay under the object (docs/dataset.md). Zero = no ground.
   Eigen::Vector3d ground_normal = Eigen::Vector3d::Zero();
+  // With ground_normal: a finite ground, a black disc of this radius (world units, > 0) centred at
+  // `ground_point` in the plane through it, instead of the infinite floor: only the directions
+  // that hit the disc from a shading point carry no radiance (a table top, past whose edge the
+  // probe's light below the horizon still reaches the object). 0 = the infinite floor.
+  double ground_radius = 0.0;
+  Eigen::Vector3d ground_point = Eigen::Vector3d::Zero();  // the disc's centre, world frame.
   // An environment map held in memory instead of `image` (RGB, linear): the fitted environment of
   // unknown lighting (src/optim/fitted_environment.h). Never read from or written to scene.json.
   Image pixels;

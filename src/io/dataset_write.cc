@@ -71,6 +71,11 @@ ojson LightsJson(const std::vector<LightSpec>& specs) {
         entry["ground_normal"] = {light.ground_normal.x(), light.ground_normal.y(),
                                   light.ground_normal.z()};
       }
+      if (light.ground_radius > 0) {
+        entry["ground_radius"] = light.ground_radius;
+        entry["ground_point"] = {light.ground_point.x(), light.ground_point.y(),
+                                 light.ground_point.z()};
+      }
     }
     AppendExtra(light.extra, &entry);
     lights.push_back(std::move(entry));

@@ -106,7 +106,10 @@ Status MakeDatasetViews(const Dataset& dataset, DatasetViews* out) {
       }
       if (!loaded[l]) {
         SFT_RETURN_IF_ERROR(LoadProbe(dataset, l, &probes[l]));
-        if (!light.ground_normal.isZero()) BlackenBelowGround(light, &probes[l]);
+        // An infinite floor cuts the map once; a finite one is a disc each ray is tested on.
+        if (!light.ground_normal.isZero() && !(light.ground_radius > 0)) {
+          BlackenBelowGround(light, &probes[l]);
+        }
         loaded[l] = true;
       }
       if (light.frame == LightFrame::kCamera) {
@@ -121,6 +124,11 @@ Status MakeDatasetViews(const Dataset& dataset, DatasetViews* out) {
               std::make_unique<EnvironmentMap>(probes[l], light.world_from_env, light.scale);
         }
         view.environment = out->environments[l].get();
+        if (light.ground_radius > 0) {
+          view.support.radius = light.ground_radius;
+          view.support.centre = light.ground_point;
+          view.support.normal = light.ground_normal;
+        }
       }
       view.environment_light_index = l;
     }

@@ -110,6 +110,23 @@ struct DirectionalLight {
 };
 
 // Everything one view needs besides the scene and material.
+// A finite black support under the object that a world-fixed environment does not show (a table
+// top; LightSpec::ground_radius): the environment seen from a point along a direction that hits
+// the disc carries no radiance. Rays that miss it below its plane's horizon still see the map.
+struct SupportDisc {
+  double radius = 0.0;  // world units; 0 = no disc.
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  // unit; the side the object is on.
+
+  // Whether the ray p + t·d, t > 0, hits the disc (d need not be unit).
+  bool Hides(const Eigen::Vector3d& p, const Eigen::Vector3d& d) const {
+    const double nd = normal.dot(d);
+    if (!(radius > 0.0) || !(nd < 0.0)) return false;
+    const double t = normal.dot(centre - p) / nd;
+    return t > 0.0 && (p + t * d - centre).squaredNorm() <= radius * radius;
+  }
+};
+
 struct ViewSetup {
   Camera camera;
   Rigid3d cam_from_world;
@@ -118,7 +135,8 @@ struct ViewSetup {
   const EnvironmentMap* environment = nullptr;  // not owned; may be null.
   bool environment_background = false;          // camera rays that miss see the environment.
   int environment_light_index = -1;             // dataset light index of `environment`.
-  double environment_scale = 1.0;               // multiplies the environment's radiance, >= 0.
+  SupportDisc support;             // hides `environment` where it blocks the view (radius 0: none).
+  double environment_scale = 1.0;  // multiplies the environment's radiance, >= 0.
   // ∂(world-frame turn δ of `environment`)/∂(its light's rotation parameters θ,
   // ParameterLayout::environment_rotations): J_l(θ) for a world-fixed environment, Rᵀ·J_l(θ)
   // for a camera-fixed one (R = cam_from_world's rotation, J_l = RotationLeftJacobian). The

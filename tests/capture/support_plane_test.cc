@@ -70,6 +70,35 @@ TEST(SupportPlaneTest, FindsTheFloorUnderTheObject) {
   EXPECT_EQ(plane.off_object, floor_off + ball_off);
 }
 
+// The support as a disc (--probe-ground): a round table of radius 1.8 under the ball. Its points
+// are uniform over the disc, so the 0.99 quantile of their distances from the centre is
+// 1.8·√0.99 = 1.791 (the ball's ~36 points in the band barely move it; the quantile's sampling
+// error over 1500 points is about 0.003). The centre is the ball's centre dropped onto the plane.
+TEST(SupportPlaneTest, DiscOfARoundTableIsItsRadiusUnderTheObject) {
+  const Scene scene = MakeScene(kRotation, kShift);
+  std::vector<Eigen::Vector3d> points = scene.ball;
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  int table = 0;
+  while (table < 1500) {
+    const double x = 1.8 * u(rng);
+    const double y = 1.8 * u(rng);
+    if (std::hypot(x, y) > 1.8 || std::hypot(x, y) < 0.35) continue;
+    points.push_back(kRotation * Eigen::Vector3d(x, y, 0) + kShift);
+    ++table;
+  }
+  const SupportPlane plane = FindSupportPlane(points, scene.cameras, SupportPlaneOptions());
+  ASSERT_TRUE(plane.found);
+  const Eigen::Vector3d ball_centre = kRotation * Eigen::Vector3d(0, 0, 0.3) + kShift;
+  Eigen::Vector3d centre;
+  double radius = 0;
+  ASSERT_TRUE(SupportDisc(plane, points, ball_centre, 0.99, &centre, &radius));
+  EXPECT_LT((centre - kShift).norm(), 0.01);
+  EXPECT_NEAR(radius, 1.8 * std::sqrt(0.99), 0.02);
+  // No plane, no disc.
+  EXPECT_FALSE(SupportDisc(SupportPlane(), points, ball_centre, 0.99, &centre, &radius));
+}
+
 TEST(SupportPlaneTest, NoPlaneWithoutOneOrWithCamerasOnBothSides) {
   const Scene scene = MakeScene(kRotation, kShift);
   // The ball alone: no plane holds 20% of its points.

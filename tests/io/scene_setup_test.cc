@@ -206,5 +206,68 @@ TEST(SceneSetupTest, GroundNormalRoundTripsAndIsRefusedWhereItCannotHold) {
       << status.message();
 }
 
+// A finite ground (ground_radius, ground_point): the map keeps its texels below the horizon (each
+// ray is tested on the disc instead, tests/render/support_disc_test.cc), every view carries the
+// disc, the keys round-trip, and bad values are one error naming the field.
+TEST(SceneSetupTest, GroundDiscKeepsTheMapAndReachesEveryView) {
+  json scene = GroundScene(Eigen::Matrix3d::Identity());
+  scene["lights"][1]["ground_radius"] = 2.5;
+  scene["lights"][1]["ground_point"] = {0.1, -0.2, -0.5};
+  testing::TempDir dir;
+  testing::WriteDataset(dir, scene);
+  ASSERT_TRUE(WriteExr(dir.Join("probes/env.exr"), Image(64, 32, 3, 1.0f)).ok());
+  Dataset dataset;
+  ASSERT_TRUE(ReadDataset(dir.path(), &dataset).ok());
+  EXPECT_EQ(dataset.lights[1].ground_radius, 2.5);
+  DatasetViews views;
+  ASSERT_TRUE(MakeDatasetViews(dataset, &views).ok());
+  for (const ViewSetup& view : views.views) {
+    EXPECT_NEAR(view.environment->Radiance(Eigen::Vector3d(0.3, 0.1, -0.9).normalized()).x(), 1.0,
+                1e-6);
+    EXPECT_EQ(view.support.radius, 2.5);
+    EXPECT_TRUE(view.support.centre.isApprox(Eigen::Vector3d(0.1, -0.2, -0.5)));
+    EXPECT_TRUE(view.support.normal.isApprox(Eigen::Vector3d::UnitZ()));
+  }
+  testing::TempDir copy;
+  ASSERT_TRUE(WriteSceneJson(dataset, copy.path()).ok());
+  const json written = json::parse(testing::ReadTestFile(copy.Join("scene.json")));
+  EXPECT_EQ(written["lights"][1]["ground_radius"], 2.5);
+  EXPECT_EQ(written["lights"][1]["ground_point"], json({0.1, -0.2, -0.5}));
+
+  struct Bad {
+    const char* key;
+    json value;
+    const char* field;
+  };
+  const Bad bads[] = {{"ground_radius", 0.0, "ground_radius"},
+                      {"ground_radius", -1.0, "ground_radius"},
+                      {"ground_radius", "far", "ground_radius"},
+                      {"ground_point", json({0, 1}), "ground_point"},
+                      {"ground_point", nullptr, "ground_point"}};
+  for (const Bad& bad : bads) {
+    json b = scene;
+    if (bad.value.is_null()) {
+      b["lights"][1].erase(bad.key);
+    } else {
+      b["lights"][1][bad.key] = bad.value;
+    }
+    testing::TempDir d;
+    testing::WriteDataset(d, b);
+    Dataset ignored;
+    const Status status = ReadDataset(d.path(), &ignored);
+    ASSERT_FALSE(status.ok()) << bad.key << " " << bad.value.dump();
+    EXPECT_NE(status.message().find(std::string("lights[1].") + bad.field), std::string::npos)
+        << status.message();
+  }
+  json no_normal = scene;
+  no_normal["lights"][1].erase("ground_normal");
+  testing::TempDir d;
+  testing::WriteDataset(d, no_normal);
+  Dataset ignored;
+  const Status status = ReadDataset(d.path(), &ignored);
+  ASSERT_FALSE(status.ok());
+  EXPECT_NE(status.message().find("needs ground_normal"), std::string::npos) << status.message();
+}
+
 }  // namespace
 }  // namespace sft

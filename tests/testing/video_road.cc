@@ -62,8 +62,7 @@ void RenderVideoTruth(const std::string& dir) {
                  StudioProbe() + " --background-environment --ground --path orbit " +
                  "--elevation 20,45 --cameras " + std::to_string(kVideoFrames) +
                  " --zooms 1 --res " + std::to_string(kVideoSize) +
-                 " --fov 45 --fill 0.5 --spp 16 --bounces 1 --ground-floor 50 --out " + dir +
-                 "/synth",
+                 " --fov 45 --fill 0.5 --spp 16 --bounces 1 --out " + dir + "/synth",
              &out),
       0)
       << out;

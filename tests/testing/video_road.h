@@ -1,9 +1,7 @@
 // The synthetic video road of issue 12, shared by the long tests that walk it
 // (tests/apps/video_import_long_test.cc: import and hull; video_reconstruct_long_test.cc: the
 // reconstruction scored against the truth): `sft synth` renders a textured spot on a textured
-// ground plane inside a plain floor 50 object diagonals wide (`--ground-floor`: the support that
-// the import's `--probe-ground` models) along an orbit under the studio probe (visible behind),
-// the frames become a video
+// ground plane along an orbit under the studio probe (visible behind), the frames become a video
 // (OpenCV VideoWriter), and `sft import video --probe --masks auto` brings it back as a dataset.
 // The imported world is the truth's up to a similarity, fitted on the camera centres.
 #ifndef SFT_TESTS_TESTING_VIDEO_ROAD_H_

@@ -183,7 +183,7 @@ void AddEnvironmentLight(const Context& ctx, const PathVertex& v, Sampler* sampl
     ++state->stats->shadow_rays;
     visible = !ctx.scene.Occluded(v.sp.p, wi, v.offset, kInfinity);
   }
-  if (!visible) return;
+  if (!visible || ctx.view.support.Hides(v.sp.p, wi)) return;
   // Without shadows the BSDF-sampled rays cannot tell whether the light is seen, so the
   // environment is lit by light sampling alone (weight 1).
   const double weight = ctx.options.effects.shadows
@@ -246,7 +246,7 @@ bool ApplyScatter(const Context& ctx, const PathVertex& v, const ScatterSample& 
   const Eigen::Vector3d& wi = s.bsdf.wi;
   const Eigen::Vector3d f = v.detached ? EvalBsdf(v.surface.params, n, v.sp.wo, wi) : s.bsdf.f;
   if (!s.next.hit) {
-    if (BsdfLightsEnvironment(ctx, v)) {
+    if (BsdfLightsEnvironment(ctx, v) && !ctx.view.support.Hides(v.sp.p, wi)) {
       const double weight = PowerHeuristic(s.bsdf.pdf, ctx.sampling_environment->Pdf(wi));
       LightTerm term;
       const double factor = ctx.view.environment_scale * weight / s.bsdf.pdf;
@@ -297,9 +297,14 @@ bool MakeVertex(const Context& ctx, const Eigen::Vector3d& dir, const RayHit& hi
   return true;
 }
 
-// The environment seen by a camera ray that misses the mesh (zero unless it is the background).
+// The environment seen by a camera ray that misses the mesh (zero unless it is the background;
+// zero where the black support disc is in the way, as the infinite floor's cut map is).
 Eigen::Vector3d Background(const Context& ctx, const Eigen::Vector3d& dir, PathDerivatives* path) {
   if (ctx.environment == nullptr || !ctx.view.environment_background) {
+    return Eigen::Vector3d::Zero();
+  }
+  if (ctx.view.support.radius > 0 &&
+      ctx.view.support.Hides(ctx.view.cam_from_world.Inverse().translation, dir)) {
     return Eigen::Vector3d::Zero();
   }
   const Eigen::Vector3d radiance = ctx.view.environment_scale * ctx.environment->Radiance(dir);

@@ -165,7 +165,7 @@ bool TwoSidedJump(const SecondaryVertex& v, const SphereCurvePoint& point, const
   for (int k = 0; k < 2; ++k) {
     Eigen::Vector3d l_in = Eigen::Vector3d::Zero();
     if (!hits[k].hit) {
-      if (v.environment) {
+      if (v.environment && !ctx.view.support.Hides(v.x, point.sides[k])) {
         l_in = ctx.view.environment_scale * ctx.environment->Radiance(point.sides[k]);
       }
     } else if (v.indirect) {
