@@ -113,6 +113,9 @@ struct DirectionalLight {
 // A finite black support under the object that a world-fixed environment does not show (a table
 // top; LightSpec::ground_radius): the environment seen from a point along a direction that hits
 // the disc carries no radiance. Rays that miss it below its plane's horizon still see the map.
+// The derivatives take the disc as part of the light: its rim is a visibility boundary that no
+// edge term samples, so the vertex rows lack the change of which directions the rim cuts off as a
+// shading point moves (a small term for a support the size of a table or larger).
 struct SupportDisc {
   double radius = 0.0;  // world units; 0 = no disc.
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();
