@@ -8,8 +8,10 @@
 // Long (minutes: rendering and COLMAP), so labelled `long` by its name.
 //
 // With SFT_VIDEO_ROAD_DIR set, the road's files go there and are kept, and a rendered truth and
-// video found there are reused (tests/testing/video_road.h; the import always runs). Otherwise a
-// temporary folder is used.
+// video found there are reused (tests/testing/video_road.h; the import always runs, into
+// DIR/import_test, so that it does not replace the import and reconstruction that
+// video_reconstruct_long_test.cc keeps in DIR/imported and DIR/recon). Otherwise a temporary
+// folder is used.
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
@@ -68,7 +70,7 @@ TEST(VideoImportLongTest, SyntheticVideoWithProbeAndAutoMasksToDatasetAndHull) {
   std::string out;
   ASSERT_EQ(testing::RunSft("import video --overwrite --video " + video + " --frames " +
                                 std::to_string(testing::kVideoSelected) + " --masks auto --probe " +
-                                testing::StudioProbe() + " --out " + dir + "/imported",
+                                testing::StudioProbe() + " --out " + dir + "/import_test",
                             &out),
             0)
       << out;
@@ -76,7 +78,7 @@ TEST(VideoImportLongTest, SyntheticVideoWithProbeAndAutoMasksToDatasetAndHull) {
   std::printf("import output (tail): %s\n",
               out.substr(out.size() > 600 ? out.size() - 600 : 0).c_str());
   Dataset imported;
-  ASSERT_TRUE(ReadDataset(dir + "/imported", &imported).ok());
+  ASSERT_TRUE(ReadDataset(dir + "/import_test", &imported).ok());
   ASSERT_GE(imported.views.size(),
             static_cast<size_t>(testing::kVideoSelected * 8 / 10));  // --min-registered
 
@@ -89,10 +91,10 @@ TEST(VideoImportLongTest, SyntheticVideoWithProbeAndAutoMasksToDatasetAndHull) {
   if (HasFatalFailure()) return;
 
   t = std::chrono::steady_clock::now();
-  ASSERT_EQ(testing::RunSft("init --quiet --dataset " + dir + "/imported", &out), 0) << out;
+  ASSERT_EQ(testing::RunSft("init --quiet --dataset " + dir + "/import_test", &out), 0) << out;
   const double init_seconds = Seconds(t);
   MeshMetrics metrics;
-  testing::MetricsInTruthFrame(dir, dir + "/imported/init/mesh.ply", fit, &metrics);
+  testing::MetricsInTruthFrame(dir, dir + "/import_test/init/mesh.ply", fit, &metrics);
   if (HasFatalFailure()) return;
 
   std::printf(
