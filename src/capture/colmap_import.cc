@@ -335,8 +335,8 @@ Status ImportInto(const ColmapImportOptions& opts, const std::string& root,
     for (const ColmapPoint3D& point : model.points) model_points.push_back(point.xyz);
     Eigen::Vector3d centre;
     double radius = 0;
-    if (SupportDisc(norm.plane, model_points, norm.centre, kSupportDiscQuantile, &centre,
-                    &radius)) {
+    if (FindSupportDisc(norm.plane, model_points, norm.centre, kSupportDiscQuantile, &centre,
+                        &radius)) {
       probe.ground_point = (centre - norm.centre) / norm.diagonal;
       probe.ground_radius = radius / norm.diagonal;
       report->probe_ground_radius = probe.ground_radius;

@@ -132,9 +132,9 @@ SupportPlane FindSupportPlane(const std::vector<Eigen::Vector3d>& points,
   return plane;
 }
 
-bool SupportDisc(const SupportPlane& plane, const std::vector<Eigen::Vector3d>& points,
-                 const Eigen::Vector3d& object_centre, double quantile, Eigen::Vector3d* centre,
-                 double* radius) {
+bool FindSupportDisc(const SupportPlane& plane, const std::vector<Eigen::Vector3d>& points,
+                     const Eigen::Vector3d& object_centre, double quantile, Eigen::Vector3d* centre,
+                     double* radius) {
   if (!plane.found) return false;
   *centre = object_centre - plane.SignedDistance(object_centre) * plane.normal;
   std::vector<double> distances;

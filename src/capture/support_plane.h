@@ -64,9 +64,9 @@ SupportPlane FindSupportPlane(const std::vector<Eigen::Vector3d>& points,
 // within the plane's band (the support's texture as far as SfM triangulated it). A table top
 // ends where its points end; a floor's points spread as far as the views see it. False when the
 // plane was not found or holds no point.
-bool SupportDisc(const SupportPlane& plane, const std::vector<Eigen::Vector3d>& points,
-                 const Eigen::Vector3d& object_centre, double quantile, Eigen::Vector3d* centre,
-                 double* radius);
+bool FindSupportDisc(const SupportPlane& plane, const std::vector<Eigen::Vector3d>& points,
+                     const Eigen::Vector3d& object_centre, double quantile, Eigen::Vector3d* centre,
+                     double* radius);
 
 }  // namespace sft
 

@@ -92,11 +92,11 @@ TEST(SupportPlaneTest, DiscOfARoundTableIsItsRadiusUnderTheObject) {
   const Eigen::Vector3d ball_centre = kRotation * Eigen::Vector3d(0, 0, 0.3) + kShift;
   Eigen::Vector3d centre;
   double radius = 0;
-  ASSERT_TRUE(SupportDisc(plane, points, ball_centre, 0.99, &centre, &radius));
+  ASSERT_TRUE(FindSupportDisc(plane, points, ball_centre, 0.99, &centre, &radius));
   EXPECT_LT((centre - kShift).norm(), 0.01);
   EXPECT_NEAR(radius, 1.8 * std::sqrt(0.99), 0.02);
   // No plane, no disc.
-  EXPECT_FALSE(SupportDisc(SupportPlane(), points, ball_centre, 0.99, &centre, &radius));
+  EXPECT_FALSE(FindSupportDisc(SupportPlane(), points, ball_centre, 0.99, &centre, &radius));
 }
 
 TEST(SupportPlaneTest, NoPlaneWithoutOneOrWithCamerasOnBothSides) {
