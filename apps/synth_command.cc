@@ -425,7 +425,7 @@ CommandRunner SetupSynthCommand(CLI::App* app) {
   app->add_option("--ground-floor", opts->ground_options.floor_half_size,
                   "Half side of a plain floor around the ground plane, in object diagonals (0 = "
                   "none); a floor many diagonals wide keeps the probe's light below the horizon "
-                  "off the object, as --probe-ground assumes");
+                  "off the object");
   app->add_option(
          "--path", opts->path,
          "Camera path: sphere (Fibonacci sphere) or orbit (one turn, elevation oscillating "

@@ -28,8 +28,8 @@ struct GroundOptions {
   uint64_t seed = 7;       // noise seed.
   // Half the side of a plain floor around the textured plane, in object-box diagonals; 0 = none,
   // else in (half_size, 1e3]. A finite plane under a far-field probe lets the probe's light below
-  // the horizon reach the object past the plane's edge; a floor many diagonals wide is the
-  // support `--probe-ground` models (docs/dataset.md).
+  // the horizon reach the object past the plane's edge; a floor many diagonals wide keeps it off
+  // (`--probe-ground` models either as a disc, docs/dataset.md).
   double floor_half_size = 0.0;
 
   bool Check(std::string* why) const;

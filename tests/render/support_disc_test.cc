@@ -75,7 +75,8 @@ double Expected(double radius) {
 }
 
 // Tolerance 1%: 65536 light and BSDF samples (MIS) of a smooth integrand; the deterministic
-// seed's error is a few 0.1%.
+// seed's error is below 0.05%. Radii 1 and above change the answer by 9% or more; radius 0.3
+// changes it by 0.5%, inside the tolerance, so that case checks only that nothing breaks.
 TEST(SupportDiscTest, LambertPatchAboveADiscMatchesTheClosedForm) {
   SupportDisc disc;
   EXPECT_NEAR(PatchRadiance(disc), 0.5, 0.005);
