@@ -98,6 +98,8 @@ nlohmann::ordered_json Summary(const std::string& mesh_path, const std::string& 
       {"voxels", {r.box.dims.x(), r.box.dims.y(), r.box.dims.z()}},
       {"min_views", r.min_views},
       {"outlier_views", r.outlier_views},
+      {"support_plane", r.support},
+      {"support_contact", r.support_contact},
       {"inside_voxels", r.inside_voxels},
       {"extracted_triangles", r.extracted_triangles},
       {"components", r.cleanup.components},
@@ -168,6 +170,7 @@ Status RunInit(const InitCommandOptions& opts) {
   SFT_RETURN_IF_ERROR(LoadCarvingViews(dataset, &views));
   InitialMeshOptions mesh_options = opts.mesh;
   mesh_options.progress = !opts.quiet;
+  UseDatasetSupport(dataset, &mesh_options.hull);
   TriMesh mesh;
   InitialMeshReport report;
   SFT_RETURN_IF_ERROR(MakeInitialMesh(views, mesh_options, points, &mesh, &report));
@@ -221,6 +224,13 @@ CommandRunner SetupInitCommand(CLI::App* app) {
                       std::to_string(VisualHullOptions::kMaxOutlierViews) + "]")
       ->capture_default_str()
       ->check(CLI::Range(0, VisualHullOptions::kMaxOutlierViews));
+  app->add_option("--support-contact", opts->mesh.hull.support_contact,
+                  "Height of the contact band above the dataset's support_plane (scene units; "
+                  "datasets have a unit diagonal): a point in it is inside when the point above "
+                  "it at the band's top is, which gives back feet or a base the masks cut off; 0: "
+                  "none. Without a support_plane it is ignored, [0, 1]")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1.0));
   app->add_option("--points", opts->points,
                   "Sparse points (PLY, world frame) to check the hull against (default: "
                   "scene.json's sparse_points, else sparse/points3D.ply if present)");

@@ -342,6 +342,17 @@ Status ImportInto(const ColmapImportOptions& opts, const std::string& root,
       report->probe_ground_radius = probe.ground_radius;
     }
   }
+  // The support plane in the normalised world (n·p_source + offset with p_source = d·p + c); its
+  // point is the world origin (the object's box centre) dropped onto it. `sft init` and
+  // reconstruct's carve cut the hull there (src/init/visual_hull.h).
+  SupportPlane world_plane = norm.plane;
+  world_plane.offset = (norm.plane.normal.dot(norm.centre) + norm.plane.offset) / norm.diagonal;
+  world_plane.band = norm.plane.band / norm.diagonal;
+  if (norm.plane.found) {
+    dataset.has_support_plane = true;
+    dataset.support_normal = world_plane.normal;
+    dataset.support_point = -world_plane.offset * world_plane.normal;
+  }
   report->probe_ground_requested = probe_ground;
   report->probe_ground = probe_ground && norm.plane.found;
 
@@ -362,10 +373,6 @@ Status ImportInto(const ColmapImportOptions& opts, const std::string& root,
   SFT_RETURN_IF_ERROR(WriteSceneJson(dataset, root));
   Dataset check;
   SFT_RETURN_IF_ERROR(ReadDataset(root, &check));
-  // The support plane in the normalised world (n·p_source + offset with p_source = d·p + c).
-  SupportPlane world_plane = norm.plane;
-  world_plane.offset = (norm.plane.normal.dot(norm.centre) + norm.plane.offset) / norm.diagonal;
-  world_plane.band = norm.plane.band / norm.diagonal;
   return AutoMasksAndProbe(opts, seeds, world_plane, &check, report);
 }
 

@@ -84,6 +84,12 @@ Status LoadCarvingViews(const Dataset& dataset, const std::vector<int>& indices,
   return Status::Ok();
 }
 
+void UseDatasetSupport(const Dataset& dataset, VisualHullOptions* hull) {
+  hull->has_support = dataset.has_support_plane;
+  hull->support_normal = dataset.support_normal;
+  hull->support_point = dataset.support_point;
+}
+
 Status MakeInitialMesh(const std::vector<CarvingView>& views, const InitialMeshOptions& options,
                        const std::vector<Eigen::Vector3d>& sparse_points, TriMesh* mesh,
                        InitialMeshReport* report) {
@@ -102,6 +108,8 @@ Status MakeInitialMesh(const std::vector<CarvingView>& views, const InitialMeshO
   report->box = hull.box;
   report->min_views = hull.min_views;
   report->outlier_views = options.hull.outlier_views;
+  report->support = options.hull.has_support;
+  report->support_contact = options.hull.has_support ? options.hull.support_contact : 0.0;
   report->inside_voxels = hull.inside_voxels;
   CheckSparsePoints(hull, sparse_points, report);
 

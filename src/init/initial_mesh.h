@@ -42,10 +42,12 @@ struct InitialMeshOptions {
 constexpr double kInsidePointVoxels = 2.0;
 
 struct InitialMeshReport {
-  VoxelBox box;           // the carving grid.
-  int min_views = 0;      // views that must see a voxel.
-  int outlier_views = 0;  // views whose "outside" a voxel may overrule (VisualHullOptions).
-  int inside_voxels = 0;  // voxels inside the hull.
+  VoxelBox box;                  // the carving grid.
+  int min_views = 0;             // views that must see a voxel.
+  int outlier_views = 0;         // views whose "outside" a voxel may overrule (VisualHullOptions).
+  bool support = false;          // the hull was cut at a support plane (VisualHullOptions).
+  double support_contact = 0.0;  // its contact band's height (scene units), 0 without a support.
+  int inside_voxels = 0;         // voxels inside the hull.
   int extracted_triangles = 0;
   SurfaceCleanupReport cleanup;
   int faces = 0;                 // output faces.
@@ -68,6 +70,9 @@ Status LoadCarvingViews(const Dataset& dataset, std::vector<CarvingView>* views)
 // read nor checked.
 Status LoadCarvingViews(const Dataset& dataset, const std::vector<int>& indices,
                         std::vector<CarvingView>* views);
+
+// Sets `hull`'s support from the dataset's support_plane (no support when it has none).
+void UseDatasetSupport(const Dataset& dataset, VisualHullOptions* hull);
 
 // Carves, extracts, cleans and decimates; compares `sparse_points` (may be empty) with the hull.
 Status MakeInitialMesh(const std::vector<CarvingView>& views, const InitialMeshOptions& options,

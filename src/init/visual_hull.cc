@@ -69,9 +69,25 @@ float FieldAt(const std::vector<CarvingView>& views, const Eigen::Vector3d& p, d
   return static_cast<float>(std::clamp(top[outliers], -band, band));
 }
 
+// FieldAt with the support (see the header): the union with the contact band's extrusion, then
+// the intersection with the half-space above the plane, clamped to [-band, band].
+float SupportedFieldAt(const std::vector<CarvingView>& views, const Eigen::Vector3d& p, double band,
+                       int min_views, const VisualHullOptions& options) {
+  const int outliers = options.outlier_views;
+  float value = FieldAt(views, p, band, min_views, outliers);
+  if (!options.has_support) return value;
+  const double height = options.support_normal.dot(p - options.support_point);
+  if (height >= 0 && height < options.support_contact) {
+    const Eigen::Vector3d top = p + (options.support_contact - height) * options.support_normal;
+    value = std::min(value, FieldAt(views, top, band, min_views, outliers));
+  }
+  return static_cast<float>(std::clamp(std::max<double>(value, -height), -band, band));
+}
+
 // Evaluates the field over `box` in parallel over z slices, advancing `progress` once per slice.
 std::vector<float> EvaluateField(const std::vector<CarvingView>& views, const VoxelBox& box,
-                                 double band, int min_views, int outliers, Progress* progress) {
+                                 double band, int min_views, const VisualHullOptions& options,
+                                 Progress* progress) {
   const int nx = box.dims.x(), ny = box.dims.y(), nz = box.dims.z();
   std::vector<float> field(static_cast<size_t>(box.NumVoxels()));
   tbb::parallel_for(tbb::blocked_range<int>(0, nz, 1), [&](const tbb::blocked_range<int>& r) {
@@ -79,7 +95,7 @@ std::vector<float> EvaluateField(const std::vector<CarvingView>& views, const Vo
       for (int j = 0; j < ny; ++j) {
         float* row = field.data() + (static_cast<size_t>(k) * ny + j) * nx;
         for (int i = 0; i < nx; ++i)
-          row[i] = FieldAt(views, box.Centre(i, j, k), band, min_views, outliers);
+          row[i] = SupportedFieldAt(views, box.Centre(i, j, k), band, min_views, options);
       }
       if (progress != nullptr) progress->Advance();
     }
@@ -96,8 +112,7 @@ bool FindCarvingBox(const std::vector<CarvingView>& views, const VisualHullOptio
   coarse.lo = Eigen::Vector3d::Constant(-options.bounds);
   coarse.dims = Eigen::Vector3i::Constant(kCoarseResolution);
   const double band = kBandVoxels * coarse.voxel_size;
-  const std::vector<float> field =
-      EvaluateField(views, coarse, band, min_views, options.outlier_views, progress);
+  const std::vector<float> field = EvaluateField(views, coarse, band, min_views, options, progress);
   const double touch = 0.5 * std::sqrt(3.0) * coarse.voxel_size;
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
   Eigen::Vector3d hi = -lo;
@@ -146,6 +161,14 @@ bool VisualHullOptions::Check(std::string* why) const {
   if (outlier_views < 0 || outlier_views > kMaxOutlierViews) {
     *why = "outlier_views: must be in [0, " + std::to_string(kMaxOutlierViews) + "], got " +
            std::to_string(outlier_views);
+    return false;
+  }
+  if (has_support && !(std::abs(support_normal.norm() - 1) < 1e-6 && support_point.allFinite())) {
+    *why = "support: the normal must be a unit vector and the point finite";
+    return false;
+  }
+  if (!(support_contact >= 0 && support_contact <= bounds)) {
+    *why = "support_contact: must be in [0, bounds], got " + std::to_string(support_contact);
     return false;
   }
   return true;
@@ -227,7 +250,7 @@ Status CarveVisualHull(const std::vector<CarvingView>& views, const VisualHullOp
   hull->box = box;
   hull->band = kBandVoxels * box.voxel_size;
   hull->min_views = min_views;
-  hull->field = EvaluateField(views, box, hull->band, min_views, options.outlier_views, progress);
+  hull->field = EvaluateField(views, box, hull->band, min_views, options, progress);
   // The progress total counts `resolution` fine slices; the box may have fewer along z.
   if (progress != nullptr) progress->Advance(options.resolution - box.dims.z());
   hull->inside_voxels = static_cast<int>(

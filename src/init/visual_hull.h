@@ -19,6 +19,16 @@
 // outside are overruled (a robust visual hull; its zero level set is where all but t of the
 // seeing views agree).
 //
+// The support. A capture's object usually stands on a plane (a table top, the floor; the dataset's
+// `support_plane`, docs/dataset.md). With one, nothing below the plane is in the hull (the field is
+// at least the point's depth below it), and a contact band of height `support_contact` above it
+// takes the cross-section at the band's top down to the plane: a point in the band is inside when
+// it or the point above it at the band's top is. Masks lose an object's lowest part more often than
+// any other (dark feet or a base against their own contact shadow, thresholded or segmented as
+// background); the band gives back what the silhouettes higher up already show, and costs, on an
+// object that narrows towards the support (a sphere, a belly), at most the band's height of
+// the cross-section's overhang.
+//
 // The carving box. A coarse pass (kCoarseResolution³ voxels) evaluates the same field over the
 // generous box [-bounds, bounds]³ (datasets are normalised: the object is centred with a
 // bounding-box diagonal of ~1). The box is the bounding box of the coarse voxels whose value is
@@ -54,6 +64,14 @@ struct VisualHullOptions {
   // shadow thresholded as background, a GrabCut miss), at the price of what only that many views
   // would have carved.
   int outlier_views = 0;
+  // The plane the object stands on (see the file comment); used when has_support.
+  bool has_support = false;
+  Eigen::Vector3d support_normal = Eigen::Vector3d::UnitZ();  // unit, towards the object.
+  Eigen::Vector3d support_point = Eigen::Vector3d::Zero();    // a point of the plane.
+  // Height of the contact band above the support (scene units), [0, bounds]; 0: no band (the
+  // plane still cuts). Ignored without a support. The default was measured on the video road's
+  // automatic masks (docs/init.md, "The support").
+  double support_contact = 0.05;
 
   static constexpr int kMaxOutlierViews = 8;
 

@@ -56,9 +56,9 @@ constexpr double kRotationTolerance = 1e-3;
 // Keys of each object that ReadDataset interprets; all others are kept verbatim as extras.
 using Keys = std::initializer_list<const char*>;
 constexpr Keys kTopLevelKeys = {
-    "format",       "cameras",           "lights",         "views",
-    "background",   "ground_truth",      "sparse_points",  "initial_mesh",
-    "dense_points", "source_from_world", "image_encoding", "lighting"};
+    "format",         "cameras",       "lights",       "views",        "background",
+    "ground_truth",   "sparse_points", "initial_mesh", "dense_points", "source_from_world",
+    "image_encoding", "lighting",      "support_plane"};
 constexpr Keys kSimilarityKeys = {"scale", "rotation", "translation"};
 constexpr Keys kCameraKeys = {"id", "model", "width", "height", "params"};
 constexpr Keys kPointLightKeys = {"id", "type", "frame", "position", "intensity"};
@@ -117,6 +117,7 @@ class SceneParser {
     SFT_RETURN_IF_ERROR(ParseBackground(root, dataset));
     SFT_RETURN_IF_ERROR(ParseGroundTruth(root, dataset));
     SFT_RETURN_IF_ERROR(ParseImportKeys(root, dataset));
+    SFT_RETURN_IF_ERROR(ParseSupportPlane(root, dataset));
     dataset->extra = UnknownKeys(root, kTopLevelKeys);
     return Status::Ok();
   }
@@ -618,6 +619,24 @@ class SceneParser {
     similarity.extra = UnknownKeys(*value, kSimilarityKeys);
     dataset->source_from_world = similarity;
     dataset->has_source_from_world = true;
+    return Status::Ok();
+  }
+
+  // "support_plane": {"normal": 3 numbers (not zero; normalised on read), "point": 3 numbers}.
+  Status ParseSupportPlane(const json& root, Dataset* dataset) const {
+    const json* value = Find(root, "support_plane");
+    if (value == nullptr || value->is_null()) return Status::Ok();
+    const std::string path = "support_plane";
+    if (!value->is_object()) return Error(path, "expected an object, got " + Describe(*value));
+    const json* field = nullptr;
+    SFT_RETURN_IF_ERROR(Require(*value, path, "normal", &field));
+    Eigen::Vector3d normal;
+    SFT_RETURN_IF_ERROR(Vector3(*field, Field(path, "normal"), &normal));
+    if (!(normal.norm() > 1e-12)) return Error(Field(path, "normal"), "must not be zero");
+    SFT_RETURN_IF_ERROR(Require(*value, path, "point", &field));
+    SFT_RETURN_IF_ERROR(Vector3(*field, Field(path, "point"), &dataset->support_point));
+    dataset->support_normal = normal.normalized();
+    dataset->has_support_plane = true;
     return Status::Ok();
   }
 

@@ -136,6 +136,10 @@ struct Dataset {
   std::string lighting;                // "lighting": free text, e.g. "unknown".
   bool has_source_from_world = false;  // "source_from_world" is present.
   Similarity3d source_from_world;      // maps this dataset's world into the import's frame.
+  // "support_plane": the plane the object stands on (world frame), when the capture found one.
+  bool has_support_plane = false;
+  Eigen::Vector3d support_normal = Eigen::Vector3d::UnitZ();  // unit, towards the object.
+  Eigen::Vector3d support_point = Eigen::Vector3d::Zero();    // a point of the plane.
   nlohmann::json extra;  // top-level keys this version does not interpret, kept verbatim.
 };
 

@@ -169,6 +169,12 @@ void AppendOptionalKeys(const Dataset& dataset, ojson* root) {
     AppendExtra(s.extra, &entry);
     (*root)["source_from_world"] = std::move(entry);
   }
+  if (dataset.has_support_plane) {
+    const Eigen::Vector3d& n = dataset.support_normal;
+    const Eigen::Vector3d& p = dataset.support_point;
+    (*root)["support_plane"] = {{"normal", {n.x(), n.y(), n.z()}},
+                                {"point", {p.x(), p.y(), p.z()}}};
+  }
   if (!dataset.image_encoding.empty()) (*root)["image_encoding"] = dataset.image_encoding;
   if (!dataset.lighting.empty()) (*root)["lighting"] = dataset.lighting;
 }

@@ -53,8 +53,10 @@ Status LoadStartMesh(const Dataset& dataset, const StartChoice& choice,
   }
   std::vector<CarvingView> views;
   SFT_RETURN_IF_ERROR(LoadCarvingViews(dataset, carved, &views));
+  InitialMeshOptions options = carve;
+  UseDatasetSupport(dataset, &options.hull);
   InitialMeshReport report;
-  return MakeInitialMesh(views, carve, /*sparse_points=*/{}, mesh, &report);
+  return MakeInitialMesh(views, options, /*sparse_points=*/{}, mesh, &report);
 }
 
 }  // namespace sft

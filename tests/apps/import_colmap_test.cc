@@ -131,6 +131,7 @@ TEST(ImportColmapTest, ProbeGroundWithoutASupportPlaneLeavesTheProbeWhole) {
   ASSERT_TRUE(ReadDataset(tmp.Join("ds"), &dataset).ok());
   ASSERT_EQ(dataset.lights.size(), 1u);
   EXPECT_TRUE(dataset.lights[0].ground_normal.isZero());
+  EXPECT_FALSE(dataset.has_support_plane);
   EXPECT_EQ(dataset.extra["import"]["normalization"]["probe_ground"], false);
 }
 

@@ -152,6 +152,35 @@ TEST(InitCommandTest, SparsePointsAreCountedAgainstTheHull) {
   EXPECT_LE(overruled["points_outside_hull"], summary["points_outside_hull"]);
 }
 
+// A support_plane through the icosphere's centre: the hull is its upper half, closed by the plane,
+// and the JSON says so. The synth icosphere has radius 0.2887.
+TEST(InitCommandTest, TheDatasetsSupportPlaneCutsTheHull) {
+  testing::TempDir tmp;
+  const std::string d = MakeDataset(tmp);
+  nlohmann::json scene = nlohmann::json::parse(testing::ReadTestFile(d + "/scene.json"));
+  scene["support_plane"] = {{"normal", {0, 0, 1}}, {"point", {0, 0, 0}}};
+  testing::WriteTestFile(d + "/scene.json", scene.dump(1));
+  std::string out;
+  ASSERT_EQ(RunSft("init --quiet --dataset " + d + " --out " + tmp.Join("o") +
+                       " --resolution 48 --faces 300",
+                   &out),
+            0)
+      << out;
+  const nlohmann::json summary = nlohmann::json::parse(out.substr(out.find('{')));
+  EXPECT_EQ(summary["support_plane"], true);
+  EXPECT_EQ(summary["support_contact"], 0.05);
+  TriMesh mesh;
+  ASSERT_TRUE(ReadMesh(tmp.Join("o/mesh.ply"), &mesh).ok());
+  double lo = 1, hi = -1;
+  for (auto vh : mesh.vertices()) {
+    lo = std::min<double>(lo, mesh.point(vh)[2]);
+    hi = std::max<double>(hi, mesh.point(vh)[2]);
+  }
+  const double voxel = summary["voxel_size"].get<double>();
+  EXPECT_GT(lo, -voxel);
+  EXPECT_NEAR(hi, 0.2887, 2 * voxel);
+}
+
 TEST(InitCommandTest, ErrorsAreOneLine) {
   testing::TempDir tmp;
   const std::string d = MakeDataset(tmp);
@@ -165,6 +194,7 @@ TEST(InitCommandTest, ErrorsAreOneLine) {
       {"--resolution 2000", "--resolution: must be in [16, 1024], got 2000"},
       {"--faces 50", "--faces: must be in [100, 50000000], got 50"},
       {"--outlier-views 9", "--outlier-views: Value 9 not in range 0 to 8"},
+      {"--support-contact 2", "--support-contact: Value 2 not in range"},
       {"--points " + tmp.Join("missing.ply"), "missing.ply"},
   };
   for (const Case& c : cases) {

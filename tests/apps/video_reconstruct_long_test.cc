@@ -92,6 +92,11 @@ TEST(VideoReconstructLongTest, SyntheticVideoReconstructedAndScoredInTheTruthsFr
   ASSERT_EQ(imported.lights.size(), 1u);
   const Eigen::Vector3d up = fit.align * imported.lights[0].ground_normal;
   EXPECT_GT(up.z(), std::cos(2.0 * M_PI / 180)) << up.transpose();
+  // The dataset's support_plane is that plane (sft init and reconstruct's carve cut there).
+  ASSERT_TRUE(imported.has_support_plane);
+  const LightSpec& probe = imported.lights[0];
+  EXPECT_GT(imported.support_normal.dot(probe.ground_normal), 1 - 1e-9);
+  EXPECT_NEAR(imported.support_normal.dot(imported.support_point - probe.ground_point), 0, 1e-9);
   // The support is a disc: the truth's ground is a square of half side 2 object diagonals (the
   // truth's mesh has a unit diagonal), so in the truth's units its radius lies between the
   // square's inner 2 and outer 2.83.

@@ -42,6 +42,15 @@ TEST(DatasetErrors, BadImportKeys) {
   scene["source_from_world"] = {{"scale", 1}, {"rotation", {1, 0, 0, 0}}};
   EXPECT_THAT(ReadError(scene), HasSubstr("source_from_world.translation: missing"));
   scene = MinimalScene();
+  scene["support_plane"] = {{"normal", {0, 0, 0}}, {"point", {0, 0, 0}}};
+  EXPECT_THAT(ReadError(scene), HasSubstr("support_plane.normal: must not be zero"));
+  scene["support_plane"] = {{"normal", {0, 0, 1}}};
+  EXPECT_THAT(ReadError(scene), HasSubstr("support_plane.point: missing"));
+  scene["support_plane"] = {{"normal", {0, 1}}, {"point", {0, 0, 0}}};
+  EXPECT_THAT(ReadError(scene), HasSubstr("support_plane.normal"));
+  scene["support_plane"] = "floor";
+  EXPECT_THAT(ReadError(scene), HasSubstr("support_plane: expected an object"));
+  scene = MinimalScene();
   scene["lighting"] = 3;
   EXPECT_THAT(ReadError(scene), HasSubstr("lighting"));
 }

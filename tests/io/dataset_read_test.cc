@@ -122,6 +122,7 @@ TEST(DatasetRead, ImportKeysAreParsedAndWrittenBack) {
       {"scale", 3.5}, {"rotation", {0, 0, 0, 2}}, {"translation", {1, 2, 3}}, {"note", "kept"}};
   scene["image_encoding"] = "sRGB 8-bit JPEG converted to PNG";
   scene["lighting"] = "unknown";
+  scene["support_plane"] = {{"normal", {0, 0, 2}}, {"point", {0.5, 0, -0.25}}};
   scene["views"][0]["lights"] = json::array();  // unknown lighting reads fine.
   TempDir dir;
   WriteJson(dir.path(), scene);
@@ -140,6 +141,9 @@ TEST(DatasetRead, ImportKeysAreParsedAndWrittenBack) {
   EXPECT_LT(
       (dataset.source_from_world * Eigen::Vector3d(1, 0, 0) - Eigen::Vector3d(-2.5, 2, 3)).norm(),
       1e-12);
+  ASSERT_TRUE(dataset.has_support_plane);
+  EXPECT_EQ(dataset.support_normal, Eigen::Vector3d(0, 0, 1));  // normalised.
+  EXPECT_EQ(dataset.support_point, Eigen::Vector3d(0.5, 0, -0.25));
   EXPECT_TRUE(dataset.views[0].lights.empty());
   EXPECT_THAT(CheckViewsHaveLights(dataset).message(), HasSubstr("views[0].lights: empty"));
   TempDir copy;
@@ -150,11 +154,14 @@ TEST(DatasetRead, ImportKeysAreParsedAndWrittenBack) {
   EXPECT_EQ(again.lighting, dataset.lighting);
   EXPECT_EQ(again.source_from_world.translation, Eigen::Vector3d(1, 2, 3));
   EXPECT_EQ(again.source_from_world.extra["note"], "kept");
+  EXPECT_TRUE(again.has_support_plane);
+  EXPECT_EQ(again.support_point, dataset.support_point);
   // Without the keys nothing changes.
   Dataset plain;
   WriteJson(copy.path(), MinimalScene());
   ASSERT_TRUE(ReadDataset(copy.path(), &plain).ok());
   EXPECT_FALSE(plain.has_source_from_world);
+  EXPECT_FALSE(plain.has_support_plane);
   EXPECT_TRUE(plain.sparse_points.empty());
   EXPECT_TRUE(CheckViewsHaveLights(plain).ok());
 }
