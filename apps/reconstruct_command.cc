@@ -268,7 +268,7 @@ Status PrepareSchedule(ReconstructCommandOptions* cli, Dataset* dataset,
   }
   SFT_RETURN_IF_ERROR(UnknownLighting("", config.environment, *cli, dataset));
   ScheduleStart state;
-  SFT_RETURN_IF_ERROR(LoadStartMesh(*dataset, start, InitialMeshOptions(), &state.mesh, held_out));
+  SFT_RETURN_IF_ERROR(LoadStartMesh(*dataset, start, config.carve, &state.mesh, held_out));
   SFT_RETURN_IF_ERROR(LoadMaterial(cli->material.empty() ? kInitialMaterial : cli->material,
                                    state.mesh, &state.material));
   if (config.environment.find_lamp) {
@@ -280,7 +280,8 @@ Status PrepareSchedule(ReconstructCommandOptions* cli, Dataset* dataset,
       {"init", start.path},
       {"material", cli->material},
       {"config", config.flat},
-      {"schedule", config.stages.is_null() ? config.schedule : "explicit"}};
+      {"schedule", config.stages.is_null() ? config.schedule : "explicit"},
+      {"carve", config.carve_keys}};
   if (before_start) SFT_RETURN_IF_ERROR(before_start(cli->dataset, *dataset, stages));
   SFT_RETURN_IF_ERROR(Schedule::Start(*dataset, cli->out, stages, state, run_info, schedule));
   (*schedule)->SetHeldOut(config.holdout, held_out);

@@ -243,6 +243,37 @@ Status ApplyStageConfig(const json& keys, const std::string& source, StageOption
   return Status::Ok();
 }
 
+// "carve": an object of `sft init`'s options (InitialMeshOptions), checked here.
+Status MergeCarveKeys(const json& value, const std::string& source, ScheduleConfig* out) {
+  const std::string where = source + ": carve";
+  if (!value.is_object()) return Status::Error(where + ": expected an object");
+  InitialMeshOptions carve = out->carve;
+  for (const auto& [key, v] : value.items()) {
+    const bool integer = v.is_number_integer() && std::abs(v.get<int64_t>()) < (int64_t{1} << 31);
+    if (key == "resolution" && integer) {
+      carve.hull.resolution = v.get<int>();
+    } else if (key == "faces" && integer) {
+      carve.faces = v.get<int>();
+    } else if (key == "outlier_views" && integer) {
+      carve.hull.outlier_views = v.get<int>();
+    } else if (key == "support_contact" && v.is_number()) {
+      carve.hull.support_contact = v.get<double>();
+    } else if (key == "resolution" || key == "faces" || key == "outlier_views" ||
+               key == "support_contact") {
+      return Status::Error(where + "." + key + ": expected a number");
+    } else {
+      return Status::Error(where + "." + key +
+                           ": unknown key (expected resolution, faces, outlier_views or "
+                           "support_contact)");
+    }
+  }
+  std::string why;
+  if (!carve.Check(&why)) return Status::Error(where + "." + why);
+  out->carve = carve;
+  out->carve_keys.update(value);
+  return Status::Ok();
+}
+
 Status MergeScheduleConfig(const json& config, const std::string& source, ScheduleConfig* out) {
   if (!config.is_object()) return Status::Error(source + ": expected a JSON object");
   for (const auto& [name, value] : config.items()) {
@@ -327,6 +358,8 @@ Status MergeScheduleConfig(const json& config, const std::string& source, Schedu
       if (!estimate.Check(&why)) return Status::Error(source + ": " + why);
       out->environment = estimate;
       out->environment_given = true;
+    } else if (name == "carve") {
+      SFT_RETURN_IF_ERROR(MergeCarveKeys(value, source, out));
     } else if (name == "environment_stage") {
       if (value.is_boolean()) {
         out->environment_stage = value.get<bool>();

@@ -13,6 +13,8 @@
 //   - "find_lamp": true, with no lights given: the map is fitted alone first and a point lamp
 //     starts in its brightest lobe's direction, "lamp_distance" half diagonals from the object
 //     (src/optim/lamp_finder.h).
+//   - "carve": {"resolution", "faces", "outlier_views", "support_contact"}: `sft init`'s options
+//     for the hull carved when the run has no start mesh (src/init/initial_mesh.h).
 // A stage object holds any flat key plus "name", and the stage-only keys "texel_resolution",
 // "remesh", "remesh_edge_pixels", "resample", "resample_fold_fraction", "material_model" and
 // "texture_size" (the effect planner's keys, "effects": "auto" and "pin", are flat keys: config.h).
@@ -26,6 +28,7 @@
 #include <vector>
 
 #include "src/core/status.h"
+#include "src/init/initial_mesh.h"
 #include "src/optim/fitted_environment.h"
 #include "src/optim/schedule.h"
 
@@ -50,6 +53,10 @@ struct ScheduleConfig {
   // environment_size, environment_stage, estimate_lights, find_lamp or lamp_distance was given
   // (a resumed run keeps its map, its lights and its stages).
   bool environment_given = false;
+  // "carve": the options of the hull carved when there is no start mesh (the dataset's
+  // support_plane is added where it is carved).
+  InitialMeshOptions carve;
+  nlohmann::json carve_keys = nlohmann::json::object();  // as given, for the run's records.
 };
 
 // Adds `config`'s keys to *out (later calls override earlier ones key by key; "stages" and

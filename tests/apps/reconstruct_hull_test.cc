@@ -4,11 +4,13 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "src/geometry/mesh.h"
 #include "tests/testing/synth_dataset.h"
 #include "tests/testing/temp_dir.h"
 
@@ -69,6 +71,50 @@ TEST(ReconstructHullTest, CarveRefineRemeshResampleTexture) {
   const nlohmann::json material = ReadJson(tmp.Join("r/material.json"));
   EXPECT_TRUE(fs::exists(tmp.Join("r/report.html")));
   EXPECT_FALSE(material.is_null());
+}
+
+// The config's "carve" key reaches the carved start (`sft init`'s options), is recorded with the
+// run, and a bad value is one error line naming the key. The dataset's support_plane (through the
+// sphere's centre) cuts the carved start: its lowest vertex lies on the plane.
+TEST(ReconstructHullTest, CarveKeysAndTheSupportPlaneShapeTheCarvedStart) {
+  testing::TempDir tmp;
+  ASSERT_EQ(testing::SynthIcosphere(tmp.Join("ds"), "--cameras 6 --zooms 1 --res 24 --spp 4"), "");
+  nlohmann::json scene = ReadJson(tmp.Join("ds/scene.json"));
+  scene["support_plane"] = {{"normal", {0, 0, 1}}, {"point", {0, 0, 0}}};
+  testing::WriteTestFile(tmp.Join("ds/scene.json"), scene.dump(1));
+  testing::WriteTestFile(tmp.Join("cfg.json"), R"({"carve": {"resolution": 32, "faces": 300},
+      "stages": [{"name": "m", "phases": "texture", "outer_iterations": 1, "steps": 1, "spp": 1,
+      "bounces": 1}]})");
+  std::string out;
+  ASSERT_EQ(RunSft("reconstruct --quiet --no-report --dataset " + tmp.Join("ds") + " --out " +
+                       tmp.Join("r") + " --config " + tmp.Join("cfg.json"),
+                   &out),
+            0)
+      << out;
+  const nlohmann::json state = ReadJson(tmp.Join("r/state.json"));
+  EXPECT_EQ(state["run"]["start"], "carved hull");
+  EXPECT_EQ(state["run"]["carve"]["faces"], 300);
+  TriMesh start;
+  ASSERT_TRUE(ReadMesh(tmp.Join("r/initial_mesh.ply"), &start).ok());
+  EXPECT_GT(start.n_faces(), 100u);
+  EXPECT_LE(start.n_faces(), 300u);
+  // Cut by the plane: no vertex below it by more than a voxel (the carving box's side, about
+  // 0.7, over 32), and the sphere's top (radius 0.2887) kept.
+  double lo = 1, hi = -1;
+  for (auto vh : start.vertices()) {
+    lo = std::min<double>(lo, start.point(vh)[2]);
+    hi = std::max<double>(hi, start.point(vh)[2]);
+  }
+  EXPECT_GT(lo, -0.7 / 32);
+  EXPECT_GT(hi, 0.25);
+  testing::WriteTestFile(tmp.Join("bad.json"), R"({"carve": {"faces": 5}})");
+  EXPECT_NE(RunSft("reconstruct --quiet --dataset " + tmp.Join("ds") + " --out " + tmp.Join("b") +
+                       " --config " + tmp.Join("bad.json"),
+                   &out),
+            0);
+  EXPECT_THAT(out, HasSubstr("carve.faces: must be in [100, 50000000], got 5"));
+  EXPECT_EQ(std::count(out.begin(), out.end(), '\n'), 1) << out;
+  EXPECT_FALSE(fs::exists(tmp.Join("b")));
 }
 
 }  // namespace
