@@ -349,6 +349,13 @@ Status RunSynth(const SynthOptions& opts) {
     fs::remove_all(partial, ec);
     return views;
   }
+  if (opts.ground) {
+    // The plane the object stands on, as importers record theirs: carving cuts the hull there.
+    dataset.has_support_plane = true;
+    dataset.support_normal = Eigen::Vector3d::UnitZ();
+    dataset.support_point =
+        Eigen::Vector3d(target.x(), target.y(), GroundHeight(lo, hi, opts.ground_options));
+  }
   SFT_RETURN_IF_ERROR(RenderImages(opts, render, mesh, material, dataset, partial));
   return FinishDataset(opts, render, mesh, material, &dataset, partial);
 }

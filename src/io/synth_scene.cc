@@ -91,6 +91,11 @@ bool GroundOptions::Check(std::string* why) const {
   return true;
 }
 
+double GroundHeight(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi,
+                    const GroundOptions& options) {
+  return lo.z() - options.gap * (hi - lo).norm();
+}
+
 Status AddGroundPlane(const TriMesh& object, const Material& object_material,
                       const GroundOptions& options, TriMesh* mesh, Material* material) {
   std::string why;
@@ -100,7 +105,7 @@ Status AddGroundPlane(const TriMesh& object, const Material& object_material,
   const double diagonal = (hi - lo).norm();
   if (!(diagonal > 0)) return Status::Error("--ground: the object has zero extent");
   const Eigen::Vector3d centre = 0.5 * (lo + hi);
-  const double z = lo.z() - options.gap * diagonal;
+  const double z = GroundHeight(lo, hi, options);
   const double half = options.half_size * diagonal;
   const int n = options.cells;
 

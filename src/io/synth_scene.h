@@ -35,6 +35,10 @@ struct GroundOptions {
   bool Check(std::string* why) const;
 };
 
+// The ground plane's height (z) under an object whose bounding box is [lo, hi].
+double GroundHeight(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi,
+                    const GroundOptions& options);
+
 // Appends a square ground plane (normal +z, at the object's lowest z minus `gap`, centred under the
 // object's bounding-box centre) to `object`, and a high-frequency procedural albedo (four octaves
 // of value noise mapped to a warm/cool palette, roughness 0.8) to the material. With

@@ -2,6 +2,7 @@
 // views follow the orbit in order, and a camera below the plane is refused.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 
@@ -28,6 +29,12 @@ TEST(SynthGroundTest, PlaneInImagesNotInMasksOrTruth) {
   TriMesh gt;
   ASSERT_TRUE(ReadMesh(tmp.Join("ds/gt/mesh.ply"), &gt).ok());
   EXPECT_EQ(gt.n_faces(), 320u);
+  // The support_plane is the ground's: +z, 0.001 diagonals under the object's lowest point.
+  double lo = 1e9;
+  for (auto vh : gt.vertices()) lo = std::min<double>(lo, gt.point(vh)[2]);
+  ASSERT_TRUE(dataset.has_support_plane);
+  EXPECT_EQ(dataset.support_normal, Eigen::Vector3d::UnitZ());
+  EXPECT_NEAR(dataset.support_point.z(), lo - 1e-3, 1e-6);
   // Orbit order: camera k at azimuth 2πk/4 (quarter turns), elevation within [20°, 40°].
   for (int k = 0; k < 4; ++k) {
     const Eigen::Vector3d c = dataset.views[k].cam_from_world.Inverse().translation;

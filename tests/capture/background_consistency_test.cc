@@ -14,7 +14,6 @@
 #include "src/capture/auto_masks.h"
 #include "src/capture/colmap_import.h"
 #include "src/core/file_util.h"
-#include "src/geometry/mesh.h"
 #include "src/image/image_io.h"
 #include "src/io/dataset.h"
 #include "src/io/point_cloud_ply.h"
@@ -74,22 +73,13 @@ class GroundSceneTest : public ::testing::Test {
   }
   static void TearDownTestSuite() { delete dir_; }
 
-  // The ground: normal +z at the object's lowest point less sft synth's default gap (1e-3
-  // diagonals).
+  // The ground: the dataset's support_plane (sft synth --ground writes the plane's).
   static SupportPlane Ground(const Dataset& dataset) {
-    TriMesh mesh;
-    EXPECT_TRUE(ReadMesh(JoinPath(dataset.root, "gt/mesh.ply"), &mesh).ok());
-    Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e30), hi = -lo;
-    for (const auto& v : mesh.vertices()) {
-      const auto p = mesh.point(v);
-      const Eigen::Vector3d q(p[0], p[1], p[2]);
-      lo = lo.cwiseMin(q);
-      hi = hi.cwiseMax(q);
-    }
+    EXPECT_TRUE(dataset.has_support_plane);
     SupportPlane plane;
     plane.found = true;
-    plane.normal = Eigen::Vector3d::UnitZ();
-    plane.offset = -(lo.z() - 1e-3 * (hi - lo).norm());
+    plane.normal = dataset.support_normal;
+    plane.offset = -dataset.support_normal.dot(dataset.support_point);
     return plane;
   }
 
