@@ -125,6 +125,9 @@ Status ResumedStages(const ReconstructCommandOptions& cli, const RunState& state
                            ": environment_stage/environment_size/estimate_lights/find_lamp: " +
                            "a resumed run keeps its stages and its fitted lighting");
     }
+    if (!overrides.carve_keys.empty()) {
+      return Status::Error(cli.config + ": carve: a resumed run has its start already");
+    }
   }
   for (const char* key : {"estimate_lights", "find_lamp"}) {
     if (cli.given.count(key) > 0) {

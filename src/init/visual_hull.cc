@@ -168,7 +168,8 @@ bool VisualHullOptions::Check(std::string* why) const {
     return false;
   }
   if (!(support_contact >= 0 && support_contact <= bounds)) {
-    *why = "support_contact: must be in [0, bounds], got " + std::to_string(support_contact);
+    *why = "support_contact: must be in [0, " + std::to_string(bounds) + "] (the carved box's " +
+           "half side), got " + std::to_string(support_contact);
     return false;
   }
   return true;

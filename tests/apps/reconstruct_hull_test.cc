@@ -115,6 +115,13 @@ TEST(ReconstructHullTest, CarveKeysAndTheSupportPlaneShapeTheCarvedStart) {
   EXPECT_THAT(out, HasSubstr("carve.faces: must be in [100, 50000000], got 5"));
   EXPECT_EQ(std::count(out.begin(), out.end(), '\n'), 1) << out;
   EXPECT_FALSE(fs::exists(tmp.Join("b")));
+  // A resumed run has its start: the key is refused.
+  testing::WriteTestFile(tmp.Join("again.json"), R"({"carve": {"outlier_views": 1}})");
+  EXPECT_NE(RunSft("reconstruct --quiet --resume " + tmp.Join("r") + " --config " +
+                       tmp.Join("again.json"),
+                   &out),
+            0);
+  EXPECT_THAT(out, HasSubstr("carve: a resumed run has its start already")) << out;
 }
 
 }  // namespace
