@@ -324,24 +324,6 @@ Status ImportInto(const ColmapImportOptions& opts, const std::string& root,
   }
 
   SFT_RETURN_IF_ERROR(AddProbeLight(opts, root, &dataset));
-  // --probe-ground: the support plane's normal (a direction: the normalisation has no rotation).
-  const bool probe_ground = opts.normalization.plane.hides_probe && !opts.probe.empty();
-  if (probe_ground && norm.plane.found) {
-    LightSpec& probe = dataset.lights[0];
-    probe.ground_normal = norm.plane.normal;
-    // The support as a disc (in the normalised world): past a table's edge the probe still lights
-    // the object from below the horizon.
-    std::vector<Eigen::Vector3d> model_points;
-    for (const ColmapPoint3D& point : model.points) model_points.push_back(point.xyz);
-    Eigen::Vector3d centre;
-    double radius = 0;
-    if (FindSupportDisc(norm.plane, model_points, norm.centre, kSupportDiscQuantile, &centre,
-                        &radius)) {
-      probe.ground_point = (centre - norm.centre) / norm.diagonal;
-      probe.ground_radius = radius / norm.diagonal;
-      report->probe_ground_radius = probe.ground_radius;
-    }
-  }
   // The support plane in the normalised world (n·p_source + offset with p_source = d·p + c); its
   // point is the world origin (the object's box centre) dropped onto it. `sft init` and
   // reconstruct's carve cut the hull there (src/init/visual_hull.h).
@@ -352,6 +334,22 @@ Status ImportInto(const ColmapImportOptions& opts, const std::string& root,
     dataset.has_support_plane = true;
     dataset.support_normal = world_plane.normal;
     dataset.support_point = -world_plane.offset * world_plane.normal;
+  }
+  // --probe-ground: the support plane's normal (a direction: the normalisation has no rotation).
+  const bool probe_ground = opts.normalization.plane.hides_probe && !opts.probe.empty();
+  if (probe_ground && norm.plane.found) {
+    LightSpec& probe = dataset.lights[0];
+    probe.ground_normal = norm.plane.normal;
+    // The support as a disc around the support point: past a table's edge the probe still lights
+    // the object from below the horizon.
+    Eigen::Vector3d centre;
+    double radius = 0;
+    if (FindSupportDisc(world_plane, sparse.positions, Eigen::Vector3d::Zero(),
+                        kSupportDiscQuantile, &centre, &radius)) {
+      probe.ground_point = centre;
+      probe.ground_radius = radius;
+      report->probe_ground_radius = radius;
+    }
   }
   report->probe_ground_requested = probe_ground;
   report->probe_ground = probe_ground && norm.plane.found;
