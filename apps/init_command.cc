@@ -22,6 +22,7 @@
 #include "src/core/memory.h"
 #include "src/geometry/mesh.h"
 #include "src/init/initial_mesh.h"
+#include "src/init/stereo_mesh.h"
 #include "src/io/dataset.h"
 #include "src/io/point_cloud_ply.h"
 
@@ -117,6 +118,22 @@ nlohmann::ordered_json Summary(const std::string& mesh_path, const std::string& 
   };
 }
 
+nlohmann::ordered_json StereoSummary(const StereoMeshReport& r) {
+  return {
+      {"pairs", r.stereo.pairs},
+      {"views_without_pair", r.stereo.views_without_pair},
+      {"matched_pixels", r.stereo.matched_pixels},
+      {"points", r.stereo.points},
+      {"poisson_points", r.surface.points},
+      {"spacing", r.surface.spacing},
+      {"trimmed_voxels", r.surface.trimmed_voxels},
+      {"components_removed", r.surface.components_removed},
+      {"load_seconds", r.load_seconds},
+      {"stereo_seconds", r.stereo.seconds},
+      {"surface_seconds", r.surface.total_seconds},
+  };
+}
+
 Status RunInit(const InitCommandOptions& opts) {
   std::string why;
   if (!opts.mesh.Check(&why)) return Status::Error("--" + why);
@@ -174,10 +191,22 @@ Status RunInit(const InitCommandOptions& opts) {
   TriMesh mesh;
   InitialMeshReport report;
   SFT_RETURN_IF_ERROR(MakeInitialMesh(views, mesh_options, points, &mesh, &report));
+  StereoMeshReport stereo_report;
+  if (mesh_options.stereo) {
+    std::vector<int> all(dataset.views.size());
+    for (size_t v = 0; v < all.size(); ++v) all[v] = static_cast<int>(v);
+    SFT_RETURN_IF_ERROR(
+        MakeStereoMesh(dataset, all, views, mesh, mesh_options, &mesh, &stereo_report));
+  }
   if (!into_dataset) SFT_RETURN_IF_ERROR(MakeDirectories(opts.out));
   SFT_RETURN_IF_ERROR(WriteMesh(mesh_path, mesh));
 
   nlohmann::ordered_json summary = Summary(mesh_path, points_path, report);
+  if (opts.mesh.stereo) {
+    summary["faces"] = static_cast<int>(mesh.n_faces());
+    summary["vertices"] = static_cast<int>(mesh.n_vertices());
+    summary["stereo"] = StereoSummary(stereo_report);
+  }
   if (into_dataset) {
     bool added = false;
     std::string existing;
@@ -234,6 +263,24 @@ CommandRunner SetupInitCommand(CLI::App* app) {
   app->add_option("--points", opts->points,
                   "Sparse points (PLY, world frame) to check the hull against (default: "
                   "scene.json's sparse_points, else sparse/points3D.ply if present)");
+  app->add_flag("--stereo", opts->mesh.stereo,
+                "Rebuild the carved hull from stereo: dense points from each view and its nearest "
+                "neighbours (semi-global matching), Poisson reconstruction, intersected with the "
+                "hull; gives back concavities silhouettes cannot see (docs/init.md)");
+  app->add_option("--stereo-max-angle", opts->mesh.stereo_options.max_angle_deg,
+                  "Stereo: largest angle (degrees) between a pair's views, seen from the object, "
+                  "(0, 90]")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 90.0));
+  app->add_option("--stereo-consistency", opts->mesh.stereo_options.consistency_pixels,
+                  "Stereo: depth tolerance between the pairs of a view, in pixels of disparity, "
+                  "(0, 16]")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 16.0));
+  app->add_option("--stereo-scale", opts->mesh.stereo_options.image_scale_log2,
+                  "Stereo: match at 2^-N of the images' resolution, [0, 4]")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 4));
   app->add_flag("--overwrite", opts->overwrite, "Replace an existing mesh.ply");
   app->add_flag("--quiet", opts->quiet, "No progress line");
   return [opts]() {

@@ -42,6 +42,10 @@ bool InitialMeshOptions::Check(std::string* why) const {
            "], got " + std::to_string(faces);
     return false;
   }
+  if (stereo && !stereo_options.Check(why)) {
+    *why = "stereo." + *why;
+    return false;
+  }
   return true;
 }
 

@@ -17,6 +17,7 @@
 
 #include "src/core/status.h"
 #include "src/geometry/mesh.h"
+#include "src/init/stereo_points.h"
 #include "src/init/surface_cleanup.h"
 #include "src/init/visual_hull.h"
 #include "src/io/dataset.h"
@@ -28,7 +29,11 @@ struct InitialMeshOptions {
   // Faces of the output mesh (upper bound; decimation stops where no legal collapse is left),
   // [kMinFaces, kMaxFaces].
   int faces = 10000;
-  bool progress = true;  // print a progress line on stderr.
+  // Rebuild the hull from stereo points (stereo_mesh.h). MakeInitialMesh only carves; the callers
+  // that read the images (`sft init`, reconstruct's carved start) run the stereo step after it.
+  bool stereo = false;
+  StereoOptions stereo_options;  // checked only when `stereo` is set.
+  bool progress = true;          // print a progress line on stderr.
 
   static constexpr int kMinFaces = 100;
   static constexpr int kMaxFaces = 50000000;

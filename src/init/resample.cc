@@ -99,6 +99,49 @@ Status ExtractSurface(const VoxelBox& box, double band, std::vector<float> field
   return Status::Ok();
 }
 
+// Steps 2-5 of resample.h on given samples.
+Status PoissonFromSamples(std::vector<OrientedPoint> samples, double h, int target_faces,
+                          const std::vector<CarvingView>* hull, const ResampleOptions& options,
+                          TriMesh* out, ResampleReport* report) {
+  auto stage = std::chrono::steady_clock::now();
+  // The grid first: it may coarsen h, which the thinning then uses.
+  const VoxelBox box = MakeGridBox(samples, &h);
+  samples = ThinSamples(samples, h);
+  report->points = static_cast<int>(samples.size());
+  report->spacing = h;
+  report->grid = box.dims;
+  report->cast_seconds += SecondsSince(stage);
+
+  stage = std::chrono::steady_clock::now();
+  const double band = kBandVoxels * h;
+  std::vector<float> field;
+  PoissonGridReport poisson;
+  SFT_RETURN_IF_ERROR(
+      EvaluatePoissonGrid(samples, box, band, &field, &poisson).Prefixed("Poisson reconstruction"));
+  report->triangulation_vertices = poisson.triangulation_vertices;
+  report->solve_seconds = poisson.solve_seconds;
+  report->poisson_seconds = SecondsSince(stage);
+
+  stage = std::chrono::steady_clock::now();
+  if (options.trim_to_hull && hull != nullptr && !hull->empty()) {
+    SFT_RETURN_IF_ERROR(TrimToHull(*hull, options, box, &field, report));
+  }
+  report->trim_seconds = SecondsSince(stage);
+
+  stage = std::chrono::steady_clock::now();
+  TriMesh result;
+  SFT_RETURN_IF_ERROR(ExtractSurface(box, band, std::move(field), &result, report));
+  report->extract_seconds = SecondsSince(stage);
+
+  stage = std::chrono::steady_clock::now();
+  DecimateMesh(target_faces, &result);
+  report->decimate_seconds = SecondsSince(stage);
+  report->vertices_after = static_cast<int>(result.n_vertices());
+  report->faces_after = static_cast<int>(result.n_faces());
+  *out = std::move(result);
+  return Status::Ok();
+}
+
 Status Resample(const TriMesh& mesh, const std::vector<ViewSetup>& views,
                 const std::vector<CarvingView>* hull, const ResampleOptions& options, TriMesh* out,
                 ResampleReport* report) {
@@ -135,41 +178,9 @@ Status Resample(const TriMesh& mesh, const std::vector<ViewSetup>& views,
                          " rays from " + std::to_string(views.size()) +
                          " views hits it (check the cameras and the mesh's position)");
   }
-  // The grid first: it may coarsen h, which the thinning then uses.
-  const VoxelBox box = MakeGridBox(samples, &h);
-  samples = ThinSamples(samples, h);
-  report->points = static_cast<int>(samples.size());
-  report->spacing = h;
-  report->grid = box.dims;
   report->cast_seconds = SecondsSince(stage);
-
-  stage = std::chrono::steady_clock::now();
-  const double band = kBandVoxels * h;
-  std::vector<float> field;
-  PoissonGridReport poisson;
   SFT_RETURN_IF_ERROR(
-      EvaluatePoissonGrid(samples, box, band, &field, &poisson).Prefixed("Poisson reconstruction"));
-  report->triangulation_vertices = poisson.triangulation_vertices;
-  report->solve_seconds = poisson.solve_seconds;
-  report->poisson_seconds = SecondsSince(stage);
-
-  stage = std::chrono::steady_clock::now();
-  if (options.trim_to_hull && hull != nullptr && !hull->empty()) {
-    SFT_RETURN_IF_ERROR(TrimToHull(*hull, options, box, &field, report));
-  }
-  report->trim_seconds = SecondsSince(stage);
-
-  stage = std::chrono::steady_clock::now();
-  TriMesh result;
-  SFT_RETURN_IF_ERROR(ExtractSurface(box, band, std::move(field), &result, report));
-  report->extract_seconds = SecondsSince(stage);
-
-  stage = std::chrono::steady_clock::now();
-  DecimateMesh(target_faces, &result);
-  report->decimate_seconds = SecondsSince(stage);
-  report->vertices_after = static_cast<int>(result.n_vertices());
-  report->faces_after = static_cast<int>(result.n_faces());
-  *out = std::move(result);
+      PoissonFromSamples(std::move(samples), h, target_faces, hull, options, out, report));
   report->total_seconds = SecondsSince(start);
   return Status::Ok();
 }
@@ -211,6 +222,31 @@ Status ResampleSurface(const TriMesh& mesh, const std::vector<ViewSetup>& views,
   } catch (const std::exception& e) {
     return Status::Error(std::string("resampling failed: ") + e.what());
   }
+}
+
+Status SurfaceFromSamples(std::vector<OrientedPoint> samples, double spacing,
+                          const std::vector<CarvingView>* hull, const ResampleOptions& options,
+                          TriMesh* out, ResampleReport* report) {
+  *report = ResampleReport();
+  std::string why;
+  if (!options.Check(&why)) return Status::Error("resample options: " + why);
+  if (options.faces <= 0) return Status::Error("resample options: faces: must be set (> 0)");
+  if (!(spacing > 0) || !std::isfinite(spacing)) {
+    return Status::Error("the sample spacing must be positive, got " + std::to_string(spacing));
+  }
+  if (samples.size() < 4) {
+    return Status::Error("too few surface samples (" + std::to_string(samples.size()) + ")");
+  }
+  const auto start = std::chrono::steady_clock::now();
+  try {
+    SFT_RETURN_IF_ERROR(
+        PoissonFromSamples(std::move(samples), spacing, options.faces, hull, options, out, report)
+            .Prefixed("surface from samples"));
+  } catch (const std::exception& e) {
+    return Status::Error(std::string("surface from samples failed: ") + e.what());
+  }
+  report->total_seconds = SecondsSince(start);
+  return Status::Ok();
 }
 
 }  // namespace sft

@@ -50,6 +50,7 @@
 #include "src/core/status.h"
 #include "src/geometry/mesh.h"
 #include "src/init/surface_cleanup.h"
+#include "src/init/view_samples.h"
 #include "src/init/visual_hull.h"
 #include "src/render/render.h"
 
@@ -123,6 +124,15 @@ struct ResampleReport {
 Status ResampleSurface(const TriMesh& mesh, const std::vector<ViewSetup>& views,
                        const std::vector<CarvingView>* hull, const ResampleOptions& options,
                        TriMesh* out, ResampleReport* report);
+
+// Steps 2-5 above on given oriented samples (e.g. stereo points, stereo_points.h): thinning and the
+// grid at `spacing` (scene units, > 0; it grows when the grid would pass kMaxGridSide), Poisson,
+// trimming to the hull of `hull` when non-null and non-empty and options.trim_to_hull, clean-up
+// and decimation to options.faces (which must be set here). pixel_stride and spacing_factor are
+// not used. Errors as ResampleSurface's, and fewer than 4 samples.
+Status SurfaceFromSamples(std::vector<OrientedPoint> samples, double spacing,
+                          const std::vector<CarvingView>* hull, const ResampleOptions& options,
+                          TriMesh* out, ResampleReport* report);
 
 }  // namespace sft
 

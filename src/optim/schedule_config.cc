@@ -258,13 +258,25 @@ Status MergeCarveKeys(const json& value, const std::string& source, ScheduleConf
       carve.hull.outlier_views = v.get<int>();
     } else if (key == "support_contact" && v.is_number()) {
       carve.hull.support_contact = v.get<double>();
+    } else if (key == "stereo" && v.is_boolean()) {
+      carve.stereo = v.get<bool>();
+    } else if (key == "stereo_max_angle" && v.is_number()) {
+      carve.stereo_options.max_angle_deg = v.get<double>();
+    } else if (key == "stereo_consistency_pixels" && v.is_number()) {
+      carve.stereo_options.consistency_pixels = v.get<double>();
+    } else if (key == "stereo_scale" && integer) {
+      carve.stereo_options.image_scale_log2 = v.get<int>();
+    } else if (key == "stereo") {
+      return Status::Error(where + ".stereo: expected true or false");
     } else if (key == "resolution" || key == "faces" || key == "outlier_views" ||
-               key == "support_contact") {
+               key == "support_contact" || key == "stereo_max_angle" ||
+               key == "stereo_consistency_pixels" || key == "stereo_scale") {
       return Status::Error(where + "." + key + ": expected a number");
     } else {
       return Status::Error(where + "." + key +
-                           ": unknown key (expected resolution, faces, outlier_views or "
-                           "support_contact)");
+                           ": unknown key (expected resolution, faces, outlier_views, "
+                           "support_contact, stereo, stereo_max_angle, "
+                           "stereo_consistency_pixels or stereo_scale)");
     }
   }
   std::string why;

@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "src/core/file_util.h"
+#include "src/init/stereo_mesh.h"
 
 namespace sft {
 
@@ -56,7 +57,10 @@ Status LoadStartMesh(const Dataset& dataset, const StartChoice& choice,
   InitialMeshOptions options = carve;
   UseDatasetSupport(dataset, &options.hull);
   InitialMeshReport report;
-  return MakeInitialMesh(views, options, /*sparse_points=*/{}, mesh, &report);
+  SFT_RETURN_IF_ERROR(MakeInitialMesh(views, options, /*sparse_points=*/{}, mesh, &report));
+  if (!options.stereo) return Status::Ok();
+  StereoMeshReport stereo;
+  return MakeStereoMesh(dataset, carved, views, *mesh, options, mesh, &stereo);
 }
 
 }  // namespace sft

@@ -115,6 +115,20 @@ TEST(ReconstructHullTest, CarveKeysAndTheSupportPlaneShapeTheCarvedStart) {
   EXPECT_THAT(out, HasSubstr("carve.faces: must be in [100, 50000000], got 5"));
   EXPECT_EQ(std::count(out.begin(), out.end(), '\n'), 1) << out;
   EXPECT_FALSE(fs::exists(tmp.Join("b")));
+  testing::WriteTestFile(tmp.Join("bad2.json"),
+                         R"({"carve": {"stereo": true, "stereo_consistency_pixels": 20}})");
+  EXPECT_NE(RunSft("reconstruct --quiet --dataset " + tmp.Join("ds") + " --out " + tmp.Join("b") +
+                       " --config " + tmp.Join("bad2.json"),
+                   &out),
+            0);
+  EXPECT_THAT(out, HasSubstr("carve.stereo.consistency_pixels: must be in (0, 16], got 20")) << out;
+  testing::WriteTestFile(tmp.Join("bad3.json"), R"({"carve": {"stereo": 1}})");
+  EXPECT_NE(RunSft("reconstruct --quiet --dataset " + tmp.Join("ds") + " --out " + tmp.Join("b") +
+                       " --config " + tmp.Join("bad3.json"),
+                   &out),
+            0);
+  EXPECT_THAT(out, HasSubstr("carve.stereo: expected true or false")) << out;
+  EXPECT_FALSE(fs::exists(tmp.Join("b")));
   // A resumed run has its start: the key is refused.
   testing::WriteTestFile(tmp.Join("again.json"), R"({"carve": {"outlier_views": 1}})");
   EXPECT_NE(RunSft("reconstruct --quiet --resume " + tmp.Join("r") + " --config " +
