@@ -110,76 +110,102 @@ cv::Mat ToCv(const Eigen::Matrix3d& m) {
   return out;
 }
 
-// Matches (a, b) and writes the depths (a's z) of a's mask pixels: depth[y·w + x], 0 = none.
-// Returns the pixels that got a depth.
-int64_t MatchPair(const MatchView& a, const MatchView& b, const Eigen::AlignedBox3d& box,
-                  const StereoOptions& options, std::vector<float>* depth) {
+// A rectified pair, turned and flipped so that StereoSGBM can match it: rows are epipolar lines
+// and b's match of a pixel of a lies to its left (disparity d = u_a − u_b in the matched images).
+struct RectifiedPair {
+  cv::Mat grey_a, grey_b;  // CV_8UC1, the matched images (before padding).
+  cv::Mat r1, p1;          // a's rectifying rotation and projection (OpenCV's).
+  Eigen::Matrix3d r1e;     // r1 as Eigen.
+  int axis = 0;            // the baseline's axis in the rectified images (0: rows, 1: columns).
+  double s = 0;            // f · (the baseline along the axis), P2's translation entry.
+  double ca = 0, cb = 0;   // the principal points along the axis (P1, P2).
+  bool mirror = false;     // flipped horizontally (s > 0).
+
+  // Disparity of depth z (rectified a frame) and back.
+  double Disparity(double z) const { return mirror ? s / z - (ca - cb) : -s / z + (ca - cb); }
+  double Depth(double d) const { return mirror ? s / (d + ca - cb) : -s / (d - (ca - cb)); }
+};
+
+RectifiedPair Rectify(const MatchView& a, const MatchView& b) {
   const Eigen::Matrix3d ra = a.cam_from_world.rotation.toRotationMatrix();
   const Eigen::Matrix3d rb = b.cam_from_world.rotation.toRotationMatrix();
   const Eigen::Matrix3d r_ba = rb * ra.transpose();
   const Eigen::Vector3d t_ba = b.cam_from_world.translation - r_ba * a.cam_from_world.translation;
   const cv::Size size(a.camera.width, a.camera.height);
-  cv::Mat r1, r2, p1, p2, q;
+  RectifiedPair pair;
+  cv::Mat r2, p2, q;
   cv::Mat t_cv = (cv::Mat_<double>(3, 1) << t_ba.x(), t_ba.y(), t_ba.z());
   // alpha 1: every source pixel stays in the rectified canvas, so the object is not cut off.
-  cv::stereoRectify(a.K, a.dist, b.K, b.dist, size, ToCv(r_ba), t_cv, r1, r2, p1, p2, q, 0, 1.0,
-                    size);
-  cv::Mat ma_x, ma_y, mb_x, mb_y, grey_a, grey_b;
-  cv::initUndistortRectifyMap(a.K, a.dist, r1, p1, size, CV_32FC1, ma_x, ma_y);
+  cv::stereoRectify(a.K, a.dist, b.K, b.dist, size, ToCv(r_ba), t_cv, pair.r1, r2, pair.p1, p2, q,
+                    0, 1.0, size);
+  cv::Mat ma_x, ma_y, mb_x, mb_y;
+  cv::initUndistortRectifyMap(a.K, a.dist, pair.r1, pair.p1, size, CV_32FC1, ma_x, ma_y);
   cv::initUndistortRectifyMap(b.K, b.dist, r2, p2, size, CV_32FC1, mb_x, mb_y);
-  cv::remap(a.grey, grey_a, ma_x, ma_y, cv::INTER_LINEAR);
-  cv::remap(b.grey, grey_b, mb_x, mb_y, cv::INTER_LINEAR);
-  // The baseline's axis in the rectified images (0: rows are epipolar lines, 1: columns).
-  const int axis = std::abs(p2.at<double>(0, 3)) >= std::abs(p2.at<double>(1, 3)) ? 0 : 1;
-  const double s = p2.at<double>(axis, 3);  // f·(baseline along the axis).
-  const double ca = p1.at<double>(axis, 2), cb = p2.at<double>(axis, 2);
-  const bool mirror = s > 0;  // flipped so that matches lie to the left, as StereoSGBM expects.
-  if (axis == 1) {
-    grey_a = grey_a.t();
-    grey_b = grey_b.t();
+  cv::remap(a.grey, pair.grey_a, ma_x, ma_y, cv::INTER_LINEAR);
+  cv::remap(b.grey, pair.grey_b, mb_x, mb_y, cv::INTER_LINEAR);
+  pair.axis = std::abs(p2.at<double>(0, 3)) >= std::abs(p2.at<double>(1, 3)) ? 0 : 1;
+  pair.s = p2.at<double>(pair.axis, 3);
+  pair.ca = pair.p1.at<double>(pair.axis, 2);
+  pair.cb = p2.at<double>(pair.axis, 2);
+  pair.mirror = pair.s > 0;
+  if (pair.axis == 1) {
+    pair.grey_a = pair.grey_a.t();
+    pair.grey_b = pair.grey_b.t();
   }
-  if (mirror) {
-    cv::flip(grey_a, grey_a, 1);
-    cv::flip(grey_b, grey_b, 1);
+  if (pair.mirror) {
+    cv::flip(pair.grey_a, pair.grey_a, 1);
+    cv::flip(pair.grey_b, pair.grey_b, 1);
   }
-  // Disparity of depth z in the matched images: d = u_a - u_b.
-  const auto disparity = [&](double z) { return mirror ? s / z - (ca - cb) : -s / z + (ca - cb); };
-  const Eigen::Matrix3d r1e = [&] {
-    Eigen::Matrix3d m;
-    for (int i = 0; i < 3; ++i) {
-      for (int j = 0; j < 3; ++j) m(i, j) = r1.at<double>(i, j);
-    }
-    return m;
-  }();
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) pair.r1e(i, j) = pair.r1.at<double>(i, j);
+  }
+  return pair;
+}
+
+// Semi-global matching's disparities of the pair (CV_16S, 1/16 pixel), searched over the depths of
+// `box` seen from a. The images are padded: column c of pair.grey_a is column c + *pad_left of
+// the result; values below *min_disparity · 16 are StereoSGBM's "invalid".
+cv::Mat MatchDisparities(const MatchView& a, const RectifiedPair& pair,
+                         const Eigen::AlignedBox3d& box, const StereoOptions& options,
+                         int* min_disparity, int* pad_left) {
   double d_lo = 1e300, d_hi = -1e300;
   for (int corner = 0; corner < 8; ++corner) {
     const Eigen::Vector3d x = box.corner(static_cast<Eigen::AlignedBox3d::CornerType>(corner));
-    const double z = (r1e * (a.cam_from_world * x)).z();
-    const double d = disparity(std::max(z, 1e-6 * box.diagonal().norm()));
+    const double z = (pair.r1e * (a.cam_from_world * x)).z();
+    const double d = pair.Disparity(std::max(z, 1e-6 * box.diagonal().norm()));
     d_lo = std::min(d_lo, d);
     d_hi = std::max(d_hi, d);
   }
-  const int min_disparity = static_cast<int>(std::floor(d_lo)) - kDisparityMargin;
-  int disparities = static_cast<int>(std::ceil(d_hi - min_disparity)) + kDisparityMargin;
+  *min_disparity = static_cast<int>(std::floor(d_lo)) - kDisparityMargin;
+  int disparities = static_cast<int>(std::ceil(d_hi - *min_disparity)) + kDisparityMargin;
   disparities = std::clamp((disparities + 15) / 16 * 16, 16, kMaxDisparities);
   // Pads so that no column of the object lies in the unsearched left border or matches past the
   // right edge.
-  const int pad_left = std::max(0, min_disparity + disparities);
-  const int pad_right = std::max(0, -min_disparity);
-  cv::copyMakeBorder(grey_a, grey_a, 0, 0, pad_left, pad_right, cv::BORDER_CONSTANT, 0);
-  cv::copyMakeBorder(grey_b, grey_b, 0, 0, pad_left, pad_right, cv::BORDER_CONSTANT, 0);
+  *pad_left = std::max(0, *min_disparity + disparities);
+  const int pad_right = std::max(0, -*min_disparity);
+  cv::Mat grey_a, grey_b;
+  cv::copyMakeBorder(pair.grey_a, grey_a, 0, 0, *pad_left, pad_right, cv::BORDER_CONSTANT, 0);
+  cv::copyMakeBorder(pair.grey_b, grey_b, 0, 0, *pad_left, pad_right, cv::BORDER_CONSTANT, 0);
   const int block = options.block_size;
   auto sgbm = cv::StereoSGBM::create(
-      min_disparity, disparities, block, 8 * block * block, 32 * block * block, /*disp12MaxDiff=*/1,
-      /*preFilterCap=*/0, /*uniquenessRatio=*/10,
+      *min_disparity, disparities, block, 8 * block * block, 32 * block * block,
+      /*disp12MaxDiff=*/1, /*preFilterCap=*/0, /*uniquenessRatio=*/10,
       /*speckleWindowSize=*/100, /*speckleRange=*/2, cv::StereoSGBM::MODE_SGBM_3WAY);
   cv::Mat disp;
   sgbm->compute(grey_a, grey_b, disp);
-  const int rows = disp.rows, cols = disp.cols - pad_left - pad_right;
+  return disp;
+}
+
+// Matches (a, b) and writes the depths (a's z) of a's mask pixels: depth[y·w + x], 0 = none.
+// Every pixel looks its disparity up in the rectified grid (an inverse map, so that no pixel is
+// left between the forward images of rectified pixels). Returns the pixels that got a depth.
+int64_t MatchPair(const MatchView& a, const MatchView& b, const Eigen::AlignedBox3d& box,
+                  const StereoOptions& options, std::vector<float>* depth) {
+  const RectifiedPair pair = Rectify(a, b);
+  int min_disparity = 0, pad_left = 0;
+  const cv::Mat disp = MatchDisparities(a, pair, box, options, &min_disparity, &pad_left);
+  const int rows = pair.grey_a.rows, cols = pair.grey_a.cols;
   const int w = a.camera.width, h = a.camera.height;
-  const double f = p1.at<double>(0, 0);
-  // Every pixel of a's mask looks its disparity up in the rectified grid (an inverse map, so that
-  // no pixel is left between the forward images of rectified pixels).
   std::vector<cv::Point2f> pixels, rectified;
   for (int y = 0; y < h; ++y) {
     for (int x = 0; x < w; ++x) {
@@ -187,7 +213,7 @@ int64_t MatchPair(const MatchView& a, const MatchView& b, const Eigen::AlignedBo
     }
   }
   if (pixels.empty()) return 0;
-  cv::undistortPoints(pixels, rectified, a.K, a.dist, r1, p1);
+  cv::undistortPoints(pixels, rectified, a.K, a.dist, pair.r1, pair.p1);
   const auto disparity_at = [&](int r, int c, double* d) {
     if (r < 0 || c < 0 || r >= rows || c >= cols) return false;
     const int16_t raw = disp.at<int16_t>(r, c + pad_left);
@@ -195,11 +221,12 @@ int64_t MatchPair(const MatchView& a, const MatchView& b, const Eigen::AlignedBo
     *d = raw / 16.0;
     return true;
   };
+  const double f = pair.p1.at<double>(0, 0);
   int64_t matched = 0;
   for (size_t i = 0; i < pixels.size(); ++i) {
     const double u = rectified[i].x, v = rectified[i].y;
-    const double along = axis == 0 ? u : v, across = axis == 0 ? v : u;
-    const double c = mirror ? cols - 1 - along : along;
+    const double along = pair.axis == 0 ? u : v, across = pair.axis == 0 ? v : u;
+    const double c = pair.mirror ? cols - 1 - along : along;
     // Bilinear between the four neighbours when all are valid and within a pixel of one another
     // (a smooth surface), else the nearest one.
     const int c0 = static_cast<int>(std::floor(c)), r0 = static_cast<int>(std::floor(across));
@@ -213,11 +240,11 @@ int64_t MatchPair(const MatchView& a, const MatchView& b, const Eigen::AlignedBo
                              static_cast<int>(std::lround(c)), &d)) {
       continue;
     }
-    const double z = mirror ? s / (d + ca - cb) : -s / (d - (ca - cb));
+    const double z = pair.Depth(d);
     if (!(z > 0) || !std::isfinite(z)) continue;
-    const Eigen::Vector3d in_rect((u - p1.at<double>(0, 2)) * z / f,
-                                  (v - p1.at<double>(1, 2)) * z / f, z);
-    const double depth_a = (r1e.transpose() * in_rect).z();
+    const Eigen::Vector3d in_rect((u - pair.p1.at<double>(0, 2)) * z / f,
+                                  (v - pair.p1.at<double>(1, 2)) * z / f, z);
+    const double depth_a = (pair.r1e.transpose() * in_rect).z();
     if (!(depth_a > 0)) continue;
     ++matched;
     (*depth)[static_cast<size_t>(pixels[i].y) * w + static_cast<int>(pixels[i].x)] =
