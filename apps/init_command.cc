@@ -277,6 +277,11 @@ CommandRunner SetupInitCommand(CLI::App* app) {
                   "(0, 16]")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 16.0));
+  app->add_option("--stereo-pairs", opts->mesh.stereo_options.pairs_per_view,
+                  "Stereo: nearest views matched with each view (any two that agree keep a "
+                  "depth), [2, 8]")
+      ->capture_default_str()
+      ->check(CLI::Range(2, 8));
   app->add_option("--stereo-scale", opts->mesh.stereo_options.image_scale_log2,
                   "Stereo: match at 2^-N of the images' resolution, [0, 4]")
       ->capture_default_str()

@@ -64,7 +64,8 @@ struct StereoOptions {
   // pair: depths agree when they differ by less than the depth this many pixels of disparity span
   // there (z² / (f · baseline)), (0, 16].
   double consistency_pixels = 1.0;
-  // Pairs of a view that must agree for a pixel to keep its depth, [2, pairs_per_view].
+  // Pairs of a view that must agree for a pixel to keep its depth (any of its pairs; the median
+  // of their depths decides which agree), [2, pairs_per_view].
   int min_agreeing_pairs = 2;
   // Match at 2^-image_scale_log2 of the images' resolution (0 = full), [0, 4].
   int image_scale_log2 = 0;

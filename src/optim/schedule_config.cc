@@ -266,17 +266,20 @@ Status MergeCarveKeys(const json& value, const std::string& source, ScheduleConf
       carve.stereo_options.consistency_pixels = v.get<double>();
     } else if (key == "stereo_scale" && integer) {
       carve.stereo_options.image_scale_log2 = v.get<int>();
+    } else if (key == "stereo_pairs" && integer) {
+      carve.stereo_options.pairs_per_view = v.get<int>();
     } else if (key == "stereo") {
       return Status::Error(where + ".stereo: expected true or false");
     } else if (key == "resolution" || key == "faces" || key == "outlier_views" ||
                key == "support_contact" || key == "stereo_max_angle" ||
-               key == "stereo_consistency_pixels" || key == "stereo_scale") {
+               key == "stereo_consistency_pixels" || key == "stereo_scale" ||
+               key == "stereo_pairs") {
       return Status::Error(where + "." + key + ": expected a number");
     } else {
       return Status::Error(where + "." + key +
                            ": unknown key (expected resolution, faces, outlier_views, "
                            "support_contact, stereo, stereo_max_angle, "
-                           "stereo_consistency_pixels or stereo_scale)");
+                           "stereo_consistency_pixels, stereo_scale or stereo_pairs)");
     }
   }
   std::string why;
