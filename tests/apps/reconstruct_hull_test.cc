@@ -122,6 +122,13 @@ TEST(ReconstructHullTest, CarveKeysAndTheSupportPlaneShapeTheCarvedStart) {
                    &out),
             0);
   EXPECT_THAT(out, HasSubstr("carve.stereo.consistency_pixels: must be in (0, 16], got 20")) << out;
+  testing::WriteTestFile(tmp.Join("bad4.json"),
+                         R"({"carve": {"stereo": true, "stereo_pairs": 1}})");
+  EXPECT_NE(RunSft("reconstruct --quiet --dataset " + tmp.Join("ds") + " --out " + tmp.Join("b") +
+                       " --config " + tmp.Join("bad4.json"),
+                   &out),
+            0);
+  EXPECT_THAT(out, HasSubstr("carve.stereo.pairs_per_view: must be in [2, 8], got 1")) << out;
   testing::WriteTestFile(tmp.Join("bad3.json"), R"({"carve": {"stereo": 1}})");
   EXPECT_NE(RunSft("reconstruct --quiet --dataset " + tmp.Join("ds") + " --out " + tmp.Join("b") +
                        " --config " + tmp.Join("bad3.json"),
