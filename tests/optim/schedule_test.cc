@@ -169,6 +169,31 @@ TEST(ScheduleConfigTest, ShippedGlossyRefineSchedulesParse) {
   }
 }
 
+// The shipped list for real captures without a probe (data/example/real_ring.json,
+// docs/reconstruct.md "Real captures without a probe"): a stereo start of 30,000 faces, every 8th
+// view held out, a growing scale that alternates texture and geometry, and a final texture stage.
+TEST(ScheduleConfigTest, ShippedRealRingScheduleParses) {
+  ScheduleConfig config;
+  const Status status = ReadScheduleConfig(testing::DataDir() + "/example/real_ring.json", &config);
+  ASSERT_TRUE(status.ok()) << status.message();
+  EXPECT_TRUE(config.carve.stereo);
+  EXPECT_EQ(config.carve.faces, 30000);
+  EXPECT_EQ(config.holdout, 8);
+  std::vector<StageOptions> stages;
+  ASSERT_TRUE(ResolveStages(config, /*carved_start=*/true, &stages).ok());
+  ASSERT_EQ(stages.size(), 5u);
+  int last_scale_log2 = 10;
+  for (const StageOptions& stage : stages) {
+    SCOPED_TRACE(stage.name);
+    EXPECT_LE(stage.fit.cache.image_scale_log2, last_scale_log2);  // coarse to fine.
+    last_scale_log2 = stage.fit.cache.image_scale_log2;
+    EXPECT_FALSE(stage.fit.fit_specular);
+  }
+  EXPECT_EQ(stages.front().fit.cache.image_scale_log2, 3);
+  EXPECT_EQ(stages[1].fit.phases, PhaseSchedule::kGeometry);
+  EXPECT_EQ(stages.back().fit.phases, PhaseSchedule::kTexture);
+}
+
 // A step's progress work: pixels × spp, and for an Adam minibatch its share of the fitted views.
 TEST(ScheduleConfigTest, StepWorkCountsTheMinibatchShare) {
   StageOptions lm;
