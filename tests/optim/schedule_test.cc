@@ -178,6 +178,7 @@ TEST(ScheduleConfigTest, ShippedRealRingScheduleParses) {
   ASSERT_TRUE(status.ok()) << status.message();
   EXPECT_TRUE(config.carve.stereo);
   EXPECT_EQ(config.carve.faces, 30000);
+  EXPECT_EQ(config.carve.stereo_options.consistency_pixels, 0.5);
   EXPECT_EQ(config.holdout, 8);
   std::vector<StageOptions> stages;
   ASSERT_TRUE(ResolveStages(config, /*carved_start=*/true, &stages).ok());
