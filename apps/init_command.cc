@@ -202,7 +202,7 @@ Status RunInit(const InitCommandOptions& opts) {
   SFT_RETURN_IF_ERROR(WriteMesh(mesh_path, mesh));
 
   nlohmann::ordered_json summary = Summary(mesh_path, points_path, report);
-  if (opts.mesh.stereo) {
+  if (mesh_options.stereo) {
     summary["faces"] = static_cast<int>(mesh.n_faces());
     summary["vertices"] = static_cast<int>(mesh.n_vertices());
     summary["stereo"] = StereoSummary(stereo_report);

@@ -159,7 +159,7 @@ Status Resample(const TriMesh& mesh, const std::vector<ViewSetup>& views,
   }
   const int target_faces = options.faces > 0 ? options.faces : static_cast<int>(faces.size());
   const double area = SurfaceArea(positions, faces);
-  double h = options.spacing_factor * std::sqrt(4.0 * area / (std::sqrt(3.0) * target_faces));
+  double h = options.spacing_factor * EquilateralEdgeLength(area, target_faces);
   if (!(h > 0) || !std::isfinite(h)) return Status::Error("the mesh has no area");
 
   auto stage = std::chrono::steady_clock::now();
@@ -186,6 +186,10 @@ Status Resample(const TriMesh& mesh, const std::vector<ViewSetup>& views,
 }
 
 }  // namespace
+
+double EquilateralEdgeLength(double area, int faces) {
+  return std::sqrt(4.0 * area / (std::sqrt(3.0) * faces));
+}
 
 bool ResampleOptions::Check(std::string* why) const {
   if (pixel_stride < 1 || pixel_stride > kMaxPixelStride) {

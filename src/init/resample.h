@@ -82,6 +82,10 @@ struct ResampleOptions {
   bool Check(std::string* why) const;
 };
 
+// The mean edge length of a mesh of `faces` equilateral triangles covering `area` (the spacing the
+// resampling's thinning and grid take for a target face count).
+double EquilateralEdgeLength(double area, int faces);
+
 // The grid's margin around the samples' bounding box: this fraction of its diagonal, and at least
 // kGridMarginVoxels voxels.
 constexpr double kGridMarginFraction = 0.05;

@@ -49,7 +49,7 @@ Status MakeStereoMesh(const Dataset& dataset, const std::vector<int>& indices,
   Eigen::AlignedBox3d box;
   for (const Eigen::Vector3d& p : positions) box.extend(p);
   const double area = SurfaceArea(positions, faces);
-  const double spacing = std::sqrt(4.0 * area / (std::sqrt(3.0) * options.faces));
+  const double spacing = EquilateralEdgeLength(area, options.faces);
 
   std::vector<StereoView> views;
   SFT_RETURN_IF_ERROR(LoadStereoViews(dataset, indices, &views));

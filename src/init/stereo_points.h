@@ -18,8 +18,9 @@
 //     dark surfaces keep their contrast). The disparity search covers the depths of the object's
 //     box seen from a, and the images are padded so that no part of the object falls in
 //     StereoSGBM's unsearched border.
-//  3. Every valid disparity becomes a 3D point, projected back into a's own (distorted) image and
-//     splatted into a depth map of a's pixels (nearest point per pixel).
+//  3. Every pixel of a's mask looks its disparity up in the rectified grid (its rectified position
+//     from OpenCV's undistortPoints; bilinear where the four neighbours agree within a pixel, else
+//     the nearest) and becomes a depth along its own ray.
 //  4. A pixel of a's mask (when a has one) keeps a depth when at least `min_agreeing_pairs` pairs
 //     give depths within `consistency_pixels` of disparity of their median (measured on the
 //     pair with the shortest baseline, whose depths are the least certain: z² / (f · baseline)
@@ -87,16 +88,16 @@ struct StereoView {
 struct StereoReport {
   int views = 0;               // views given.
   int pairs = 0;               // pairs matched.
-  int views_without_pair = 0;  // views with fewer than two partners in the angle range.
+  int views_without_pair = 0;  // views with fewer than min_agreeing_pairs partners in range.
   int64_t matched_pixels = 0;  // valid disparities inside the masks, over all pairs.
   int64_t points = 0;          // pixels that kept a depth (the result's size).
   double seconds = 0.0;
 };
 
 // Points of the surface seen by `views`, whose object lies in `object_box` (world frame; it bounds
-// the disparity search). Runs the pairs in parallel (TBB). Errors (no exception escapes): invalid
-// options; fewer than 3 views; a view whose image or mask does not have its camera's size; an
-// unsupported camera; an empty box.
+// the disparity search). Runs the views in parallel (TBB), each with its pairs. Errors (no
+// exception escapes): invalid options; fewer than 3 views; an invalid camera; a view whose image or
+// mask does not have its camera's size; an empty box.
 Status ComputeStereoPoints(const std::vector<StereoView>& views,
                            const Eigen::AlignedBox3d& object_box, const StereoOptions& options,
                            std::vector<OrientedPoint>* points, StereoReport* report);

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <functional>
+#include <iterator>
 #include <map>
 
 #include "src/core/file_util.h"
@@ -243,6 +244,12 @@ Status ApplyStageConfig(const json& keys, const std::string& source, StageOption
   return Status::Ok();
 }
 
+// The keys of "carve" (docs/reconstruct.md), for the error messages.
+constexpr const char* kCarveKeys[] = {
+    "resolution",       "faces",        "outlier_views",
+    "support_contact",  "stereo",       "stereo_pairs",
+    "stereo_max_angle", "stereo_scale", "stereo_consistency_pixels"};
+
 // "carve": an object of `sft init`'s options (InitialMeshOptions), checked here.
 Status MergeCarveKeys(const json& value, const std::string& source, ScheduleConfig* out) {
   const std::string where = source + ": carve";
@@ -270,16 +277,13 @@ Status MergeCarveKeys(const json& value, const std::string& source, ScheduleConf
       carve.stereo_options.pairs_per_view = v.get<int>();
     } else if (key == "stereo") {
       return Status::Error(where + ".stereo: expected true or false");
-    } else if (key == "resolution" || key == "faces" || key == "outlier_views" ||
-               key == "support_contact" || key == "stereo_max_angle" ||
-               key == "stereo_consistency_pixels" || key == "stereo_scale" ||
-               key == "stereo_pairs") {
+    } else if (std::find(std::begin(kCarveKeys), std::end(kCarveKeys), key) !=
+               std::end(kCarveKeys)) {
       return Status::Error(where + "." + key + ": expected a number");
     } else {
-      return Status::Error(where + "." + key +
-                           ": unknown key (expected resolution, faces, outlier_views, "
-                           "support_contact, stereo, stereo_max_angle, "
-                           "stereo_consistency_pixels, stereo_scale or stereo_pairs)");
+      std::string known;
+      for (const char* name : kCarveKeys) known += (known.empty() ? "" : ", ") + std::string(name);
+      return Status::Error(where + "." + key + ": unknown key (expected one of " + known + ")");
     }
   }
   std::string why;

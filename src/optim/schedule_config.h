@@ -14,8 +14,8 @@
 //     starts in its brightest lobe's direction, "lamp_distance" half diagonals from the object
 //     (src/optim/lamp_finder.h).
 //   - "carve": {"resolution", "faces", "outlier_views", "support_contact", "stereo",
-//     "stereo_max_angle", "stereo_consistency_pixels", "stereo_scale"}: `sft init`'s options
-//     for the hull carved when the run has no start mesh (src/init/initial_mesh.h).
+//     "stereo_pairs", "stereo_max_angle", "stereo_consistency_pixels", "stereo_scale"}: `sft
+//     init`'s options for the hull carved when the run has no start mesh (src/init/initial_mesh.h).
 // A stage object holds any flat key plus "name", and the stage-only keys "texel_resolution",
 // "remesh", "remesh_edge_pixels", "resample", "resample_fold_fraction", "material_model" and
 // "texture_size" (the effect planner's keys, "effects": "auto" and "pin", are flat keys: config.h).

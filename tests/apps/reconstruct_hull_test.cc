@@ -9,6 +9,9 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "src/geometry/mesh.h"
 #include "tests/testing/synth_dataset.h"
@@ -107,35 +110,26 @@ TEST(ReconstructHullTest, CarveKeysAndTheSupportPlaneShapeTheCarvedStart) {
   }
   EXPECT_GT(lo, -0.7 / 32);
   EXPECT_GT(hi, 0.25);
-  testing::WriteTestFile(tmp.Join("bad.json"), R"({"carve": {"faces": 5}})");
-  EXPECT_NE(RunSft("reconstruct --quiet --dataset " + tmp.Join("ds") + " --out " + tmp.Join("b") +
-                       " --config " + tmp.Join("bad.json"),
-                   &out),
-            0);
-  EXPECT_THAT(out, HasSubstr("carve.faces: must be in [100, 50000000], got 5"));
-  EXPECT_EQ(std::count(out.begin(), out.end(), '\n'), 1) << out;
-  EXPECT_FALSE(fs::exists(tmp.Join("b")));
-  testing::WriteTestFile(tmp.Join("bad2.json"),
-                         R"({"carve": {"stereo": true, "stereo_consistency_pixels": 20}})");
-  EXPECT_NE(RunSft("reconstruct --quiet --dataset " + tmp.Join("ds") + " --out " + tmp.Join("b") +
-                       " --config " + tmp.Join("bad2.json"),
-                   &out),
-            0);
-  EXPECT_THAT(out, HasSubstr("carve.stereo.consistency_pixels: must be in (0, 16], got 20")) << out;
-  testing::WriteTestFile(tmp.Join("bad4.json"),
-                         R"({"carve": {"stereo": true, "stereo_pairs": 1}})");
-  EXPECT_NE(RunSft("reconstruct --quiet --dataset " + tmp.Join("ds") + " --out " + tmp.Join("b") +
-                       " --config " + tmp.Join("bad4.json"),
-                   &out),
-            0);
-  EXPECT_THAT(out, HasSubstr("carve.stereo.pairs_per_view: must be in [2, 8], got 1")) << out;
-  testing::WriteTestFile(tmp.Join("bad3.json"), R"({"carve": {"stereo": 1}})");
-  EXPECT_NE(RunSft("reconstruct --quiet --dataset " + tmp.Join("ds") + " --out " + tmp.Join("b") +
-                       " --config " + tmp.Join("bad3.json"),
-                   &out),
-            0);
-  EXPECT_THAT(out, HasSubstr("carve.stereo: expected true or false")) << out;
-  EXPECT_FALSE(fs::exists(tmp.Join("b")));
+  // A bad carve value is one line that writes nothing.
+  const std::vector<std::pair<std::string, std::string>> bad_configs = {
+      {R"({"carve": {"faces": 5}})", "carve.faces: must be in [100, 50000000], got 5"},
+      {R"({"carve": {"stereo": true, "stereo_consistency_pixels": 20}})",
+       "carve.stereo.consistency_pixels: must be in (0, 16], got 20"},
+      {R"({"carve": {"stereo": true, "stereo_pairs": 1}})",
+       "carve.stereo.pairs_per_view: must be in [2, 8], got 1"},
+      {R"({"carve": {"stereo": 1}})", "carve.stereo: expected true or false"},
+  };
+  for (const auto& [config, message] : bad_configs) {
+    SCOPED_TRACE(config);
+    testing::WriteTestFile(tmp.Join("bad.json"), config);
+    EXPECT_NE(RunSft("reconstruct --quiet --dataset " + tmp.Join("ds") + " --out " + tmp.Join("b") +
+                         " --config " + tmp.Join("bad.json"),
+                     &out),
+              0);
+    EXPECT_THAT(out, HasSubstr(message)) << out;
+    EXPECT_EQ(std::count(out.begin(), out.end(), '\n'), 1) << out;
+    EXPECT_FALSE(fs::exists(tmp.Join("b")));
+  }
   // A resumed run has its start: the key is refused.
   testing::WriteTestFile(tmp.Join("again.json"), R"({"carve": {"outlier_views": 1}})");
   EXPECT_NE(RunSft("reconstruct --quiet --resume " + tmp.Join("r") + " --config " +
