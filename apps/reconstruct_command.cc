@@ -271,7 +271,13 @@ Status PrepareSchedule(ReconstructCommandOptions* cli, Dataset* dataset,
   }
   SFT_RETURN_IF_ERROR(UnknownLighting("", config.environment, *cli, dataset));
   ScheduleStart state;
-  SFT_RETURN_IF_ERROR(LoadStartMesh(*dataset, start, config.carve, &state.mesh, held_out));
+  std::string start_line;
+  SFT_RETURN_IF_ERROR(
+      LoadStartMesh(*dataset, start, config.carve, &state.mesh, held_out, &start_line));
+  if (!cli->quiet) {
+    std::printf("%s\n", start_line.c_str());
+    std::fflush(stdout);  // before the progress lines on stderr.
+  }
   SFT_RETURN_IF_ERROR(LoadMaterial(cli->material.empty() ? kInitialMaterial : cli->material,
                                    state.mesh, &state.material));
   if (config.environment.find_lamp) {

@@ -70,13 +70,16 @@ struct LevelCache {
   }
 };
 
+// Residuals per pixel block: its R, G and B differences.
+constexpr int kPixelResiduals = 3;
+
 class PyramidPixelCost : public ceres::CostFunction {
  public:
   // `level` and `finite` are owned by the render cache and outlive the cost function.
   PyramidPixelCost(const LevelCache* level, const bool* finite, int pixel,
                    std::vector<int> block_offsets, const std::vector<int>& block_sizes)
       : level_(level), finite_(finite), pixel_(pixel), offsets_(std::move(block_offsets)) {
-    set_num_residuals(3);
+    set_num_residuals(kPixelResiduals);
     for (int size : block_sizes) mutable_parameter_block_sizes()->push_back(size);
   }
 

@@ -4,7 +4,10 @@
 
 #include <algorithm>
 #include <chrono>
+#include <limits>
 #include <set>
+
+#include "src/core/memory.h"
 
 namespace sft {
 namespace {
@@ -87,11 +90,47 @@ void CollectSupersets(RenderCache* cache, const SceneParameters& params, int ren
   cache->SetSeed(seed);
 }
 
+// Refuses a problem whose Jacobian Ceres cannot index (its block-sparse matrix counts entries in
+// an int) or that does not fit into the available memory, with one line that says what to
+// change. Bytes: 8 per Jacobian value, and about 32 per (residual block, parameter block) cell for
+// Ceres' block structure, the residual blocks' parameter lists and the costs' offsets.
+Status CheckJacobianSize(const std::vector<std::vector<PixelBlocks>>& supersets,
+                         const SceneParameters& params, int64_t max_values) {
+  int64_t cells = 0, values = 0;
+  for (const std::vector<PixelBlocks>& view : supersets) {
+    for (const PixelBlocks& level : view) {
+      for (const std::vector<int>& offsets : level) {
+        cells += static_cast<int64_t>(offsets.size());
+        for (int offset : offsets) values += kPixelResiduals * params.BlockOf(offset).size;
+      }
+    }
+  }
+  const std::string hint =
+      "; lower this stage's image_scale or texel_resolution, or fit it with \"solver\": "
+      "\"adam\"";
+  if (values > max_values) {
+    return Status::Error("the Levenberg-Marquardt problem's Jacobian would hold " +
+                         std::to_string(values) + " values, more than the " +
+                         std::to_string(max_values) + " allowed (Ceres indexes them with an int)" +
+                         hint);
+  }
+  std::string why;
+  const uint64_t bytes = 8 * static_cast<uint64_t>(values) + 32 * static_cast<uint64_t>(cells);
+  if (!CheckMemoryBudget(bytes, "the Levenberg-Marquardt problem's Jacobian", &why)) {
+    return Status::Error(why + hint);
+  }
+  return Status::Ok();
+}
+
 }  // namespace
 
 bool ProblemOptions::Check(std::string* why) const {
   if (superset_renders < 1 || superset_renders > 8) {
     *why = "superset_renders: must be in [1, 8]";
+    return false;
+  }
+  if (max_jacobian_values < 1 || max_jacobian_values > std::numeric_limits<int>::max()) {
+    *why = "max_jacobian_values: must be in [1, 2147483647]";
     return false;
   }
   return bounds.Check(why);
@@ -107,7 +146,10 @@ Status ReconstructionProblem::Build(RenderCache* cache, SceneParameters* params,
   // Without an image term (regularizers only) there are no pixel blocks to build.
   const bool image_term = cache->level(0, 0).sqrt_weight > 0.0;
   std::vector<std::vector<PixelBlocks>> supersets;
-  if (image_term) CollectSupersets(cache, *params, options.superset_renders, &supersets);
+  if (image_term) {
+    CollectSupersets(cache, *params, options.superset_renders, &supersets);
+    SFT_RETURN_IF_ERROR(CheckJacobianSize(supersets, *params, options.max_jacobian_values));
+  }
 
   // The problem owns every cost function: the pixel costs below and the regularizers that
   // SolverHooks::add_regularizers adds later.

@@ -11,6 +11,8 @@
 
 #include <ceres/problem.h>
 
+#include <cstdint>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -24,6 +26,10 @@ namespace sft {
 struct ProblemOptions {
   int superset_renders = 2;  // renders whose touched blocks form each pixel's superset, [1, 8].
   ParameterBounds bounds;    // the feasible set.
+  // The most Jacobian values (residuals × parameters over all cells) a build accepts, [1, 2^31 −
+  // 1]: Ceres' block-sparse matrix indexes its values with an int. A larger problem, or one whose
+  // Jacobian does not fit into the available memory, is an error that names what to change.
+  int64_t max_jacobian_values = std::numeric_limits<int>::max();
 
   bool Check(std::string* why) const;
 };

@@ -541,14 +541,17 @@ Status Schedule::RunStageOuter(const ScheduleCallbacks& callbacks, bool* stop) {
   const int outer = progress_.outer_done;
   json plan_record;
   SFT_RETURN_IF_ERROR(PlanEffects(callbacks, &plan_record));
-  SFT_RETURN_IF_ERROR(reconstruction_->RunOuter(outer, [&](const IterationRecord& record) {
+  const auto on_iteration = [&](const IterationRecord& record) {
     IterationRecord r = record;
     r.stage = stage.name;
     records_.push_back(r);
     const bool go_on = !callbacks.on_iteration || callbacks.on_iteration(r);
     *stop = *stop || !go_on;
     return go_on;
-  }));
+  };
+  // A failure names its stage: the fix is usually one of that stage's keys.
+  SFT_RETURN_IF_ERROR(
+      reconstruction_->RunOuter(outer, on_iteration).Prefixed("stage " + stage.name));
   SyncCurrent();
   if (callbacks.on_event && stage.fit.fit_environment_rotation) {
     for (const std::string& line : ProbeRotationLines(*dataset_, current_.environment_rotations)) {

@@ -42,8 +42,15 @@ Status ChooseStart(const Dataset& dataset, const std::string& init_path, StartCh
 
 Status LoadStartMesh(const Dataset& dataset, const StartChoice& choice,
                      const InitialMeshOptions& carve, TriMesh* mesh,
-                     const std::vector<int>& excluded_views) {
-  if (choice.kind != StartKind::kCarved) return ReadMesh(choice.path, mesh);
+                     const std::vector<int>& excluded_views, std::string* summary) {
+  if (choice.kind != StartKind::kCarved) {
+    SFT_RETURN_IF_ERROR(ReadMesh(choice.path, mesh));
+    if (summary != nullptr) {
+      *summary = "start: " + choice.path + " (" + choice.Describe() + ", " +
+                 std::to_string(mesh->n_faces()) + " faces)";
+    }
+    return Status::Ok();
+  }
   // Held-out masks are not even read: neither their content nor their absence may change the
   // start.
   std::vector<int> carved;
@@ -58,9 +65,17 @@ Status LoadStartMesh(const Dataset& dataset, const StartChoice& choice,
   UseDatasetSupport(dataset, &options.hull);
   InitialMeshReport report;
   SFT_RETURN_IF_ERROR(MakeInitialMesh(views, options, /*sparse_points=*/{}, mesh, &report));
-  if (!options.stereo) return Status::Ok();
-  StereoMeshReport stereo;
-  return MakeStereoMesh(dataset, carved, views, *mesh, options, mesh, &stereo);
+  std::string how = "the hull carved from " + std::to_string(carved.size()) + " views' masks";
+  if (options.stereo) {
+    StereoMeshReport stereo;
+    SFT_RETURN_IF_ERROR(MakeStereoMesh(dataset, carved, views, *mesh, options, mesh, &stereo));
+    how += ", rebuilt from stereo (" + std::to_string(stereo.stereo.points) + " points from " +
+           std::to_string(stereo.stereo.pairs) + " view pairs)";
+  }
+  if (summary != nullptr) {
+    *summary = "start: " + how + ", " + std::to_string(mesh->n_faces()) + " faces";
+  }
+  return Status::Ok();
 }
 
 }  // namespace sft

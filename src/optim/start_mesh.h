@@ -33,10 +33,12 @@ struct StartChoice {
 Status ChooseStart(const Dataset& dataset, const std::string& init_path, StartChoice* choice);
 
 // Loads (or carves, with `carve` options) the start mesh. Carving neither reads nor uses the masks
-// of `excluded_views` (held-out views, src/optim/holdout.h).
+// of `excluded_views` (held-out views, src/optim/holdout.h). *summary (when given) gets one line
+// for the console: the start's source, how a carved start was made (views, stereo points and
+// pairs) and its face count.
 Status LoadStartMesh(const Dataset& dataset, const StartChoice& choice,
                      const InitialMeshOptions& carve, TriMesh* mesh,
-                     const std::vector<int>& excluded_views = {});
+                     const std::vector<int>& excluded_views = {}, std::string* summary = nullptr);
 
 }  // namespace sft
 

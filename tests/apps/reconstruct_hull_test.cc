@@ -43,6 +43,7 @@ TEST(ReconstructHullTest, CarveRefineRemeshResampleTexture) {
             0)
       << out;
   // One line per stage start and per topology change, the stage names on the progress line.
+  EXPECT_THAT(out, HasSubstr("start: the hull carved from 8 views' masks, "));
   EXPECT_THAT(out, HasSubstr("stage 1/9 material_quarter"));
   EXPECT_THAT(out, HasSubstr("remesh adaptive"));
   EXPECT_THAT(out, HasSubstr("resample"));

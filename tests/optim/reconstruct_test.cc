@@ -405,6 +405,37 @@ TEST_F(ReconstructTest, GradientsMatchFiniteDifferencesOfTheCost) {
   }
 }
 
+// A problem whose Jacobian would pass the allowed size is refused with one line that names what to
+// change, and nothing is built; at exactly its size it builds.
+TEST_F(ReconstructTest, OversizedJacobianIsRefusedWithOneLine) {
+  FitSetup s;
+  MakeSetup(dataset_, mesh_, guess_, options_.cache, ActiveParameters(), &s);
+  std::unique_ptr<ReconstructionProblem> problem;
+  ProblemOptions problem_options;
+  ASSERT_TRUE(
+      ReconstructionProblem::Build(s.cache.get(), &s.params, problem_options, &problem).ok());
+  const int64_t values = kPixelResiduals * problem->stats().superset_entries;
+  ASSERT_GT(values, 1000);
+  problem_options.max_jacobian_values = values - 1;
+  std::unique_ptr<ReconstructionProblem> refused;
+  const Status status =
+      ReconstructionProblem::Build(s.cache.get(), &s.params, problem_options, &refused);
+  ASSERT_FALSE(status.ok());
+  EXPECT_EQ(refused, nullptr);
+  EXPECT_NE(status.message().find("would hold " + std::to_string(values) + " values"),
+            std::string::npos)
+      << status.message();
+  EXPECT_NE(status.message().find("image_scale"), std::string::npos);
+  EXPECT_NE(status.message().find("\"adam\""), std::string::npos);
+  EXPECT_EQ(status.message().find('\n'), std::string::npos);
+  problem_options.max_jacobian_values = values;
+  EXPECT_TRUE(
+      ReconstructionProblem::Build(s.cache.get(), &s.params, problem_options, &refused).ok());
+  problem_options.max_jacobian_values = 0;
+  EXPECT_FALSE(
+      ReconstructionProblem::Build(s.cache.get(), &s.params, problem_options, &refused).ok());
+}
+
 // A minibatch of the adjoint objective (Adam's views_per_step) is the batch views' part of the
 // full objective scaled by views / batch: cost and gradient, at the same point and seed.
 TEST_F(ReconstructTest, MinibatchObjectiveIsTheScaledPartOfItsViews) {

@@ -51,6 +51,14 @@ TEST(StartMeshTest, CarvingIgnoresExcludedViewsMasks) {
   const TriMesh clean_all = Carve(dataset, {});
   const TriMesh clean_fitted = Carve(dataset, {0, 3});
   ASSERT_GT(clean_fitted.n_faces(), 100u);
+  // The console line names the views carved and the faces.
+  TriMesh summarized;
+  std::string summary;
+  ASSERT_TRUE(
+      LoadStartMesh(dataset, {StartKind::kCarved, ""}, SmallCarve(), &summarized, {0, 3}, &summary)
+          .ok());
+  EXPECT_EQ(summary, "start: the hull carved from 4 views' masks, " +
+                         std::to_string(clean_fitted.n_faces()) + " faces");
 
   // View 0's mask with a hole: used, it changes the hull; excluded, the hull is the carve of the
   // other views to the vertex.
