@@ -1,7 +1,9 @@
 #include "src/eval/model_viewer.h"
 
 #include <Eigen/Core>
+#include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <vector>
 
@@ -77,7 +79,7 @@ constexpr char kViewerScript[] = R"JS(
   View.prototype.frame = function (box) {
     var c = box.getCenter(new THREE.Vector3()), r = box.getSize(new THREE.Vector3()).length() / 2;
     this.controls.target.copy(c);
-    var from = new THREE.Vector3(0.35, 0.25, 1).normalize().multiplyScalar(2.5 * r);
+    var from = new THREE.Vector3(@FROM@).normalize().multiplyScalar(2.5 * r);
     this.camera.position.copy(c).add(from);
     this.camera.near = r / 100; this.camera.far = r * 100;
     this.camera.updateProjectionMatrix();
@@ -166,6 +168,29 @@ Status StartMeshBytes(const std::string& path, const Dataset& dataset, std::stri
   positions->assign(reinterpret_cast<const char*>(xyz.data()), xyz.size() * sizeof(float));
   indices->assign(reinterpret_cast<const char*>(tri.data()), tri.size() * sizeof(uint32_t));
   return Status::Ok();
+}
+
+// The direction (GLB frame, Y-up, unit) the two views look at the object from when the page opens:
+// back along view 0's optical axis, so the object first appears as the first photograph shows it
+// (a fixed direction can show a capture's unseen underside). A dataset without views: a fixed
+// three-quarter view. Printed as "x, y, z" for the script.
+std::string ViewerFrom(const Dataset& dataset) {
+  Eigen::Vector3d from(0.35, 0.25, 1.0);
+  if (!dataset.views.empty()) {
+    const Eigen::Quaterniond world_from_cam = dataset.views[0].cam_from_world.rotation.conjugate();
+    Eigen::Vector3d toward_camera = -(world_from_cam * Eigen::Vector3d::UnitZ());
+    if (dataset.has_source_from_world) {
+      toward_camera = dataset.source_from_world.rotation * toward_camera;
+    }
+    from = Eigen::Vector3d(toward_camera.x(), toward_camera.z(), -toward_camera.y());  // Y-up.
+  }
+  from.normalize();
+  // Components below the printed precision as 0, not "-0.000000".
+  const auto printed = [](double v) { return std::abs(v) < 5e-7 ? 0.0 : v; };
+  char text[96];
+  std::snprintf(text, sizeof(text), "%.6f, %.6f, %.6f", printed(from.x()), printed(from.y()),
+                printed(from.z()));
+  return text;
 }
 
 // Copies three.js into report_files/three/; false (no error) when three_dir lacks a file.
@@ -281,6 +306,7 @@ Status AddModelViewer(const ModelViewerOptions& options, const Dataset& dataset,
   ReplaceAll("@START_POSITIONS@", Base64Encode(start_positions), &script);
   ReplaceAll("@START_INDICES@", Base64Encode(start_indices), &script);
   ReplaceAll("@GLB@", Base64Encode(glb), &script);
+  ReplaceAll("@FROM@", ViewerFrom(dataset), &script);
   html->AddHtml(section + "<script>" + script + "</script>" + maps);
   return Status::Ok();
 }

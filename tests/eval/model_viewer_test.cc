@@ -96,6 +96,34 @@ TEST_F(ModelViewerFixture, SourceFrameIsApplied) {
       HasSubstr(Base64Encode(std::string(reinterpret_cast<const char*>(xyz), sizeof(xyz)))));
 }
 
+// The page opens looking back along view 0's optical axis (in the export's Y-up frame), and from
+// a fixed three-quarter direction without views.
+TEST_F(ModelViewerFixture, OpensFromTheFirstViewsDirection) {
+  {
+    HtmlReport html(tmp_.Join("report"), "t");
+    ASSERT_TRUE(AddModelViewer(options_, dataset_, &html).ok());
+    EXPECT_THAT(html.Html(), HasSubstr("new THREE.Vector3(0.321521, 0.229658, 0.918630)"));
+  }
+  // A camera at +x looking at the origin: its optical axis is −x in the world, so the viewer looks
+  // from +x; the source frame's 90° turn about z takes +x to +y, which is −z in Y-up.
+  ViewSpec view;
+  view.cam_from_world.rotation =
+      Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitY()) * Eigen::Quaterniond::Identity();
+  ASSERT_NEAR((view.cam_from_world.rotation.conjugate() * Eigen::Vector3d::UnitZ()).x(), -1.0,
+              1e-12);
+  dataset_.views.push_back(view);
+  {
+    HtmlReport html(tmp_.Join("report"), "t");
+    ASSERT_TRUE(AddModelViewer(options_, dataset_, &html).ok());
+    EXPECT_THAT(html.Html(), HasSubstr("new THREE.Vector3(1.000000, 0.000000, 0.000000)"));
+  }
+  dataset_.has_source_from_world = true;
+  dataset_.source_from_world.rotation = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ());
+  HtmlReport html(tmp_.Join("report"), "t");
+  ASSERT_TRUE(AddModelViewer(options_, dataset_, &html).ok());
+  EXPECT_THAT(html.Html(), HasSubstr("new THREE.Vector3(0.000000, 0.000000, -1.000000)"));
+}
+
 TEST_F(ModelViewerFixture, WithoutStartMeshOnlyTheResult) {
   options_.start_mesh.clear();
   HtmlReport html(tmp_.Join("report"), "t");
