@@ -171,7 +171,8 @@ TEST(ScheduleConfigTest, ShippedGlossyRefineSchedulesParse) {
 
 // The shipped list for real captures without a probe (data/example/real_ring.json,
 // docs/reconstruct.md "Real captures without a probe"): a stereo start of 30,000 faces, every 8th
-// view held out, a growing scale that alternates texture and geometry, and a final texture stage.
+// view held out, a growing scale that alternates texture and geometry, and two final texture
+// stages, the last at full scale.
 TEST(ScheduleConfigTest, ShippedRealRingScheduleParses) {
   ScheduleConfig config;
   const Status status = ReadScheduleConfig(testing::DataDir() + "/example/real_ring.json", &config);
@@ -182,7 +183,7 @@ TEST(ScheduleConfigTest, ShippedRealRingScheduleParses) {
   EXPECT_EQ(config.holdout, 8);
   std::vector<StageOptions> stages;
   ASSERT_TRUE(ResolveStages(config, /*carved_start=*/true, &stages).ok());
-  ASSERT_EQ(stages.size(), 5u);
+  ASSERT_EQ(stages.size(), 6u);
   int last_scale_log2 = 10;
   for (const StageOptions& stage : stages) {
     SCOPED_TRACE(stage.name);
@@ -195,6 +196,9 @@ TEST(ScheduleConfigTest, ShippedRealRingScheduleParses) {
   EXPECT_EQ(stages.front().fit.cache.image_scale_log2, 3);
   EXPECT_EQ(stages[1].fit.phases, PhaseSchedule::kGeometry);
   EXPECT_EQ(stages.back().fit.phases, PhaseSchedule::kTexture);
+  // The last stage fits texels at full scale with Adam: LM's Jacobian would not fit there.
+  EXPECT_EQ(stages.back().fit.cache.image_scale_log2, 0);
+  EXPECT_EQ(stages.back().fit.solver.kind, SolverKind::kAdam);
 }
 
 // A step's progress work: pixels × spp, and for an Adam minibatch its share of the fitted views.
