@@ -190,7 +190,8 @@ TEST(ScheduleConfigTest, ShippedRealRingScheduleParses) {
     EXPECT_LE(stage.fit.cache.image_scale_log2, last_scale_log2);  // coarse to fine.
     last_scale_log2 = stage.fit.cache.image_scale_log2;
     EXPECT_FALSE(stage.fit.fit_specular);
-    // Unweighted, as the held-out PSNR it is measured by (the relative loss lost 0.7 dB there).
+    // Unweighted, as the held-out PSNR it is measured by (docs/design-notes.md, "The dino's last
+    // texture stage").
     EXPECT_EQ(stage.fit.cache.image_loss, ImageLoss::kL2);
   }
   EXPECT_EQ(stages.front().fit.cache.image_scale_log2, 3);
